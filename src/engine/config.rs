@@ -1,0 +1,182 @@
+//! The model's constants and the allowed range of every input, shared by the engine's sanitising,
+//! the scene validator and the plugin's parameters so that all three agree.
+
+/// An input's allowed closed range and its default (MODEL.md).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    pub min: f64,
+    pub max: f64,
+    pub default: f64,
+}
+
+impl Range {
+    const fn new(min: f64, max: f64, default: f64) -> Self {
+        Self { min, max, default }
+    }
+
+    pub fn contains(&self, value: f64) -> bool {
+        value >= self.min && value <= self.max
+    }
+
+    /// Brings any f64 into range: NaN becomes the default, ±∞ and outliers the nearest bound.
+    #[inline]
+    pub fn sanitize(&self, value: f64) -> f64 {
+        if value.is_nan() {
+            self.default
+        } else {
+            value.clamp(self.min, self.max)
+        }
+    }
+}
+
+pub const SAMPLE_RATE_HZ: Range = Range::new(1_000.0, 768_000.0, 48_000.0);
+pub const TILT_DEG: Range = Range::new(0.0, 180.0, 0.0);
+pub const VISCOSITY: Range = Range::new(0.0, 1.0, 0.33);
+pub const FILL_PERCENT: Range = Range::new(0.0, 100.0, 100.0);
+pub const POUR_TIME_S: Range = Range::new(0.01, 3600.0, 5.0);
+pub const GAIN_DB: Range = Range::new(-120.0, 24.0, -6.0);
+pub const CAPACITY_ML: Range = Range::new(1.0, 100_000.0, 300.0);
+pub const POCKET_ML: Range = Range::new(0.001, 1_000.0, 5.0);
+pub const F1_HZ: Range = Range::new(0.0, 400_000.0, 80.0);
+pub const F2_HZ: Range = Range::new(0.0, 400_000.0, 300.0);
+pub const B1_PER_S: Range = Range::new(0.0, 1e9, 45.0);
+pub const B2_PER_S: Range = Range::new(0.0, 1e9, 40.0);
+/// Below 1 so that a pocket volume b·(1 + j·u) is always positive.
+pub const TIMING_JITTER: Range = Range::new(0.0, 0.95, 0.15);
+pub const FREQ_JITTER: Range = Range::new(0.0, 1.0, 0.05);
+pub const DECAY_SIGMA: Range = Range::new(0.0, 3.0, 0.35);
+pub const CEILING: Range = Range::new(0.001, 1.0, 1.0);
+
+/// How the residual volume evolves (MODEL.md §8).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DrainMode {
+    /// V drains by the outflow of §3.
+    #[default]
+    Simulate,
+    /// V is the fill level at every sample; the outflow only drives the onsets.
+    Follow,
+}
+
+/// The constants of the model that do not change sample by sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModelConfig {
+    pub capacity_ml: f64,
+    pub pocket_ml: f64,
+    /// f1, f2 of §5.
+    pub frequency_hz: [f64; 2],
+    /// B1, B2 of §5 (amplitude decay rates).
+    pub decay_per_s: [f64; 2],
+    pub timing_jitter: f64,
+    pub freq_jitter: f64,
+    pub decay_sigma: f64,
+    pub seed: u64,
+    pub drain: DrainMode,
+    /// The hard output ceiling of §6 (linear).
+    pub ceiling: f64,
+}
+
+impl Default for ModelConfig {
+    fn default() -> Self {
+        Self {
+            capacity_ml: CAPACITY_ML.default,
+            pocket_ml: POCKET_ML.default,
+            frequency_hz: [F1_HZ.default, F2_HZ.default],
+            decay_per_s: [B1_PER_S.default, B2_PER_S.default],
+            timing_jitter: TIMING_JITTER.default,
+            freq_jitter: FREQ_JITTER.default,
+            decay_sigma: DECAY_SIGMA.default,
+            seed: 1,
+            drain: DrainMode::Simulate,
+            ceiling: CEILING.default,
+        }
+    }
+}
+
+impl ModelConfig {
+    /// The same constants with every random spread at zero (MODEL.md §7, "deterministic").
+    pub fn deterministic(self) -> Self {
+        Self {
+            timing_jitter: 0.0,
+            freq_jitter: 0.0,
+            decay_sigma: 0.0,
+            ..self
+        }
+    }
+
+    /// Every field brought into its range, so that no input can make the engine misbehave.
+    pub fn sanitized(self) -> Self {
+        Self {
+            capacity_ml: CAPACITY_ML.sanitize(self.capacity_ml),
+            pocket_ml: POCKET_ML.sanitize(self.pocket_ml),
+            frequency_hz: [
+                F1_HZ.sanitize(self.frequency_hz[0]),
+                F2_HZ.sanitize(self.frequency_hz[1]),
+            ],
+            decay_per_s: [
+                B1_PER_S.sanitize(self.decay_per_s[0]),
+                B2_PER_S.sanitize(self.decay_per_s[1]),
+            ],
+            timing_jitter: TIMING_JITTER.sanitize(self.timing_jitter),
+            freq_jitter: FREQ_JITTER.sanitize(self.freq_jitter),
+            decay_sigma: DECAY_SIGMA.sanitize(self.decay_sigma),
+            ceiling: CEILING.sanitize(self.ceiling),
+            ..self
+        }
+    }
+}
+
+/// The per-sample inputs of the model (MODEL.md §1), as one sample sees them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControlValues {
+    pub tilt_deg: f64,
+    pub viscosity: f64,
+    pub fill_percent: f64,
+    pub pour_time_s: f64,
+}
+
+impl Default for ControlValues {
+    fn default() -> Self {
+        Self {
+            tilt_deg: TILT_DEG.default,
+            viscosity: VISCOSITY.default,
+            fill_percent: FILL_PERCENT.default,
+            pour_time_s: POUR_TIME_S.default,
+        }
+    }
+}
+
+impl ControlValues {
+    #[inline]
+    pub fn sanitized(self) -> Self {
+        Self {
+            tilt_deg: TILT_DEG.sanitize(self.tilt_deg),
+            viscosity: VISCOSITY.sanitize(self.viscosity),
+            fill_percent: FILL_PERCENT.sanitize(self.fill_percent),
+            pour_time_s: POUR_TIME_S.sanitize(self.pour_time_s),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sanitize_maps_nan_to_default_and_infinities_to_bounds() {
+        assert_eq!(TILT_DEG.sanitize(f64::NAN), 0.0);
+        assert_eq!(TILT_DEG.sanitize(f64::INFINITY), 180.0);
+        assert_eq!(POUR_TIME_S.sanitize(f64::NEG_INFINITY), 0.01);
+        assert_eq!(VISCOSITY.sanitize(-3.0), 0.0);
+        assert_eq!(VISCOSITY.sanitize(0.5), 0.5);
+    }
+
+    #[test]
+    fn deterministic_zeroes_every_spread_only() {
+        let config = ModelConfig::default().deterministic();
+        assert_eq!(
+            (config.timing_jitter, config.freq_jitter, config.decay_sigma),
+            (0.0, 0.0, 0.0)
+        );
+        assert_eq!(config.pocket_ml, 5.0);
+    }
+}

@@ -1,0 +1,208 @@
+//! The glug model of MODEL.md as plain Rust: no plugin, GUI or file-format type in here.
+//!
+//! Data flows one way: [`Controls`] (from a scene or a host) → [`Pour`] (bottle, onsets,
+//! randomness) → [`VoiceBank`] (wave units) → the caller's output buffer.
+
+pub mod amplitude;
+pub mod bottle;
+pub mod config;
+pub mod controls;
+pub mod curves;
+pub mod onsets;
+pub mod partial;
+pub mod pour;
+pub mod randomness;
+pub mod synthesis;
+pub mod voices;
+
+pub use config::{ControlValues, DrainMode, ModelConfig};
+pub use controls::{Controls, Lane};
+pub use pour::{Pour, PourStats, UnitOnset};
+pub use synthesis::Synthesis;
+pub use voices::VoiceBank;
+pub 
+use amplitude::db_to_gain;
+use partial::GRID;
+
+/// Renders the model into caller-provided buffers; allocation-free after construction.
+///
+/// The output of a given sample depends only on the controls up to it, never on how the caller
+/// cuts time into blocks. `S` is the synthesis path; the default is the real-time f32 path.
+pub struct Engine<S: Synthesis = VoiceBank> {
+    sample_rate: f64,
+    pour: Pour,
+    voices: S,
+    /// Samples since the last reset: the grid periods and onset times are counted from it.
+    sample: u64,
+    /// The pour's last step changed nothing and would change nothing again under these controls.
+    resting_under: Option<ControlValues>,
+    gain: (f64, f64),
+    last_unit: Option<UnitOnset>,
+}
+
+impl Engine {
+    /// An engine on the default, real-time synthesis path.
+    pub fn new(sample_rate: f64, config: ModelConfig) -> Self {
+        Self::with_synthesis(sample_rate, config)
+    }
+}
+
+impl<S: Synthesis> Engine<S> {
+    /// An engine on synthesis path `S`.
+    pub fn with_synthesis(sample_rate: f64, config: ModelConfig) -> Self {
+        let sample_rate = config::SAMPLE_RATE_HZ.sanitize(sample_rate);
+        let mut engine = Self {
+            sample_rate,
+            pour: Pour::new(sample_rate, config),
+            voices: S::new(sample_rate),
+            sample: 0,
+            resting_under: None,
+            gain: (f64::NAN, 0.0),
+            last_unit: None,
+        };
+        engine.reset();
+        engine
+    }
+
+    pub fn sample_rate(&self) -> f64 {
+        self.sample_rate
+    }
+
+    pub fn config(&self) -> &ModelConfig {
+        self.pour.config()
+    }
+
+    /// New constants apply to units that start from now on; a new seed at the next reset.
+    pub fn set_config(&mut self, config: ModelConfig) {
+        self.pour.set_config(config);
+        self.resting_under = None;
+    }
+
+    /// MODEL.md §8 reset: refill, silence every unit, re-seed.
+    pub fn reset(&mut self) {
+        self.pour.reset();
+        self.voices.clear();
+        self.sample = 0;
+        self.resting_under = None;
+        self.last_unit = None;
+    }
+
+    /// MODEL.md §8 refill: sounding units ring on, the generator goes on.
+    pub fn refill(&mut self) {
+        self.pour.refill();
+        self.resting_under = None;
+    }
+
+    pub fn volume_ml(&self) -> f64 {
+        self.pour.volume_ml()
+    }
+
+    pub fn stats(&self) -> PourStats {
+        self.pour.stats()
+    }
+
+    /// The unit that started last, if any since the reset.
+    pub fn last_unit(&self) -> Option<&UnitOnset> {
+        self.last_unit.as_ref()
+    }
+
+    /// Components currently sounding.
+    pub fn sounding_components(&self) -> usize {
+        self.voices.len()
+    }
+
+    /// Components given up because more were sounding than the engine voices.
+    pub fn components_given_up(&self) -> u64 {
+        self.voices.given_up()
+    }
+
+    /// Samples rendered since the last reset.
+    pub fn position(&self) -> u64 {
+        self.sample
+    }
+
+    /// Nothing sounds and, under constant controls, nothing would start: the rest is silence.
+    pub fn is_settled(&self) -> bool {
+        self.voices.is_empty() && self.resting_under.is_some()
+    }
+
+    /// Renders `out.len()` samples; `controls` give the inputs from the block's first sample.
+    pub fn process(&mut self, controls: &Controls, out: &mut [f32]) {
+        let mut done = 0;
+        while done < out.len() {
+            let period_end = (self.sample / GRID as u64 + 1) * GRID as u64;
+            let span = (out.len() - done).min((period_end - self.sample) as usize);
+            self.process_span(&controls.offset(done), &mut out[done..done + span]);
+            done += span;
+        }
+    }
+
+    /// Renders a span that lies within one grid period.
+    fn process_span(&mut self, controls: &Controls, out: &mut [f32]) {
+        out.fill(0.0);
+        self.step_pour(controls, out.len());
+        if self.voices.is_empty() {
+            self.advance_position(out.len());
+            return;
+        }
+        self.voices.render(self.sample, out);
+        self.apply_output_stage(controls, out);
+        self.advance_position(out.len());
+    }
+
+    fn step_pour(&mut self, controls: &Controls, len: usize) {
+        let constant = controls.pour_is_constant();
+        if constant && self.resting_under == Some(controls.values_at(0)) {
+            return;
+        }
+        let Self {
+            pour,
+            voices,
+            last_unit,
+            ..
+        } = self;
+        let mut outflow = None;
+        let mut values = controls.values_at(0);
+        for index in 0..len {
+            values = controls.values_at(index);
+            let step = pour.step(self.sample + index as u64, values, |onset| {
+                voices.start_unit(onset);
+                *last_unit = Some(*onset);
+            });
+            outflow = Some(step);
+        }
+        self.resting_under = match outflow {
+            Some(step) if constant && step.amount_ml == 0.0 && !step.refilled => Some(values),
+            _ => None,
+        };
+    }
+
+    /// Output gain, then the guarantees of MODEL.md §6: finite, within the ceiling, no denormal.
+    fn apply_output_stage(&mut self, controls: &Controls, out: &mut [f32]) {
+        let ceiling = self.pour.config().ceiling as f32;
+        for (index, y) in out.iter_mut().enumerate() {
+            let gain = self.gain_at(controls.gain_db.at(index));
+            let value = (*y as f64 * gain) as f32;
+            *y = if value.is_nan() || value.abs() < f32::MIN_POSITIVE {
+                0.0
+            } else {
+                value.clamp(-ceiling, ceiling)
+            };
+        }
+    }
+
+    #[inline]
+    fn gain_at(&mut self, gain_db: f64) -> f64 {
+        if gain_db.to_bits() != self.gain.0.to_bits() {
+            self.gain = (gain_db, db_to_gain(config::GAIN_DB.sanitize(gain_db)));
+        }
+        self.gain.1
+    }
+
+    fn advance_position(&mut self, len: usize) {
+        self.sample += len as u64;
+        if self.sample % GRID as u64 == 0 {
+            self.voices.advance(self.sample);
+        }
+    }
+}

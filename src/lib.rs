@@ -1,0 +1,5 @@
+//! Sake Glug: the glug vibration of liquid poured from a Japanese sake bottle, as a CLAP/VST3
+//! plugin and an offline renderer that drive the same engine.
+
+pub mod engine;
+pub mod reference;
