@@ -12,12 +12,14 @@ pub mod onsets;
 pub mod partial;
 pub mod pour;
 pub mod randomness;
+pub mod recursive;
 pub mod synthesis;
 pub mod voices;
 
 pub use config::{ControlValues, DrainMode, ModelConfig};
 pub use controls::{Controls, Lane};
 pub use pour::{Pour, PourStats, UnitOnset};
+pub use recursive::{RecursiveF32, RecursiveF64};
 pub use synthesis::Synthesis;
 pub use voices::VoiceBank;
 pub 
