@@ -40,6 +40,8 @@ pub struct Engine<S: Synthesis = VoiceBank> {
     resting_under: Option<ControlValues>,
     gain: (f64, f64),
     last_unit: Option<UnitOnset>,
+    /// The sample after the last one during which liquid flowed or a component sounded.
+    active_until: u64,
 }
 
 impl Engine {
@@ -61,6 +63,7 @@ impl<S: Synthesis> Engine<S> {
             resting_under: None,
             gain: (f64::NAN, 0.0),
             last_unit: None,
+            active_until: 0,
         };
         engine.reset();
         engine
@@ -87,6 +90,7 @@ impl<S: Synthesis> Engine<S> {
         self.sample = 0;
         self.resting_under = None;
         self.last_unit = None;
+        self.active_until = 0;
     }
 
     /// MODEL.md §8 refill: sounding units ring on, the generator goes on.
@@ -123,6 +127,12 @@ impl<S: Synthesis> Engine<S> {
         self.sample
     }
 
+    /// The sample after the last one during which liquid flowed or a component sounded: where a
+    /// render that runs "until pouring stops and every unit has decayed" ends.
+    pub fn active_until(&self) -> u64 {
+        self.active_until
+    }
+
     /// Nothing sounds and, under constant controls, nothing would start: the rest is silence.
     pub fn is_settled(&self) -> bool {
         self.voices.is_empty() && self.resting_under.is_some()
@@ -148,6 +158,7 @@ impl<S: Synthesis> Engine<S> {
             return;
         }
         self.voices.render(self.sample, out);
+        self.active_until = self.sample + out.len() as u64;
         self.apply_output_stage(controls, out);
         self.advance_position(out.len());
     }
@@ -167,10 +178,14 @@ impl<S: Synthesis> Engine<S> {
         let mut values = controls.values_at(0);
         for index in 0..len {
             values = controls.values_at(index);
-            let step = pour.step(self.sample + index as u64, values, |onset| {
+            let sample = self.sample + index as u64;
+            let step = pour.step(sample, values, |onset| {
                 voices.start_unit(onset);
                 *last_unit = Some(*onset);
             });
+            if step.amount_ml > 0.0 {
+                self.active_until = sample + 1;
+            }
             outflow = Some(step);
         }
         self.resting_under = match outflow {

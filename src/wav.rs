@@ -1,0 +1,131 @@
+//! Writing renders to WAV files all or nothing: samples go to a temporary file beside the target,
+//! which replaces the target only once complete, so a failed render never leaves a partial file.
+
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use hound::{SampleFormat as HoundFormat, WavSpec, WavWriter};
+use tempfile::NamedTempFile;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum SampleFormat {
+    /// 32-bit float.
+    #[default]
+    F32,
+    /// 24-bit integer.
+    S24,
+    /// 16-bit integer.
+    S16,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum WavError {
+    #[error("cannot write {}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot write {}: {source}", path.display())]
+    Encode { path: PathBuf, source: hound::Error },
+}
+
+/// A mono WAV file being written; it appears at its path only on [`WavFile::commit`].
+pub struct WavFile {
+    path: PathBuf,
+    temp: NamedTempFile,
+    writer: WavWriter<BufWriter<std::fs::File>>,
+    format: SampleFormat,
+}
+
+impl WavFile {
+    pub fn create(path: &Path, sample_rate: u32, format: SampleFormat) -> Result<Self, WavError> {
+        let io_error = |source| WavError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let directory = match path.parent() {
+            Some(parent) if !parent.as_os_str().is_empty() => parent,
+            _ => Path::new("."),
+        };
+        let temp = NamedTempFile::new_in(directory).map_err(io_error)?;
+        let file = temp.reopen().map_err(io_error)?;
+        let (bits_per_sample, sample_format) = match format {
+            SampleFormat::F32 => (32, HoundFormat::Float),
+            SampleFormat::S24 => (24, HoundFormat::Int),
+            SampleFormat::S16 => (16, HoundFormat::Int),
+        };
+        let spec = WavSpec {
+            channels: 1,
+            sample_rate,
+            bits_per_sample,
+            sample_format,
+        };
+        let writer = WavWriter::new(BufWriter::new(file), spec).map_err(|source| WavError::Encode {
+            path: path.to_owned(),
+            source,
+        })?;
+        Ok(Self {
+            path: path.to_owned(),
+            temp,
+            writer,
+            format,
+        })
+    }
+
+    pub fn write(&mut self, samples: &[f32]) -> Result<(), WavError> {
+        let result = match self.format {
+            SampleFormat::F32 => samples.iter().try_for_each(|&y| self.writer.write_sample(y)),
+            SampleFormat::S24 => samples
+                .iter()
+                .try_for_each(|&y| self.writer.write_sample(quantize(y, 23))),
+            SampleFormat::S16 => samples
+                .iter()
+                .try_for_each(|&y| self.writer.write_sample(quantize(y, 15) as i16)),
+        };
+        result.map_err(|source| self.encode_error(source))
+    }
+
+    /// Completes the file and moves it into place.
+    pub fn commit(self) -> Result<(), WavError> {
+        let Self {
+            path, temp, writer, ..
+        } = self;
+        writer.finalize().map_err(|source| WavError::Encode {
+            path: path.clone(),
+            source,
+        })?;
+        temp.persist(&path).map_err(|error| WavError::Io {
+            path,
+            source: error.error,
+        })?;
+        Ok(())
+    }
+
+    fn encode_error(&self, source: hound::Error) -> WavError {
+        WavError::Encode {
+            path: self.path.clone(),
+            source,
+        }
+    }
+}
+
+/// Rounds a sample in [−1, 1] to a signed integer of `fraction_bits` + 1 bits, saturating.
+fn quantize(sample: f32, fraction_bits: u32) -> i32 {
+    let full_scale = (1i64 << fraction_bits) as f64;
+    (sample as f64 * full_scale)
+        .round()
+        .clamp(-full_scale, full_scale - 1.0) as i32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::quantize;
+
+    #[test]
+    fn quantize_rounds_and_saturates() {
+        assert_eq!(quantize(0.5, 15), 16_384);
+        assert_eq!(quantize(1.0, 15), 32_767);
+        assert_eq!(quantize(-1.0, 15), -32_768);
+        assert_eq!(quantize(-2.0, 23), -8_388_608);
+    }
+}
