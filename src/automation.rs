@@ -120,14 +120,30 @@ impl<'de> Visitor<'de> for AutomationVisitor {
     }
 }
 
-/// One `[time_s, value]` pair, numbers either integer or float.
+/// One `[time_s, value]` pair, numbers either integer or float, nothing more.
 struct Point(f64, f64);
 
 impl<'de> Deserialize<'de> for Point {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let [time_s, value] = <[Number; 2]>::deserialize(deserializer)
-            .map_err(|_| de::Error::custom("each point must be a [time_s, value] pair of numbers"))?;
-        Ok(Point(time_s.0, value.0))
+        struct PointVisitor;
+        impl<'de> Visitor<'de> for PointVisitor {
+            type Value = Point;
+            fn expecting(&self, formatter: &mut fmt::Formatter) -> fmt::Result {
+                formatter.write_str("a [time_s, value] pair of numbers")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Point, A::Error> {
+                let pair_error = || de::Error::custom("each point must be a [time_s, value] pair of numbers");
+                let time_s: Number = seq.next_element()?.ok_or_else(pair_error)?;
+                let value: Number = seq.next_element()?.ok_or_else(pair_error)?;
+                if seq.next_element::<de::IgnoredAny>()?.is_some() {
+                    return Err(pair_error());
+                }
+                Ok(Point(time_s.0, value.0))
+            }
+        }
+        deserializer
+            .deserialize_seq(PointVisitor)
+            .map_err(|_: D::Error| de::Error::custom("each point must be a [time_s, value] pair of numbers"))
     }
 }
 
