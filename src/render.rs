@@ -2,7 +2,7 @@
 
 use std::time::{Duration, Instant};
 
-use crate::engine::Engine;
+use crate::engine::{DrainMode, Engine};
 use crate::scene::{LaneBuffers, Scene, MAX_DURATION_S};
 
 /// Samples per engine call offline; any size gives the same samples.
@@ -11,8 +11,8 @@ pub const BLOCK_SIZE: usize = 4096;
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
     #[error(
-        "the scene still sounds {MAX_DURATION_S} s in (it pours or rings for ever, e.g. in follow \
-         mode or with a decay of 0); give it a duration_s"
+        "the scene never falls silent (it pours or rings for ever after its last automation \
+         point, or past {MAX_DURATION_S} s), so it has no natural end; give it a duration_s"
     )]
     NeverSettles,
 }
@@ -82,11 +82,11 @@ pub fn render<E: From<RenderError>>(
                 held_zeros = (len - last - 1) as u64;
             }
         }
-        if total.is_none() {
-            if engine.position() >= settle_from && engine.is_settled() {
+        if total.is_none() && position >= settle_from {
+            if engine.is_settled() {
                 break;
             }
-            if engine.position() >= give_up_at {
+            if endless(scene, &engine) || engine.position() >= give_up_at {
                 return Err(RenderError::NeverSettles.into());
             }
         }
@@ -100,6 +100,16 @@ pub fn render<E: From<RenderError>>(
         peak,
         elapsed: started.elapsed(),
     })
+}
+
+/// Whether, with the controls held still for good, the scene can be seen never to fall silent:
+/// follow mode holds the volume, so a bottle still pouring pours for ever, and a decay rate of 0
+/// rings for ever.
+fn endless(scene: &Scene, engine: &Engine) -> bool {
+    let pours_for_ever = scene.config.drain == DrainMode::Follow && !engine.is_resting();
+    let rings_for_ever =
+        scene.config.decay_per_s.contains(&0.0) && engine.sounding_components() > 0;
+    pours_for_ever || rings_for_ever
 }
 
 fn write_zeros<E>(sink: &mut impl FnMut(&[f32]) -> Result<(), E>, count: u64) -> Result<(), E> {

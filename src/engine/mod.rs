@@ -133,6 +133,11 @@ impl<S: Synthesis> Engine<S> {
         self.active_until
     }
 
+    /// Under the controls of the last block, which were constant, no liquid flows.
+    pub fn is_resting(&self) -> bool {
+        self.resting_under.is_some()
+    }
+
     /// Nothing sounds and, under constant controls, nothing would start: the rest is silence.
     pub fn is_settled(&self) -> bool {
         self.voices.is_empty() && self.resting_under.is_some()
