@@ -1,3 +1,58 @@
+//! `cargo xtask`: nice-plug's bundler, plus the project's two everyday jobs.
+//!
+//! - `cargo xtask pour`: build the plugin bundles and render the built-in scene to `pour.wav`.
+//! - `cargo xtask test`: every test: the Rust suites, then the bundles in a real VST3 host.
+
+use std::path::Path;
+use std::process::Command;
+
 fn main() -> nice_plug_xtask::Result<()> {
-    nice_plug_xtask::main()
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match args.first().map(String::as_str) {
+        Some("pour") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            build_release()?;
+            run("target/release/sake-glug", &["render", "-o", "pour.wav"])
+        }
+        Some("test") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            // The dev profile keeps debug assertions, which assert_process_allocs needs.
+            cargo(&["test", "--workspace", "--features", "assert_process_allocs"])?;
+            build_release()?;
+            host_tests()
+        }
+        _ => nice_plug_xtask::main(),
+    }
+}
+
+/// The CLAP and VST3 bundles under target/bundled/, and the release CLI beside them.
+fn build_release() -> nice_plug_xtask::Result<()> {
+    nice_plug_xtask::main_with_args(
+        "cargo xtask",
+        ["bundle", "sake_glug", "--release"].map(String::from),
+    )?;
+    cargo(&["build", "--release", "--bin", "sake-glug"])
+}
+
+/// The bundles loaded in pedalboard, in a virtual environment made on first use.
+fn host_tests() -> nice_plug_xtask::Result<()> {
+    let python = ".venv/bin/python";
+    if !Path::new(python).exists() {
+        run("python3", &["-m", "venv", ".venv"])?;
+    }
+    run(python, &["-m", "pip", "install", "--quiet", "-r", "tests/host/requirements.txt"])?;
+    run(python, &["-m", "pytest", "tests/host", "-q"])
+}
+
+fn cargo(args: &[&str]) -> nice_plug_xtask::Result<()> {
+    run(&std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()), args)
+}
+
+fn run(program: &str, args: &[&str]) -> nice_plug_xtask::Result<()> {
+    let status = Command::new(program).args(args).status()?;
+    if status.success() {
+        Ok(())
+    } else {
+        anyhow::bail!("`{program} {}` failed ({status})", args.join(" "))
+    }
 }
