@@ -154,11 +154,12 @@ impl Partial {
 
     fn fill_powers(&mut self) {
         let step = complex_exp(-self.decay_per_sample, self.radians_per_sample);
+        // |z^j| = e^(−dj) falls below NEGLIGIBLE_POWER from j = ln(1/NEGLIGIBLE_POWER)/d on;
+        // counted up front rather than with a hypot per power, which made starts costly.
+        let audible = (-NEGLIGIBLE_POWER.ln() / self.decay_per_sample).ceil();
+        let count = if audible < GRID as f64 { audible as usize } else { GRID };
         let mut power: [f64; 2] = [1.0, 0.0];
-        for j in 0..GRID {
-            if power[0].hypot(power[1]) < NEGLIGIBLE_POWER {
-                break;
-            }
+        for j in 0..count {
             self.powers_re[j] = power[0] as f32;
             self.powers_im[j] = power[1] as f32;
             power = complex_mul(power, step);

@@ -9,11 +9,18 @@ use super::synthesis::Synthesis;
 /// sounding one if it is louder, and is given up otherwise: a bottle pours a handful of units at
 /// a time, so this only bites in stress cases (B near 0, pocket volumes near zero).
 pub const MAX_PARTIALS: usize = 256;
+/// At most this many components start per grid period (8 units per 64 samples, 6000 units/s at
+/// 48 kHz, 500 times a real bottle's rate); the rest are given up before anything is computed.
+/// Without it a flood of onsets (pour time and pocket volume at their minimums) costs a component
+/// start and a scan of the full bank per onset, and rendering falls far behind real time.
+pub const MAX_STARTS_PER_PERIOD: u32 = 16;
 
 pub struct VoiceBank {
     partials: Vec<Partial>,
     sample_rate: f64,
     given_up: u64,
+    /// Component starts left in the current grid period.
+    starts_left: u32,
 }
 
 impl VoiceBank {
@@ -40,12 +47,14 @@ impl Synthesis for VoiceBank {
             partials: Vec::with_capacity(MAX_PARTIALS),
             sample_rate,
             given_up: 0,
+            starts_left: MAX_STARTS_PER_PERIOD,
         }
     }
 
     fn clear(&mut self) {
         self.partials.clear();
         self.given_up = 0;
+        self.starts_left = MAX_STARTS_PER_PERIOD;
     }
 
     fn is_empty(&self) -> bool {
@@ -62,6 +71,11 @@ impl Synthesis for VoiceBank {
 
     fn start_unit(&mut self, onset: &UnitOnset) {
         for index in 0..2 {
+            if self.starts_left == 0 {
+                self.given_up += 1;
+                continue;
+            }
+            self.starts_left -= 1;
             if let Some(partial) = Partial::start(onset, index, self.sample_rate) {
                 self.insert(partial);
             }
@@ -76,6 +90,7 @@ impl Synthesis for VoiceBank {
     }
 
     fn advance(&mut self, period_start: u64) {
+        self.starts_left = MAX_STARTS_PER_PERIOD;
         self.partials.retain_mut(|partial| partial.advance(period_start));
     }
 }
