@@ -10,7 +10,8 @@
 //!
 //! Drop rules are the default path's: no component with zero amplitude, a frequency of 0 or at
 //! or above Nyquist, or already below −120 dB; a component stops below −120 dB; at most
-//! [`MAX_PARTIALS`] sound at once, the weakest giving way.
+//! [`MAX_PARTIALS`] sound at once, the weakest giving way; at most [`MAX_STARTS_PER_PERIOD`]
+//! start per grid period.
 
 use num_complex::Complex;
 use num_traits::Float;
@@ -18,7 +19,7 @@ use num_traits::Float;
 use super::partial::GRID;
 use super::pour::UnitOnset;
 use super::synthesis::Synthesis;
-use super::voices::MAX_PARTIALS;
+use super::voices::{MAX_PARTIALS, MAX_STARTS_PER_PERIOD};
 
 /// Components are re-evaluated from the closed form on every multiple of this many samples
 /// (1024 grid periods, ≈ 1.4 s at 48 kHz): the longest a recursion runs unchecked.
@@ -140,6 +141,7 @@ pub struct RecursiveBank<T> {
     scratch: [T; GRID],
     sample_rate: f64,
     given_up: u64,
+    starts_left: u32,
 }
 
 impl<T: Float> RecursiveBank<T> {
@@ -167,12 +169,14 @@ impl<T: Float> Synthesis for RecursiveBank<T> {
             scratch: [T::zero(); GRID],
             sample_rate,
             given_up: 0,
+            starts_left: MAX_STARTS_PER_PERIOD,
         }
     }
 
     fn clear(&mut self) {
         self.oscillators.clear();
         self.given_up = 0;
+        self.starts_left = MAX_STARTS_PER_PERIOD;
     }
 
     fn is_empty(&self) -> bool {
@@ -189,6 +193,11 @@ impl<T: Float> Synthesis for RecursiveBank<T> {
 
     fn start_unit(&mut self, onset: &UnitOnset) {
         for index in 0..2 {
+            if self.starts_left == 0 {
+                self.given_up += 1;
+                continue;
+            }
+            self.starts_left -= 1;
             if let Some(oscillator) = Oscillator::start(onset, index, self.sample_rate) {
                 self.insert(oscillator);
             }
@@ -207,6 +216,7 @@ impl<T: Float> Synthesis for RecursiveBank<T> {
     }
 
     fn advance(&mut self, period_start: u64) {
+        self.starts_left = MAX_STARTS_PER_PERIOD;
         self.oscillators
             .retain_mut(|oscillator| oscillator.advance(period_start));
     }
