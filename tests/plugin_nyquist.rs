@@ -3,6 +3,8 @@
 
 mod plugin_support;
 
+use nice_plug::prelude::Plugin;
+
 use plugin_support::{peak, TestHost};
 
 const RATES: [f32; 10] = [1_000.0, 8_000.0, 22_050.0, 44_100.0, 48_000.0, 88_200.0, 96_000.0, 192_000.0, 384_000.0, 768_000.0];

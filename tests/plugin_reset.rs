@@ -4,6 +4,8 @@
 
 mod plugin_support;
 
+use nice_plug::prelude::Plugin;
+
 use plugin_support::{note_on, peak, Playhead, TestHost};
 use sake_glug::engine::{Controls, Engine};
 

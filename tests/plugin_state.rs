@@ -2,6 +2,8 @@
 
 mod plugin_support;
 
+use nice_plug::prelude::Plugin;
+
 use plugin_support::TestHost;
 use sake_glug::midi::MidiMap;
 
@@ -31,7 +33,7 @@ fn save_restore_save_is_byte_identical_and_sounds_the_same() {
     assert_eq!(restored.plugin.glug_params().midi_map(), original.plugin.glug_params().midi_map());
 
     // Saving the restored copy again gives the same bytes, and the same sound.
-    let mut again = TestHost::new(48_000.0, 2);
+    let again = TestHost::new(48_000.0, 2);
     again.restore(&restored);
     assert_eq!(again.state(), saved);
     original.plugin.reset();

@@ -188,9 +188,9 @@ impl TestHost {
 pub fn note_on(timing: u32) -> PluginNoteEvent<SakeGlug> {
     NoteEvent::NoteOn {
         timing,
-        voice_id: None,
-        channel: 0,
-        key: 60,
+        voice_id: nice_plug::midi::VoiceID::Wildcard,
+        channel: nice_plug::midi::Channel::Number(0),
+        key: nice_plug::midi::Key::Number(60),
         velocity: 0.8,
     }
 }
