@@ -5,6 +5,8 @@ pub mod accuracy;
 pub mod automation;
 pub mod engine;
 pub mod reference;
+pub mod report_cli;
+pub mod stability;
 pub mod render;
 pub mod scene;
 pub mod timed_render;

@@ -34,6 +34,12 @@ pub struct TimedRender {
     pub all_finite: bool,
     /// Sum of y² over consecutive spans of `energy_span` samples (empty if not asked for).
     pub energies: Vec<f64>,
+    /// Engine time spent up to the end of each energy span (the block that ends it).
+    pub span_times: Vec<Duration>,
+    /// The most components that sounded at the end of any block.
+    pub max_sounding: usize,
+    /// The sample after the one in which the last unit started (0 if none did).
+    pub last_onset_by: u64,
 }
 
 /// Options of [`render`] besides the scene itself.
@@ -68,6 +74,9 @@ pub fn render_with<S: Synthesis>(
         peak: 0.0,
         all_finite: true,
         energies: Vec::new(),
+        span_times: Vec::new(),
+        max_sounding: 0,
+        last_onset_by: 0,
     };
     let mut energy = 0.0;
     let mut start = 0u64;
@@ -95,6 +104,8 @@ pub fn render_with<S: Synthesis>(
         let began = Instant::now();
         engine.process(&block, out);
         result.engine_time += began.elapsed();
+        result.max_sounding = result.max_sounding.max(engine.sounding_components());
+        result.last_onset_by = engine.last_unit().map_or(0, |unit| unit.sample + 1);
 
         for (offset, &y) in out.iter().enumerate() {
             let sample = start + offset as u64;
@@ -104,6 +115,7 @@ pub fn render_with<S: Synthesis>(
                 energy += y as f64 * y as f64;
                 if (sample + 1) % spec.energy_span == 0 {
                     result.energies.push(energy);
+                    result.span_times.push(result.engine_time);
                     energy = 0.0;
                 }
             }
