@@ -22,6 +22,10 @@ struct Cli {
 enum Command {
     /// Renders a scene file (or the built-in pour) to a mono WAV file.
     Render(RenderArgs),
+    /// Error against run time of every synthesis path (MODEL.md §9); see docs/accuracy.md.
+    Accuracy(sake_glug::report_cli::AccuracyArgs),
+    /// Stiff and extreme cases: finite, bounded, no slow-down; see docs/stability.md.
+    Stability(sake_glug::report_cli::StabilityArgs),
 }
 
 #[derive(Args)]
@@ -53,6 +57,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => run_render(args),
+        Command::Accuracy(args) => return sake_glug::report_cli::accuracy(args),
+        Command::Stability(args) => return sake_glug::report_cli::stability(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
