@@ -73,8 +73,8 @@ impl Feed {
         let slot = &self.units[index % UNIT_SLOTS];
         let amplitudes = unit.component_amplitudes();
         slot.onset_s.store(onset_s, Ordering::Relaxed);
-        for k in 0..2 {
-            slot.amplitude[k].store(amplitudes[k] as f32, Ordering::Relaxed);
+        for (k, amplitude) in amplitudes.into_iter().enumerate() {
+            slot.amplitude[k].store(amplitude as f32, Ordering::Relaxed);
             slot.frequency_hz[k].store(unit.shape.frequency_hz[k] as f32, Ordering::Relaxed);
             slot.decay_per_s[k].store(unit.shape.decay_per_s[k] as f32, Ordering::Relaxed);
         }

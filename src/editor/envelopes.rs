@@ -22,7 +22,7 @@ pub fn show(ui: &mut egui::Ui, feed: &Feed, size: Vec2) {
     for (age_rank, unit) in units.iter().enumerate() {
         let fade = 1.0 - age_rank as f32 / units.len().max(1) as f32 * 0.8;
         let colours = [Color32::from_rgb(255, 170, 60), Color32::from_rgb(90, 200, 140)];
-        for component in 0..2 {
+        for (component, colour) in colours.into_iter().enumerate() {
             let points: Vec<_> = (0..=POINTS)
                 .map(|step| {
                     let tau = step as f32 / POINTS as f32 * SPAN_S;
@@ -30,7 +30,7 @@ pub fn show(ui: &mut egui::Ui, feed: &Feed, size: Vec2) {
                     pos2(x(tau), y(value))
                 })
                 .collect();
-            painter.add(egui::Shape::line(points, Stroke::new(1.5, colours[component].gamma_multiply(fade))));
+            painter.add(egui::Shape::line(points, Stroke::new(1.5, colour.gamma_multiply(fade))));
         }
         let age = unit.age_s as f32;
         if (0.0..SPAN_S).contains(&age) {
