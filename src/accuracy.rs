@@ -363,6 +363,9 @@ pub fn plot(rows: &[Measurement], file: &std::path::Path) -> Result<(), Box<dyn 
         .build_cartesian_2d(x_range.log_scale(), PLOT_FLOOR_DB - 10.0..0.0)?;
     chart
         .configure_mesh()
+        .x_labels(8)
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .light_line_style(RGBColor(238, 238, 238))
         .x_desc("speed (× real time, log)")
         .y_desc("largest sample error re peak (dB)")
         .axis_desc_style(("sans-serif", 18))
