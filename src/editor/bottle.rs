@@ -76,3 +76,21 @@ fn clip_below(polygon: &[Pos2], level_y: f32) -> Vec<Pos2> {
     }
     clipped
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn area(polygon: &[Pos2]) -> f32 {
+        let n = polygon.len();
+        (0..n).map(|i| polygon[i].x * polygon[(i + 1) % n].y - polygon[(i + 1) % n].x * polygon[i].y).sum::<f32>().abs() / 2.0
+    }
+
+    #[test]
+    fn clipping_keeps_the_part_below_the_level() {
+        let square = [pos2(0.0, 0.0), pos2(10.0, 0.0), pos2(10.0, 10.0), pos2(0.0, 10.0)];
+        assert_eq!(area(&clip_below(&square, 5.0)), 50.0);
+        assert_eq!(area(&clip_below(&square, -1.0)), 100.0);
+        assert!(clip_below(&square, 11.0).is_empty());
+    }
+}

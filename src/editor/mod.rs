@@ -83,3 +83,44 @@ impl NiceEguiApp for GlugEditor {
         self.gui = None;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::ModelConfig;
+
+    /// Runs the drawings in a headless egui frame; returns the number of shapes painted.
+    fn paint(feed: &Feed, params: &GlugParams) -> usize {
+        let ctx = egui::Context::default();
+        let mut output = ctx.run_ui(egui::RawInput::default(), |ui| {
+            bottle::show(ui, feed, egui::vec2(420.0, 220.0));
+            scope::show(ui, feed, egui::vec2(370.0, 200.0));
+            envelopes::show(ui, feed, egui::vec2(370.0, 200.0));
+            midi_settings::show(ui, params);
+        });
+        // Nothing uploads the font atlas here.
+        output.textures_delta.clear();
+        output.shapes.len()
+    }
+
+    #[test]
+    fn views_draw_a_pouring_bottle_its_scope_and_envelopes() {
+        use std::sync::atomic::Ordering::Relaxed;
+        let feed = Feed::default();
+        let params = GlugParams::default();
+        let idle = paint(&feed, &params);
+        assert!(idle > 5, "frames, outlines and labels: {idle}");
+
+        // Feed it a second of pouring, as the audio thread would.
+        let mut renderer = crate::plugin_render::Renderer::new(48_000.0, ModelConfig::default());
+        let mut settings = crate::plugin_render::Settings::from_params(&params);
+        settings.values.tilt_deg = 135.0;
+        let mut block = vec![0.0f32; 48_000];
+        renderer.render(&settings, &mut block, &feed);
+        assert!(feed.units().count() > 0);
+        assert_eq!(feed.tilt_deg.load(Relaxed), 135.0);
+        assert!(feed.volume_ml.load(Relaxed) < 300.0);
+        let busy = paint(&feed, &params);
+        assert!(busy > idle + 8, "scope columns and envelope curves: {busy} vs {idle}");
+    }
+}
