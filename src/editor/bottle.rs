@@ -41,14 +41,18 @@ pub fn show(ui: &mut egui::Ui, feed: &Feed, size: Vec2) {
     let mut outline: Vec<Pos2> = right.iter().map(|&point| place(point)).collect();
     outline.extend(right.iter().rev().map(|&(x, y)| place((-x, y))));
 
-    // The liquid: everything of the outline below a level line (in screen space) chosen so the
-    // filled share of the drawing's height matches the residual share of the capacity; a drawing,
-    // not the bottle's geometry.
+    // The liquid: the inside of the outline below a level line (in screen space) chosen so that
+    // the filled share of the drawing's height is the residual share of the capacity; a drawing,
+    // not the bottle's geometry. Filled by scanlines, as the outline is not convex.
     let (top, bottom) = outline.iter().fold((f32::MAX, f32::MIN), |(top, bottom), p| (top.min(p.y), bottom.max(p.y)));
     let level_y = bottom - (bottom - top) * fraction;
-    let liquid = clip_below(&outline, level_y);
-    if liquid.len() >= 3 {
-        painter.add(Shape::convex_polygon(liquid, Color32::from_rgb(200, 190, 120), Stroke::NONE));
+    let liquid = Color32::from_rgb(200, 190, 120);
+    let mut y = level_y.ceil();
+    while y <= bottom {
+        for span in inside_spans(&outline, y).chunks_exact(2) {
+            painter.line_segment([pos2(span[0], y), pos2(span[1], y)], Stroke::new(1.5, liquid));
+        }
+        y += 1.0;
     }
     painter.add(Shape::closed_line(outline, Stroke::new(2.0, Color32::from_gray(220))));
     painter.text(
@@ -60,37 +64,32 @@ pub fn show(ui: &mut egui::Ui, feed: &Feed, size: Vec2) {
     );
 }
 
-/// The part of a polygon below (greater y than) a horizontal line, as a polygon.
-fn clip_below(polygon: &[Pos2], level_y: f32) -> Vec<Pos2> {
-    let mut clipped = Vec::with_capacity(polygon.len() + 2);
-    for (index, &current) in polygon.iter().enumerate() {
-        let next = polygon[(index + 1) % polygon.len()];
-        let current_in = current.y >= level_y;
-        if current_in {
-            clipped.push(current);
-        }
-        if current_in != (next.y >= level_y) {
-            let t = (level_y - current.y) / (next.y - current.y);
-            clipped.push(pos2(current.x + t * (next.x - current.x), level_y));
-        }
-    }
-    clipped
+/// Where a horizontal line at `y` is inside a polygon: sorted crossings, in pairs (even-odd rule).
+fn inside_spans(polygon: &[Pos2], y: f32) -> Vec<f32> {
+    let mut crossings: Vec<f32> = (0..polygon.len())
+        .filter_map(|index| {
+            let (a, b) = (polygon[index], polygon[(index + 1) % polygon.len()]);
+            // Half-open in y, so a vertex on the line counts once.
+            ((a.y <= y) != (b.y <= y)).then(|| a.x + (y - a.y) / (b.y - a.y) * (b.x - a.x))
+        })
+        .collect();
+    crossings.sort_by(f32::total_cmp);
+    crossings
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn area(polygon: &[Pos2]) -> f32 {
-        let n = polygon.len();
-        (0..n).map(|i| polygon[i].x * polygon[(i + 1) % n].y - polygon[(i + 1) % n].x * polygon[i].y).sum::<f32>().abs() / 2.0
-    }
-
     #[test]
-    fn clipping_keeps_the_part_below_the_level() {
-        let square = [pos2(0.0, 0.0), pos2(10.0, 0.0), pos2(10.0, 10.0), pos2(0.0, 10.0)];
-        assert_eq!(area(&clip_below(&square, 5.0)), 50.0);
-        assert_eq!(area(&clip_below(&square, -1.0)), 100.0);
-        assert!(clip_below(&square, 11.0).is_empty());
+    fn spans_follow_a_non_convex_outline() {
+        // A "U": two prongs joined at the bottom.
+        let u = [
+            pos2(0.0, 0.0), pos2(3.0, 0.0), pos2(3.0, 7.0), pos2(7.0, 7.0), pos2(7.0, 0.0),
+            pos2(10.0, 0.0), pos2(10.0, 10.0), pos2(0.0, 10.0),
+        ];
+        assert_eq!(inside_spans(&u, 5.0), vec![0.0, 3.0, 7.0, 10.0]);
+        assert_eq!(inside_spans(&u, 8.0), vec![0.0, 10.0]);
+        assert!(inside_spans(&u, 11.0).is_empty());
     }
 }
