@@ -6,6 +6,8 @@
 
 mod plugin_support;
 
+use nice_plug::prelude::Plugin;
+
 use plugin_support::{cc, note_on, peak, Playhead, TestHost};
 
 #[cfg(all(debug_assertions, feature = "assert_process_allocs"))]
@@ -56,6 +58,11 @@ fn process_does_not_allocate_under_a_busy_session() {
                 assert_eq!(channel, &out[0], "every channel carries the mono signal");
             }
             heard = heard.max(peak(&out[0]));
+            // Hosts may call reset() from the audio thread at any time.
+            if index % 7 == 3 {
+                let plugin = &mut host.plugin;
+                no_alloc(&mut || plugin.reset());
+            }
         }
         assert!(heard > 0.0, "the session at {sample_rate} Hz must make sound");
     }
