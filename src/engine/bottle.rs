@@ -86,6 +86,26 @@ impl Bottle {
         }
     }
 
+    /// [`Bottle::step`] again under the controls of the previous step: no refill can be pending
+    /// and no level can have changed, so only the volume moves. Same arithmetic, same result.
+    #[inline]
+    pub fn step_steady(&mut self, drain: DrainMode) -> Outflow {
+        let levels = &self.levels;
+        let volume_before_ml = self.volume_ml;
+        let amount_ml = levels
+            .max_outflow_per_sample_ml
+            .min((volume_before_ml - levels.rest_ml).max(0.0));
+        if drain == DrainMode::Simulate {
+            self.volume_ml = volume_before_ml - amount_ml;
+        }
+        Outflow {
+            volume_before_ml,
+            amount_ml,
+            submerged: volume_before_ml > levels.submerged_ml,
+            refilled: false,
+        }
+    }
+
     #[inline]
     fn levels(&mut self, controls: &ControlValues, capacity_ml: f64) -> Levels {
         let key = [controls.tilt_deg, controls.pour_time_s, capacity_ml];

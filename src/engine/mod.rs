@@ -169,32 +169,39 @@ impl<S: Synthesis> Engine<S> {
     }
 
     fn step_pour(&mut self, controls: &Controls, len: usize) {
-        let constant = controls.pour_is_constant();
-        if constant && self.resting_under == Some(controls.values_at(0)) {
+        let constant = controls.pour_is_constant().then(|| controls.values_at(0));
+        if constant.is_some() && self.resting_under == constant {
             return;
         }
+        // Under constant controls they are read and sanitised once for the whole span.
+        let held = constant.map(ControlValues::sanitized);
         let Self {
             pour,
             voices,
             last_unit,
             ..
         } = self;
-        let mut outflow = None;
-        let mut values = controls.values_at(0);
+        let mut last_step = None;
         for index in 0..len {
-            values = controls.values_at(index);
             let sample = self.sample + index as u64;
-            let step = pour.step(sample, values, |onset| {
+            let mut start_unit = |onset: &UnitOnset| {
                 voices.start_unit(onset);
                 *last_unit = Some(*onset);
-            });
+            };
+            let step = match held {
+                // Nothing can have changed since the span's first sample: refills only happen
+                // between calls, and the controls are the same.
+                Some(values) if index > 0 => pour.step_steady(sample, values.viscosity, start_unit),
+                Some(values) => pour.step_sanitized(sample, &values, start_unit),
+                None => pour.step_sanitized(sample, &controls.values_at(index).sanitized(), start_unit),
+            };
             if step.amount_ml > 0.0 {
                 self.active_until = sample + 1;
             }
-            outflow = Some(step);
+            last_step = Some(step);
         }
-        self.resting_under = match outflow {
-            Some(step) if constant && step.amount_ml == 0.0 && !step.refilled => Some(values),
+        self.resting_under = match last_step {
+            Some(step) if step.amount_ml == 0.0 && !step.refilled => constant,
             _ => None,
         };
     }
@@ -202,14 +209,23 @@ impl<S: Synthesis> Engine<S> {
     /// Output gain, then the guarantees of MODEL.md §6: finite, within the ceiling, no denormal.
     fn apply_output_stage(&mut self, controls: &Controls, out: &mut [f32]) {
         let ceiling = self.pour.config().ceiling as f32;
-        for (index, y) in out.iter_mut().enumerate() {
-            let gain = self.gain_at(controls.gain_db.at(index));
-            let value = (*y as f64 * gain) as f32;
-            *y = if value.is_nan() || value.abs() < f32::MIN_POSITIVE {
+        let limit = |value: f32| {
+            if value.is_nan() || value.abs() < f32::MIN_POSITIVE {
                 0.0
             } else {
                 value.clamp(-ceiling, ceiling)
-            };
+            }
+        };
+        if let Lane::Constant(gain_db) = controls.gain_db {
+            let gain = self.gain_at(gain_db);
+            for y in out.iter_mut() {
+                *y = limit((*y as f64 * gain) as f32);
+            }
+        } else {
+            for (index, y) in out.iter_mut().enumerate() {
+                let gain = self.gain_at(controls.gain_db.at(index));
+                *y = limit((*y as f64 * gain) as f32);
+            }
         }
     }
 

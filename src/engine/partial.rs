@@ -39,7 +39,8 @@ pub struct Partial {
     decay_per_sample: f64,
     radians_per_sample: f64,
     periods_since_direct: u32,
-    /// |anchor| as a plain number, for choosing which component to give up when the bank is full.
+    /// |anchor|², for choosing which component to give up when the bank is full (squared: only
+    /// the order matters, and it saves a hypot per component per period).
     level: f32,
 }
 
@@ -149,7 +150,7 @@ impl Partial {
 
     fn set_anchor(&mut self, state: [f64; 2]) {
         self.anchor = [state[0] as f32, state[1] as f32];
-        self.level = state[0].hypot(state[1]) as f32;
+        self.level = (state[0] * state[0] + state[1] * state[1]) as f32;
     }
 
     fn fill_powers(&mut self) {

@@ -97,13 +97,48 @@ impl Pour {
         &mut self,
         sample: u64,
         controls: ControlValues,
-        mut emit: impl FnMut(&UnitOnset),
+        emit: impl FnMut(&UnitOnset),
     ) -> Outflow {
-        let controls = controls.sanitized();
-        let outflow = self.bottle.step(&controls, &self.config);
+        self.step_sanitized(sample, &controls.sanitized(), emit)
+    }
+
+    /// [`Pour::step`] for controls already brought into range, so that a caller stepping many
+    /// samples under the same controls sanitises them once.
+    #[inline]
+    pub fn step_sanitized(
+        &mut self,
+        sample: u64,
+        controls: &ControlValues,
+        emit: impl FnMut(&UnitOnset),
+    ) -> Outflow {
+        let outflow = self.bottle.step(controls, &self.config);
         if outflow.refilled {
             self.onsets.clear();
         }
+        self.count_onsets(sample, controls.viscosity, outflow, emit)
+    }
+
+    /// [`Pour::step_sanitized`] under the same controls as the previous step and with no refill
+    /// asked for since: the bottle skips its checks for changes.
+    #[inline]
+    pub fn step_steady(
+        &mut self,
+        sample: u64,
+        viscosity: f64,
+        emit: impl FnMut(&UnitOnset),
+    ) -> Outflow {
+        let outflow = self.bottle.step_steady(self.config.drain);
+        self.count_onsets(sample, viscosity, outflow, emit)
+    }
+
+    #[inline]
+    fn count_onsets(
+        &mut self,
+        sample: u64,
+        viscosity: f64,
+        outflow: Outflow,
+        mut emit: impl FnMut(&UnitOnset),
+    ) -> Outflow {
         let capacity_ml = self.config.capacity_ml;
         let mut started = 0;
         let skipped = self.onsets.feed(
@@ -117,7 +152,7 @@ impl Pour {
                     fraction: crossing.fraction,
                     volume_ml: crossing.volume_ml,
                     amplitude: unit_amplitude(crossing.volume_ml, capacity_ml),
-                    viscosity: controls.viscosity,
+                    viscosity,
                     shape,
                 });
             },
