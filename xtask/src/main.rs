@@ -17,7 +17,7 @@ fn main() -> nice_plug_xtask::Result<()> {
         Some("test") => {
             nice_plug_xtask::chdir_workspace_root()?;
             // The dev profile keeps debug assertions, which assert_process_allocs needs.
-            cargo(&["test", "--workspace", "--features", "assert_process_allocs"])?;
+            cargo(&["test", "--workspace", "--no-fail-fast", "--features", "assert_process_allocs"])?;
             build_release()?;
             host_tests()
         }
