@@ -6,17 +6,18 @@ use sake_glug::render::render;
 use sake_glug::scene::Scene;
 
 /// One hour of repeated pours at 48 kHz: every 10 s tilt up and pour 6 s, put the bottle
-/// upright, and refill it (a change of the fill level refills in simulate mode).
+/// upright, and refill it. A change of the fill level refills in simulate mode, so the level
+/// steps (two points at one time) between 100 % and 99.9 % once per pour.
 fn hour_of_pours() -> Scene {
     let (mut tilt, mut fill) = (Vec::new(), Vec::new());
     for pour in 0..360 {
         let t = pour as f64 * 10.0;
         tilt.push(format!("[{t}, 90.0], [{}, 135.0], [{}, 135.0], [{}, 0.0]", t + 0.5, t + 6.0, t + 6.5));
-        let level = if pour % 2 == 0 { 100.0 } else { 99.9 };
-        fill.push(format!("[{}, {level}]", t + 9.0));
+        let (from, to) = if pour % 2 == 0 { (100.0, 99.9) } else { (99.9, 100.0) };
+        fill.push(format!("[{}, {from}], [{}, {to}]", t + 9.0, t + 9.0));
     }
     let text = format!(
-        "duration_s = 3600.0\ntilt_deg = [{}]\nfill_percent = [[0.0, 99.9], {}]\n",
+        "duration_s = 3600.0\ntilt_deg = [{}]\nfill_percent = [{}]\n",
         tilt.join(", "),
         fill.join(", ")
     );
