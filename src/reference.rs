@@ -67,11 +67,13 @@ pub fn render(
 /// q_i(τ) of MODEL.md §5 (without G), added at every sample of `window` with τ ≥ 0.
 fn add_unit(onset: &UnitOnset, sample_rate: f64, window: &Range<u64>, out: &mut [f64]) {
     let onset_time = onset.sample as f64 + onset.fraction;
-    let amplitudes = onset.component_amplitudes();
-    for component in 0..2 {
-        let frequency_hz = onset.shape.frequency_hz[component];
-        let decay_per_s = onset.shape.decay_per_s[component];
-        if amplitudes[component] == 0.0 || frequency_hz >= 0.5 * sample_rate {
+    let components = onset
+        .component_amplitudes()
+        .into_iter()
+        .zip(onset.shape.frequency_hz)
+        .zip(onset.shape.decay_per_s);
+    for ((amplitude, frequency_hz), decay_per_s) in components {
+        if amplitude == 0.0 || frequency_hz >= 0.5 * sample_rate {
             continue;
         }
         let first = window.start.max(onset.sample + 1);
@@ -82,7 +84,7 @@ fn add_unit(onset: &UnitOnset, sample_rate: f64, window: &Range<u64>, out: &mut 
                 break;
             }
             let phase = std::f64::consts::TAU * frequency_hz * tau;
-            out[(sample - window.start) as usize] += amplitudes[component] * envelope * phase.sin();
+            out[(sample - window.start) as usize] += amplitude * envelope * phase.sin();
         }
     }
 }

@@ -184,7 +184,7 @@ impl<S: Synthesis> Engine<S> {
         let mut last_step = None;
         for index in 0..len {
             let sample = self.sample + index as u64;
-            let mut start_unit = |onset: &UnitOnset| {
+            let start_unit = |onset: &UnitOnset| {
                 voices.start_unit(onset);
                 *last_unit = Some(*onset);
             };
@@ -239,7 +239,7 @@ impl<S: Synthesis> Engine<S> {
 
     fn advance_position(&mut self, len: usize) {
         self.sample += len as u64;
-        if self.sample % GRID as u64 == 0 {
+        if self.sample.is_multiple_of(GRID as u64) {
             self.voices.advance(self.sample);
         }
     }

@@ -50,9 +50,9 @@ impl Partial {
     pub fn start(onset: &UnitOnset, index: usize, sample_rate: f64) -> Option<Self> {
         let amplitude = onset.component_amplitudes()[index];
         let frequency_hz = onset.shape.frequency_hz[index];
-        if !(amplitude >= NEGLIGIBLE_AMPLITUDE)
-            || !(frequency_hz > 0.0 && frequency_hz < 0.5 * sample_rate)
-        {
+        let audible_amplitude = amplitude >= NEGLIGIBLE_AMPLITUDE;
+        let below_nyquist = frequency_hz > 0.0 && frequency_hz < 0.5 * sample_rate;
+        if !audible_amplitude || !below_nyquist {
             return None;
         }
         let decay_per_sample = onset.shape.decay_per_s[index] / sample_rate;
