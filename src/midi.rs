@@ -92,19 +92,22 @@ impl Target {
 /// Turns CC messages into control values, assembling 14-bit tilt from its MSB and LSB.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct CcDecoder {
-    /// The last tilt MSB, until a reset.
+    /// The last tilt MSB and LSB, until a reset.
     tilt_msb: Option<u8>,
+    tilt_lsb: u8,
 }
 
 impl CcDecoder {
     pub fn reset(&mut self) {
-        self.tilt_msb = None;
+        *self = Self::default();
     }
 
     /// One CC message (`value` 0–127); returns the control it sets, if it is mapped.
     ///
-    /// In 14-bit mode an MSB applies at once with a zero LSB (as MIDI specifies), and the LSB
-    /// that follows refines it; an LSB without an MSB before it is ignored.
+    /// In 14-bit mode an MSB applies at once with the last LSB, and the LSB that follows
+    /// refines it; an LSB without an MSB before it is only remembered. Keeping the last LSB
+    /// (rather than zeroing it on a new MSB) gives the exact angle also through hosts that pass
+    /// a CC on only when its value changes, as VST3 hosts may.
     pub fn feed(&mut self, map: &MidiMap, channel: u8, cc: u8, value: u8) -> Option<(Target, f64)> {
         if !map.listens_on(channel) || cc > 127 {
             return None;
@@ -114,12 +117,13 @@ impl CcDecoder {
             return Some(match map.tilt_lsb {
                 Some(_) => {
                     self.tilt_msb = Some(value);
-                    (Target::Tilt, Target::Tilt.value(fourteen_bit(value, 0)))
+                    (Target::Tilt, Target::Tilt.value(fourteen_bit(value, self.tilt_lsb)))
                 }
                 None => (Target::Tilt, Target::Tilt.value(value as f64 / 127.0)),
             });
         }
         if map.tilt_lsb.is_some() && Some(cc) == map.tilt_lsb {
+            self.tilt_lsb = value;
             let msb = self.tilt_msb?;
             return Some((Target::Tilt, Target::Tilt.value(fourteen_bit(msb, value))));
         }

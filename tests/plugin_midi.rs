@@ -13,12 +13,17 @@ fn fourteen_bit_tilt_assembles_msb_and_lsb() {
     let map = MidiMap::default();
     let mut decoder = CcDecoder::default();
     let lsb = map.tilt_lsb.expect("14-bit by default");
-    assert_eq!(decoder.feed(&map, 0, lsb, 5), None, "an LSB before any MSB is ignored");
+    assert_eq!(decoder.feed(&map, 0, lsb, 5), None, "an LSB before any MSB only waits");
     let (target, coarse) = decoder.feed(&map, 0, 16, 96).expect("tilt MSB");
     assert_eq!(target, Target::Tilt);
-    assert_eq!(coarse, (96 << 7) as f64 / 16383.0 * 180.0);
+    assert_eq!(coarse, ((96 << 7) + 5) as f64 / 16383.0 * 180.0, "the MSB applies with the last LSB");
     let (_, fine) = decoder.feed(&map, 0, lsb, 64).expect("tilt LSB");
     assert_eq!(fine, ((96 << 7) + 64) as f64 / 16383.0 * 180.0);
+    // A host that drops the unchanged LSB still gives the exact angle.
+    let (_, next) = decoder.feed(&map, 0, 16, 97).expect("tilt MSB");
+    assert_eq!(next, ((97 << 7) + 64) as f64 / 16383.0 * 180.0);
+    decoder.reset();
+    assert_eq!(decoder.feed(&map, 0, lsb, 9), None, "a reset forgets the MSB");
     let (_, top) = {
         decoder.feed(&map, 0, 16, 127);
         decoder.feed(&map, 0, lsb, 127).expect("tilt LSB")
