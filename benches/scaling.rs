@@ -44,7 +44,13 @@ impl Handling {
 }
 
 /// Renders `seconds` from a reset, block by block as a host would; returns units started.
-fn render(engine: &mut Engine, handling: Handling, seconds: f64, ramp: &[f64], out: &mut [f32]) -> u64 {
+fn render(
+    engine: &mut Engine,
+    handling: Handling,
+    seconds: f64,
+    ramp: &[f64],
+    out: &mut [f32],
+) -> u64 {
     engine.reset();
     let len = (seconds * FS) as usize;
     let mut done = 0;
@@ -170,13 +176,16 @@ fn cost_follows_units(c: &mut Criterion) {
         let handling = Handling::PourFor { seconds: pour_s };
         units.push(render(&mut engine, handling, 600.0, &[], &mut out));
         let key = format!("pour {pour_s} s");
-        group.bench_function(BenchmarkId::new("10 min render, pouring for", pour_s), |b| {
-            b.iter_custom(|iters| {
-                timed(&medians, &key, iters, || {
-                    render(&mut engine, handling, 600.0, &[], &mut out);
+        group.bench_function(
+            BenchmarkId::new("10 min render, pouring for", pour_s),
+            |b| {
+                b.iter_custom(|iters| {
+                    timed(&medians, &key, iters, || {
+                        render(&mut engine, handling, 600.0, &[], &mut out);
+                    })
                 })
-            })
-        });
+            },
+        );
     }
     group.finish();
 

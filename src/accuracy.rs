@@ -60,7 +60,11 @@ pub fn scenes() -> Vec<Scene> {
                     0.0
                 };
                 // In simulate mode a change of fill refills (MODEL.md §8).
-                let fill_percent = if cycle as u64 % 2 == 0 { 100.0 } else { 99.9 };
+                let fill_percent = if (cycle as u64).is_multiple_of(2) {
+                    100.0
+                } else {
+                    99.9
+                };
                 ControlValues {
                     tilt_deg,
                     fill_percent,
@@ -149,7 +153,7 @@ pub struct Measurement {
 pub fn windows(len: u64, sample_rate: f64) -> Vec<Range<u64>> {
     let window = (WINDOW_S * sample_rate) as u64;
     if len <= 2 * window {
-        vec![0..len]
+        vec![Range { start: 0, end: len }]
     } else {
         vec![0..window, len - window..len]
     }
@@ -185,7 +189,9 @@ pub fn reference_windows(
     for window in windows {
         let controls = scene.controls(sample_rate);
         let mut source = |sample: u64| controls.at(sample);
-        samples.extend(reference::render(sample_rate, scene.config, &mut source, window.clone()).samples);
+        samples.extend(
+            reference::render(sample_rate, scene.config, &mut source, window.clone()).samples,
+        );
     }
     let audio_s = samples.len() as f64 / sample_rate;
     (samples, audio_s / began.elapsed().as_secs_f64())
@@ -302,23 +308,33 @@ pub fn table(rows: &[Measurement]) -> String {
     text
 }
 
+/// (speed, error in dB, render length in s) of one path at one length.
+type PlotPoint = (f64, f64, f64);
+
 /// The floor at which the reference (error 0 by definition) is drawn on the diagram.
 const PLOT_FLOOR_DB: f64 = -200.0;
 
 /// Draws the work-precision diagram: speed across, the worst error over the scenes up, one line
 /// per path through its render lengths.
-pub fn plot(rows: &[Measurement], file: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
+pub fn plot(
+    rows: &[Measurement],
+    file: &std::path::Path,
+) -> Result<(), Box<dyn std::error::Error>> {
     use plotters::prelude::*;
 
     // A font compiled into the binary: no system font library needed.
-    plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT)
-        .map_err(|_| "the embedded font did not load")?;
+    plotters::style::register_font(
+        "sans-serif",
+        FontStyle::Normal,
+        epaint_default_fonts::UBUNTU_LIGHT,
+    )
+    .map_err(|_| "the embedded font did not load")?;
 
     let mut lengths: Vec<f64> = rows.iter().map(|r| r.length_s).collect();
     lengths.sort_by(f64::total_cmp);
     lengths.dedup();
     // Per path and length: the worst error over the scenes, and the total speed over them.
-    let lines: Vec<(Path, Vec<(f64, f64, f64)>)> = Path::ALL
+    let lines: Vec<(Path, Vec<PlotPoint>)> = Path::ALL
         .iter()
         .map(|&path| {
             let points = lengths
@@ -398,14 +414,22 @@ pub fn plot(rows: &[Measurement], file: &std::path::Path) -> Result<(), Box<dyn 
                 colour.stroke_width(2),
             ))?
             .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
         chart.draw_series(
             points
                 .iter()
                 .map(|&(s, e, _)| Circle::new((s, e), 4, colour.filled())),
         )?;
-        chart.draw_series(points.iter().map(|&(s, e, length_s)| {
-            Text::new(length_label(length_s), (s, e + 4.0), ("sans-serif", 13).into_font())
+        // Lengths that do not drift land on one spot: stagger their labels upwards.
+        chart.draw_series(points.iter().enumerate().map(|(k, &(s, e, length_s))| {
+            let lift = 4.0 + 7.0 * k as f64;
+            Text::new(
+                length_label(length_s),
+                (s, e + lift),
+                ("sans-serif", 13).into_font(),
+            )
         }))?;
     }
     chart

@@ -216,12 +216,23 @@ fn energy_not_growing(run: &Run, span: u64) -> Check {
     let energies = run.render.energies.get(first..).unwrap_or(&[]);
     let worst = energies
         .windows(2)
-        .map(|pair| if pair[0] > 0.0 { pair[1] / pair[0] } else if pair[1] > 0.0 { f64::INFINITY } else { 0.0 })
+        .map(|pair| {
+            if pair[0] > 0.0 {
+                pair[1] / pair[0]
+            } else if pair[1] > 0.0 {
+                f64::INFINITY
+            } else {
+                0.0
+            }
+        })
         .fold(0.0, f64::max);
     check(
         "energy",
         worst <= 1.0 + ENERGY_TOLERANCE && energies.len() >= 2,
-        format!("largest span-to-span ratio {worst:.4} over {} spans", energies.len()),
+        format!(
+            "largest span-to-span ratio {worst:.4} over {} spans",
+            energies.len()
+        ),
     )
 }
 
@@ -234,7 +245,13 @@ fn time_ratio(run: &Run, normal: &Run) -> Check {
     )
 }
 
-fn outcome(group: &'static str, name: String, checks: Vec<Check>, run: &Run, sample_rate: f64) -> Outcome {
+fn outcome(
+    group: &'static str,
+    name: String,
+    checks: Vec<Check>,
+    run: &Run,
+    sample_rate: f64,
+) -> Outcome {
     Outcome {
         group,
         name,
@@ -290,31 +307,52 @@ pub fn frequency_sweep(scale: Scale) -> Vec<Outcome> {
     let seconds = scale.sweep_s();
     let normal = normal(fs, seconds, scale);
     let span = (ENERGY_SPAN_S * fs) as u64;
-    [0.0, 1.0, 80.0, 0.4999 * fs, 0.5 * fs, fs, config::F1_HZ.max, 1e9]
-        .into_iter()
-        .map(|frequency| {
-            let config = ModelConfig {
-                frequency_hz: [frequency; 2],
-                ..follow().deterministic()
-            };
-            let run = run(fs, config, seconds, &pour_then_stop(fs, 1.0), scale.repeats());
-            let mut checks = vec![finite(&run), ceiling(&run)];
-            if frequency > 0.0 && frequency < 0.5 * fs {
-                checks.push(energy_not_growing(&run, span));
-            } else {
-                checks.push(check(
-                    "not computed",
-                    run.render.max_sounding == 0 && run.render.peak == 0.0,
-                    format!(
-                        "at most {} components sounded, peak {}",
-                        run.render.max_sounding, run.render.peak
-                    ),
-                ));
-            }
-            checks.push(time_ratio(&run, &normal));
-            outcome("frequency", format!("f1 = f2 = {frequency} Hz"), checks, &run, fs)
-        })
-        .collect()
+    [
+        0.0,
+        1.0,
+        80.0,
+        0.4999 * fs,
+        0.5 * fs,
+        fs,
+        config::F1_HZ.max,
+        1e9,
+    ]
+    .into_iter()
+    .map(|frequency| {
+        let config = ModelConfig {
+            frequency_hz: [frequency; 2],
+            ..follow().deterministic()
+        };
+        let run = run(
+            fs,
+            config,
+            seconds,
+            &pour_then_stop(fs, 1.0),
+            scale.repeats(),
+        );
+        let mut checks = vec![finite(&run), ceiling(&run)];
+        if frequency > 0.0 && frequency < 0.5 * fs {
+            checks.push(energy_not_growing(&run, span));
+        } else {
+            checks.push(check(
+                "not computed",
+                run.render.max_sounding == 0 && run.render.peak == 0.0,
+                format!(
+                    "at most {} components sounded, peak {}",
+                    run.render.max_sounding, run.render.peak
+                ),
+            ));
+        }
+        checks.push(time_ratio(&run, &normal));
+        outcome(
+            "frequency",
+            format!("f1 = f2 = {frequency} Hz"),
+            checks,
+            &run,
+            fs,
+        )
+    })
+    .collect()
 }
 
 /// Sample rates from 1 kHz to 768 kHz, and out-of-range ones (sanitised to the nearest bound or
@@ -322,7 +360,14 @@ pub fn frequency_sweep(scale: Scale) -> Vec<Outcome> {
 pub fn sample_rate_sweep(scale: Scale) -> Vec<Outcome> {
     let seconds = scale.sweep_s();
     let normal = normal(48_000.0, seconds, scale);
-    let at_48k = run(48_000.0, follow(), seconds, &pour_then_stop(48_000.0, 1.0), 1).units_started;
+    let at_48k = run(
+        48_000.0,
+        follow(),
+        seconds,
+        &pour_then_stop(48_000.0, 1.0),
+        1,
+    )
+    .units_started;
     [
         1_000.0,
         8_000.0,
@@ -354,7 +399,13 @@ pub fn sample_rate_sweep(scale: Scale) -> Vec<Outcome> {
             ),
             time_ratio(&run, &normal),
         ];
-        outcome("sample rate", format!("fs = {requested} Hz (runs at {fs} Hz)"), checks, &run, fs)
+        outcome(
+            "sample rate",
+            format!("fs = {requested} Hz (runs at {fs} Hz)"),
+            checks,
+            &run,
+            fs,
+        )
     })
     .collect()
 }
@@ -384,7 +435,10 @@ pub fn flood(scale: Scale) -> Vec<Outcome> {
     };
     let mut outcomes = Vec::new();
     for (name, drain) in [
-        ("flood, bottle empties in 10 ms (simulate)", DrainMode::Simulate),
+        (
+            "flood, bottle empties in 10 ms (simulate)",
+            DrainMode::Simulate,
+        ),
         ("flood for the whole render (follow)", DrainMode::Follow),
     ] {
         let config = ModelConfig {
@@ -422,7 +476,7 @@ pub fn tilt_flip(scale: Scale) -> Vec<Outcome> {
     let flip = |sample: u64| {
         (
             ControlValues {
-                tilt_deg: if sample % 2 == 0 { 0.0 } else { 180.0 },
+                tilt_deg: if sample.is_multiple_of(2) { 0.0 } else { 180.0 },
                 ..ControlValues::default()
             },
             -6.0,
@@ -442,7 +496,13 @@ pub fn tilt_flip(scale: Scale) -> Vec<Outcome> {
                 ),
                 time_ratio(&run, &normal),
             ];
-            outcome("tilt flip", format!("0° ↔ 180° every sample ({mode})"), checks, &run, fs)
+            outcome(
+                "tilt flip",
+                format!("0° ↔ 180° every sample ({mode})"),
+                checks,
+                &run,
+                fs,
+            )
         })
         .collect()
 }
@@ -558,7 +618,12 @@ pub fn long_render(scale: Scale) -> Vec<Outcome> {
     let cost_flat = |run: &Run| {
         let times = &run.render.span_times;
         let minute = |k: usize| {
-            times[k].as_secs_f64() - if k == 0 { 0.0 } else { times[k - 1].as_secs_f64() }
+            times[k].as_secs_f64()
+                - if k == 0 {
+                    0.0
+                } else {
+                    times[k - 1].as_secs_f64()
+                }
         };
         // Medians of the first and of the last third (the first minute aside: start-up), so one
         // busy moment of the machine does not count.
@@ -625,7 +690,10 @@ pub fn long_render(scale: Scale) -> Vec<Outcome> {
     ];
     outcomes.push(outcome(
         "long render",
-        format!("a unit with B = 0 ringing for {}", accuracy::length_label(seconds)),
+        format!(
+            "a unit with B = 0 ringing for {}",
+            accuracy::length_label(seconds)
+        ),
         checks,
         &run_ring,
         fs,
@@ -683,12 +751,20 @@ pub fn run_all(scale: Scale, mut progress: impl FnMut(&Outcome)) -> Vec<Outcome>
 
 /// The outcomes as a Markdown table.
 pub fn report(outcomes: &[Outcome]) -> String {
-    let mut text = String::from("| group | case | result | checks | measured |\n|---|---|---|---|---|\n");
+    let mut text =
+        String::from("| group | case | result | checks | measured |\n|---|---|---|---|---|\n");
     for o in outcomes {
         let checks: Vec<String> = o
             .checks
             .iter()
-            .map(|c| format!("{}{}: {}", if c.passed { "" } else { "**FAILED** " }, c.what, c.detail))
+            .map(|c| {
+                format!(
+                    "{}{}: {}",
+                    if c.passed { "" } else { "**FAILED** " },
+                    c.what,
+                    c.detail
+                )
+            })
             .collect();
         text += &format!(
             "| {} | {} | {} | {} | {} |\n",

@@ -67,7 +67,11 @@ pub fn render_with<S: Synthesis>(
 ) -> TimedRender {
     let mut lanes: [Vec<f64>; 5] = std::array::from_fn(|_| Vec::with_capacity(BLOCK));
     let mut out = vec![0.0f32; BLOCK];
-    let kept_len: u64 = spec.keep.iter().map(|w| w.end.min(spec.len) - w.start.min(spec.len)).sum();
+    let kept_len: u64 = spec
+        .keep
+        .iter()
+        .map(|w| w.end.min(spec.len) - w.start.min(spec.len))
+        .sum();
     let mut result = TimedRender {
         kept: Vec::with_capacity(kept_len as usize),
         engine_time: Duration::ZERO,
@@ -113,7 +117,7 @@ pub fn render_with<S: Synthesis>(
             result.peak = result.peak.max(y.abs());
             if spec.energy_span > 0 {
                 energy += y as f64 * y as f64;
-                if (sample + 1) % spec.energy_span == 0 {
+                if (sample + 1).is_multiple_of(spec.energy_span) {
                     result.energies.push(energy);
                     result.span_times.push(result.engine_time);
                     energy = 0.0;

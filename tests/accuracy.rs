@@ -65,7 +65,11 @@ fn no_path_drifts_with_render_length() {
 fn recursive_paths_are_reanchored() {
     let ring = scene("ring");
     let f64_errors = window_errors(Path::RecursiveF64, &ring, 600.0);
-    assert!(f64_errors[1] < -130.0, "recursive f64 at 10 min: {:.1} dB", f64_errors[1]);
+    assert!(
+        f64_errors[1] < -130.0,
+        "recursive f64 at 10 min: {:.1} dB",
+        f64_errors[1]
+    );
     // An f32 recursion of 65 536 samples shows its rounding but, re-anchored, stays bounded: an
     // unanchored one would have lost more than 30 dB more over 10 minutes.
     let f32_errors = window_errors(Path::RecursiveF32, &ring, 600.0);

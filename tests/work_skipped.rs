@@ -9,7 +9,11 @@ const FS: f64 = 48_000.0;
 /// Tilt 135° for 3 s, upright for 5 s, then (after a refill) 135° again for 2 s.
 fn controls_at(second: f64) -> ControlValues {
     ControlValues {
-        tilt_deg: if second < 3.0 || second >= 8.0 { 135.0 } else { 0.0 },
+        tilt_deg: if (3.0..8.0).contains(&second) {
+            0.0
+        } else {
+            135.0
+        },
         ..ControlValues::default()
     }
 }
@@ -30,7 +34,10 @@ fn render(block: usize) -> (Vec<f32>, Vec<bool>) {
             engine.refill();
         }
         let values = controls_at(start as f64 / FS);
-        engine.process(&Controls::constant(values, -6.0), &mut out[start..start + n]);
+        engine.process(
+            &Controls::constant(values, -6.0),
+            &mut out[start..start + n],
+        );
         settled.push(engine.is_settled());
         start += n;
     }
@@ -40,10 +47,16 @@ fn render(block: usize) -> (Vec<f32>, Vec<bool>) {
 #[test]
 fn settled_silence_is_the_same_in_any_block_size() {
     let (whole, settled) = render(8000);
-    assert!(settled.iter().any(|&s| s), "the engine never settled, so nothing was tested");
+    assert!(
+        settled.iter().any(|&s| s),
+        "the engine never settled, so nothing was tested"
+    );
     for block in [1, 63, 64, 4096] {
         let (cut, _) = render(block);
-        let first_difference = whole.iter().zip(&cut).position(|(a, b)| a.to_bits() != b.to_bits());
+        let first_difference = whole
+            .iter()
+            .zip(&cut)
+            .position(|(a, b)| a.to_bits() != b.to_bits());
         assert_eq!(first_difference, None, "block {block}");
     }
     // The second pour sounds after the silence: the shortcut left the engine ready for it.

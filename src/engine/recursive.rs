@@ -53,9 +53,9 @@ impl<T: Float> Oscillator<T> {
     fn start(onset: &UnitOnset, index: usize, sample_rate: f64) -> Option<Self> {
         let amplitude = onset.component_amplitudes()[index];
         let frequency_hz = onset.shape.frequency_hz[index];
-        if !(amplitude >= NEGLIGIBLE_AMPLITUDE)
-            || !(frequency_hz > 0.0 && frequency_hz < 0.5 * sample_rate)
-        {
+        let audible_amplitude = amplitude >= NEGLIGIBLE_AMPLITUDE;
+        let below_nyquist = frequency_hz > 0.0 && frequency_hz < 0.5 * sample_rate;
+        if !audible_amplitude || !below_nyquist {
             return None;
         }
         let decay_per_sample = onset.shape.decay_per_s[index] / sample_rate;
@@ -123,7 +123,7 @@ impl<T: Float> Oscillator<T> {
         if period_start >= self.silent_from {
             return false;
         }
-        if period_start % REANCHOR_SAMPLES == 0 && self.next_sample == period_start {
+        if period_start.is_multiple_of(REANCHOR_SAMPLES) && self.next_sample == period_start {
             self.anchor_at(period_start);
         }
         true
@@ -278,7 +278,7 @@ mod tests {
             let end = ((sample / GRID as u64 + 1) * GRID as u64).min(len);
             bank.render(sample, &mut out[sample as usize..end as usize]);
             sample = end;
-            if sample % GRID as u64 == 0 {
+            if sample.is_multiple_of(GRID as u64) {
                 bank.advance(sample);
             }
         }
@@ -311,8 +311,14 @@ mod tests {
         };
         let first = error_in(0..REANCHOR_SAMPLES);
         let last = error_in(5 * REANCHOR_SAMPLES..6 * REANCHOR_SAMPLES);
-        assert!(first > 1e-6, "an f32 recursion should show its rounding: {first}");
-        assert!(last < 2.0 * first, "drift: first interval {first}, last {last}");
+        assert!(
+            first > 1e-6,
+            "an f32 recursion should show its rounding: {first}"
+        );
+        assert!(
+            last < 2.0 * first,
+            "drift: first interval {first}, last {last}"
+        );
     }
 
     #[test]
