@@ -4,7 +4,9 @@ use super::pour::UnitOnset;
 
 /// A bank of sounding wave-unit components. The engine renders spans that lie within one grid
 /// period of [`super::partial::GRID`] samples and calls [`Synthesis::advance`] at each period's
-/// start, counted from the last reset; a path must give the same samples however spans are cut.
+/// start, counted from the last reset (while the bank is empty and the pour rests, only at the
+/// last period start before it renders again); a path must give the same samples however spans
+/// are cut.
 pub trait Synthesis {
     fn new(sample_rate: f64) -> Self;
     /// Silences every component.
