@@ -562,7 +562,9 @@ pub fn hostile_inputs(scale: Scale) -> Vec<Outcome> {
                 check("finite", all_finite, format!("{} renders", runs.len())),
                 check("ceiling", within, format!("largest peak {peak:.3}")),
             ],
-            notes: "values: NaN, +∞, −∞, −1e300, 1e300, −1, 0".into(),
+            notes: "values: NaN, +∞, −∞, −1e300, 1e300, −1, 0 (constants: at construction and \
+                    again through set_config mid-pour)"
+                .into(),
         });
     };
     for (name, set) in controls {
@@ -591,10 +593,51 @@ pub fn hostile_inputs(scale: Scale) -> Vec<Outcome> {
                 let sample_rate = if name == "sample rate" { value } else { fs };
                 run(sample_rate, config, seconds, &steady, 1)
             })
+            .chain(HOSTILE.iter().map(|&value| {
+                // The same value arriving mid-pour through `set_config`.
+                let mut config = follow();
+                set(&mut config, value);
+                switch_config(fs, config, seconds, &steady)
+            }))
             .collect();
         judge(format!("constant: {name}"), runs);
     }
     outcomes
+}
+
+/// Renders `seconds` under the normal constants, switching to `config` with `set_config` halfway.
+fn switch_config(
+    sample_rate: f64,
+    config: ModelConfig,
+    seconds: f64,
+    inputs: &impl ControlFn,
+) -> Run {
+    let mut engine = Engine::<VoiceBank>::with_synthesis(sample_rate, follow());
+    let half = (seconds * sample_rate / 2.0).round() as u64;
+    let spec = RenderSpec {
+        sample_rate,
+        config: follow(),
+        len: half,
+        keep: &[],
+        energy_span: 0,
+    };
+    let before = timed_render::render_with(&mut engine, &spec, inputs);
+    engine.set_config(config);
+    let mut after = timed_render::render_with(&mut engine, &spec, inputs);
+    // Each half answers to its own ceiling; a first half over the old one fails the case.
+    after.all_finite &= before.all_finite;
+    if before.peak > follow().ceiling as f32 {
+        after.peak = f32::INFINITY;
+    }
+    after.engine_time += before.engine_time;
+    Run {
+        render: after,
+        len: 2 * half,
+        ceiling: engine.config().ceiling,
+        units_started: engine.stats().units_started,
+        units_skipped: engine.stats().units_skipped,
+        given_up: engine.components_given_up(),
+    }
 }
 
 /// Hours of rendering: continuous pouring stays stationary, a never-decaying unit neither grows
