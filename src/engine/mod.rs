@@ -4,7 +4,9 @@
 //! randomness) → [`VoiceBank`] (wave units) → the caller's output buffer.
 
 pub mod amplitude;
+pub mod bank;
 pub mod bottle;
+pub mod component;
 pub mod config;
 pub mod controls;
 pub mod curves;

@@ -8,26 +8,21 @@
 //! far below the budget; in f32 it is not, which is why the default path ([`super::VoiceBank`])
 //! anchors every 64 samples instead of recursing.
 //!
-//! Drop rules are the default path's: no component with zero amplitude, a frequency of 0 or at
-//! or above Nyquist, or already below −120 dB; a component stops below −120 dB; at most
-//! [`MAX_PARTIALS`] sound at once, the weakest giving way; at most [`MAX_STARTS_PER_PERIOD`]
-//! start per grid period.
+//! Which components are computed ([`Component::of`]) and admitted ([`Bank`]) is shared with the
+//! default path; a component stops below −120 dB here too.
 
 use num_complex::Complex;
 use num_traits::Float;
 
+use super::bank::{Bank, Sounding};
+use super::component::{Component, SILENT_DECAY_EXPONENT};
 use super::partial::GRID;
 use super::pour::UnitOnset;
 use super::synthesis::Synthesis;
-use super::voices::{MAX_PARTIALS, MAX_STARTS_PER_PERIOD};
 
 /// Components are re-evaluated from the closed form on every multiple of this many samples
 /// (1024 grid periods, ≈ 1.4 s at 48 kHz): the longest a recursion runs unchecked.
 pub const REANCHOR_SAMPLES: u64 = 1024 * GRID as u64;
-/// ln 10⁶: a component is silent once e^(−Bτ) < 10⁻⁶ (−120 dB, MODEL.md §6).
-const SILENT_DECAY_EXPONENT: f64 = 13.815_510_557_964_274;
-/// Below −240 dB nothing is audible; skipping it keeps the recursion out of denormals.
-const NEGLIGIBLE_AMPLITUDE: f64 = 1e-12;
 
 /// The f64 recursive path: the precise one.
 pub type RecursiveF64 = RecursiveBank<f64>;
@@ -42,56 +37,36 @@ struct Oscillator<T> {
     next_sample: u64,
     /// The first sample at which the component is below −120 dB; never rendered.
     silent_from: u64,
-    onset_sample: u64,
-    onset_fraction: f64,
-    amplitude: f64,
-    decay_per_sample: f64,
-    radians_per_sample: f64,
+    component: Component,
+}
+
+impl<T: Float> Sounding for Oscillator<T> {
+    fn start(component: Component) -> Self {
+        // Bτ ≤ ln 10⁶ ⇔ sample ≤ onset + x + ln 10⁶ / d; `as` saturates for d = 0 (rings for ever).
+        let audible_until = component.onset_sample as f64
+            + component.onset_fraction
+            + SILENT_DECAY_EXPONENT / component.decay_per_sample;
+        let first_sample = component.first_sample();
+        let mut oscillator = Self {
+            state: Complex::new(T::zero(), T::zero()),
+            step: to_complex(component.step()),
+            next_sample: first_sample,
+            silent_from: (audible_until.floor() as u64).saturating_add(1),
+            component,
+        };
+        oscillator.anchor_at(first_sample);
+        oscillator
+    }
+
+    fn level(&self) -> f64 {
+        self.state.norm().to_f64().unwrap_or(0.0)
+    }
 }
 
 impl<T: Float> Oscillator<T> {
-    fn start(onset: &UnitOnset, index: usize, sample_rate: f64) -> Option<Self> {
-        let amplitude = onset.component_amplitudes()[index];
-        let frequency_hz = onset.shape.frequency_hz[index];
-        let audible_amplitude = amplitude >= NEGLIGIBLE_AMPLITUDE;
-        let below_nyquist = frequency_hz > 0.0 && frequency_hz < 0.5 * sample_rate;
-        if !audible_amplitude || !below_nyquist {
-            return None;
-        }
-        let decay_per_sample = onset.shape.decay_per_s[index] / sample_rate;
-        let radians_per_sample = std::f64::consts::TAU * frequency_hz / sample_rate;
-        // Bτ ≤ ln 10⁶ ⇔ sample ≤ onset + x + ln 10⁶ / d; `as` saturates for d = 0 (rings for ever).
-        let audible_until =
-            onset.sample as f64 + onset.fraction + SILENT_DECAY_EXPONENT / decay_per_sample;
-        let silent_from = (audible_until.floor() as u64).saturating_add(1);
-        // As on the default path, the first sample at or after the onset time is n + 1.
-        let first_sample = onset.sample + 1;
-        if first_sample >= silent_from {
-            return None;
-        }
-        let mut oscillator = Self {
-            state: Complex::new(T::zero(), T::zero()),
-            step: to_complex(complex_exp(-decay_per_sample, radians_per_sample)),
-            next_sample: first_sample,
-            silent_from,
-            onset_sample: onset.sample,
-            onset_fraction: onset.fraction,
-            amplitude,
-            decay_per_sample,
-            radians_per_sample,
-        };
-        oscillator.anchor_at(first_sample);
-        Some(oscillator)
-    }
-
     /// Sets the state from the closed form at `sample`.
     fn anchor_at(&mut self, sample: u64) {
-        let elapsed = (sample - self.onset_sample) as f64 - self.onset_fraction;
-        let [re, im] = complex_exp(
-            -self.decay_per_sample * elapsed,
-            self.radians_per_sample * elapsed,
-        );
-        self.state = to_complex([self.amplitude * re, self.amplitude * im]);
+        self.state = to_complex(self.component.state_at(sample));
         self.next_sample = sample;
     }
 
@@ -128,86 +103,49 @@ impl<T: Float> Oscillator<T> {
         }
         true
     }
-
-    fn level(&self) -> f64 {
-        self.state.norm().to_f64().unwrap_or(0.0)
-    }
 }
 
-/// The sounding components of a recursive path, in a bank of fixed capacity allocated once.
+/// The sounding components of a recursive path.
 pub struct RecursiveBank<T> {
-    oscillators: Vec<Oscillator<T>>,
+    bank: Bank<Oscillator<T>>,
     /// Sums the components of a span in the path's own precision before it meets the f32 output.
     scratch: [T; GRID],
     sample_rate: f64,
-    given_up: u64,
-    starts_left: u32,
-}
-
-impl<T: Float> RecursiveBank<T> {
-    fn insert(&mut self, oscillator: Oscillator<T>) {
-        if self.oscillators.len() < MAX_PARTIALS {
-            self.oscillators.push(oscillator);
-            return;
-        }
-        self.given_up += 1;
-        let weakest = self
-            .oscillators
-            .iter_mut()
-            .min_by(|a, b| a.level().total_cmp(&b.level()))
-            .expect("a full bank is not empty");
-        if weakest.level() < oscillator.level() {
-            *weakest = oscillator;
-        }
-    }
 }
 
 impl<T: Float> Synthesis for RecursiveBank<T> {
     fn new(sample_rate: f64) -> Self {
         Self {
-            oscillators: Vec::with_capacity(MAX_PARTIALS),
+            bank: Bank::new(),
             scratch: [T::zero(); GRID],
             sample_rate,
-            given_up: 0,
-            starts_left: MAX_STARTS_PER_PERIOD,
         }
     }
 
     fn clear(&mut self) {
-        self.oscillators.clear();
-        self.given_up = 0;
-        self.starts_left = MAX_STARTS_PER_PERIOD;
+        self.bank.clear();
     }
 
     fn is_empty(&self) -> bool {
-        self.oscillators.is_empty()
+        self.bank.sounding().is_empty()
     }
 
     fn len(&self) -> usize {
-        self.oscillators.len()
+        self.bank.sounding().len()
     }
 
     fn given_up(&self) -> u64 {
-        self.given_up
+        self.bank.given_up()
     }
 
     fn start_unit(&mut self, onset: &UnitOnset) {
-        for index in 0..2 {
-            if self.starts_left == 0 {
-                self.given_up += 1;
-                continue;
-            }
-            self.starts_left -= 1;
-            if let Some(oscillator) = Oscillator::start(onset, index, self.sample_rate) {
-                self.insert(oscillator);
-            }
-        }
+        self.bank.start_unit(onset, self.sample_rate);
     }
 
     fn render(&mut self, span_start: u64, out: &mut [f32]) {
         let scratch = &mut self.scratch[..out.len()];
         scratch.fill(T::zero());
-        for oscillator in &mut self.oscillators {
+        for oscillator in self.bank.sounding_mut() {
             oscillator.render(span_start, scratch);
         }
         for (y, &sum) in out.iter_mut().zip(scratch.iter()) {
@@ -216,16 +154,9 @@ impl<T: Float> Synthesis for RecursiveBank<T> {
     }
 
     fn advance(&mut self, period_start: u64) {
-        self.starts_left = MAX_STARTS_PER_PERIOD;
-        self.oscillators
-            .retain_mut(|oscillator| oscillator.advance(period_start));
+        self.bank
+            .advance(|oscillator| oscillator.advance(period_start));
     }
-}
-
-fn complex_exp(log_magnitude: f64, phase: f64) -> [f64; 2] {
-    let magnitude = log_magnitude.exp();
-    let (sin, cos) = phase.sin_cos();
-    [magnitude * cos, magnitude * sin]
 }
 
 fn to_complex<T: Float>([re, im]: [f64; 2]) -> Complex<T> {
