@@ -141,6 +141,18 @@ struct Run {
 }
 
 impl Run {
+    /// What `engine` did in `render`, a render of `len` samples.
+    fn of(render: TimedRender, len: u64, engine: &Engine<VoiceBank>) -> Self {
+        Self {
+            render,
+            len,
+            ceiling: engine.config().ceiling,
+            units_started: engine.stats().units_started,
+            units_skipped: engine.stats().units_skipped,
+            given_up: engine.components_given_up(),
+        }
+    }
+
     fn time_per_sample(&self) -> f64 {
         self.render.engine_time.as_secs_f64() / self.len as f64
     }
@@ -171,14 +183,7 @@ fn run(
             energy_span: (ENERGY_SPAN_S * fs).round() as u64,
         };
         let render = timed_render::render_with(&mut engine, &spec, inputs);
-        let this = Run {
-            render,
-            len,
-            ceiling: engine.config().ceiling,
-            units_started: engine.stats().units_started,
-            units_skipped: engine.stats().units_skipped,
-            given_up: engine.components_given_up(),
-        };
+        let this = Run::of(render, len, &engine);
         if best
             .as_ref()
             .is_none_or(|b| this.render.engine_time < b.render.engine_time)
@@ -761,14 +766,7 @@ fn long_run(
         energy_span,
     };
     let render = timed_render::render_with(&mut engine, &spec, inputs);
-    Run {
-        render,
-        len,
-        ceiling: engine.config().ceiling,
-        units_started: engine.stats().units_started,
-        units_skipped: engine.stats().units_skipped,
-        given_up: engine.components_given_up(),
-    }
+    Run::of(render, len, &engine)
 }
 
 /// Every group of cases, in the report's order.
