@@ -75,25 +75,26 @@ impl Renderer {
         &self.engine
     }
 
-    /// MODEL.md §8 reset; MIDI overrides are dropped too, so a bounce starts from the parameters.
+    /// The host's reset: the bottle's, and the transport is watched afresh.
     pub fn reset(&mut self, config: ModelConfig) {
-        self.apply_config(config);
-        self.engine.reset();
-        self.decoder.reset();
-        self.overrides.clear();
+        self.reset_bottle(config);
         self.transport.reset();
-        self.units_seen = 0;
     }
 
     /// Call once per `process()` before rendering; resets when the transport starts or jumps.
     pub fn observe_transport(&mut self, playing: bool, position: Option<i64>, config: ModelConfig) {
         if self.transport.observe(playing, position) {
-            self.apply_config(config);
-            self.engine.reset();
-            self.decoder.reset();
-            self.overrides.clear();
-            self.units_seen = 0;
+            self.reset_bottle(config);
         }
+    }
+
+    /// MODEL.md §8 reset; MIDI overrides are dropped too, so a bounce starts from the parameters.
+    fn reset_bottle(&mut self, config: ModelConfig) {
+        self.apply_config(config);
+        self.engine.reset();
+        self.decoder.reset();
+        self.overrides.clear();
+        self.units_seen = 0;
     }
 
     /// Call once per `process()` after rendering `samples` samples.
