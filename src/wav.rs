@@ -47,7 +47,7 @@ impl WavFile {
             Some(parent) if !parent.as_os_str().is_empty() => parent,
             _ => Path::new("."),
         };
-        let temp = NamedTempFile::new_in(directory).map_err(io_error)?;
+        let temp = temp_file_builder().tempfile_in(directory).map_err(io_error)?;
         let file = temp.reopen().map_err(io_error)?;
         let (bits_per_sample, sample_format) = match format {
             SampleFormat::F32 => (32, HoundFormat::Float),
@@ -107,6 +107,18 @@ impl WavFile {
             source,
         }
     }
+}
+
+/// Temporary files are private by default; the finished WAV should get the permissions any new
+/// file gets (0o666 less the umask), as if it had been written in place.
+fn temp_file_builder() -> tempfile::Builder<'static, 'static> {
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder
 }
 
 /// Rounds a sample in [−1, 1] to a signed integer of `fraction_bits` + 1 bits, saturating.

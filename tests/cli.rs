@@ -35,6 +35,14 @@ fn with_no_scene_it_renders_the_default_pour_to_pour_wav() {
     let seconds = reader.duration() as f64 / 48_000.0;
     assert!((5.0..5.6).contains(&seconds), "{seconds} s");
     assert_eq!(files_in(directory.path()), ["pour.wav"]);
+    #[cfg(unix)]
+    {
+        // Readable like any new file, not private like the temporary file it was written as.
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(directory.path().join("pour.wav")).unwrap().permissions().mode();
+        assert_eq!(mode & 0o600, 0o600);
+        assert_ne!(mode & 0o044, 0, "mode {mode:o}");
+    }
 }
 
 #[test]
