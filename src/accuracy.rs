@@ -14,7 +14,8 @@ use std::time::Instant;
 use crate::engine::config::ControlValues;
 use crate::engine::{DrainMode, ModelConfig, RecursiveF32, RecursiveF64, Synthesis, VoiceBank};
 use crate::reference;
-use crate::timed_render::{self, ControlFn, RenderSpec};
+use crate::engine::ControlSource;
+use crate::timed_render::{self, RenderSpec};
 
 /// Seconds compared at the start and at the end of a long render.
 pub const WINDOW_S: f64 = 10.0;
@@ -36,7 +37,7 @@ pub struct Scene {
 
 impl Scene {
     /// The scene's inputs at `sample` of a render at `sample_rate`, with the output gain.
-    pub fn controls(&self, sample_rate: f64) -> impl ControlFn + '_ {
+    pub fn controls(&self, sample_rate: f64) -> impl ControlSource + '_ {
         move |sample: u64| ((self.inputs)(sample as f64 / sample_rate), GAIN_DB)
     }
 }
@@ -188,9 +189,8 @@ pub fn reference_windows(
     let mut samples = Vec::new();
     for window in windows {
         let controls = scene.controls(sample_rate);
-        let mut source = |sample: u64| controls.at(sample);
         samples.extend(
-            reference::render(sample_rate, scene.config, &mut source, window.clone()).samples,
+            reference::render(sample_rate, scene.config, &controls, window.clone()).samples,
         );
     }
     let audio_s = samples.len() as f64 / sample_rate;
@@ -468,8 +468,7 @@ mod tests {
     fn the_ring_scene_starts_exactly_one_unit() {
         let scene = scenes().into_iter().find(|s| s.name == "ring").unwrap();
         let controls = scene.controls(48_000.0);
-        let mut source = |n: u64| controls.at(n);
-        let render = reference::render(48_000.0, scene.config, &mut source, 0..48_000);
+        let render = reference::render(48_000.0, scene.config, &controls, 0..48_000);
         assert_eq!(render.onsets.len(), 1);
     }
 }

@@ -7,24 +7,12 @@
 use std::ops::Range;
 
 use crate::engine::amplitude::db_to_gain;
-use crate::engine::config::{ControlValues, GAIN_DB, SAMPLE_RATE_HZ};
-use crate::engine::{ModelConfig, Pour, UnitOnset};
+use crate::engine::config::{GAIN_DB, SAMPLE_RATE_HZ};
+use crate::engine::{ControlSource, ModelConfig, Pour, UnitOnset};
 
 /// A component's envelope e^(−Bτ) below which the reference stops adding it (−260 dB): far below
 /// any error budget, and keeps the evaluation finite in time.
 const NEGLIGIBLE_ENVELOPE: f64 = 1e-13;
-
-/// The inputs of every sample, as a function of the sample index.
-pub trait ControlSource {
-    /// The model's inputs and the output gain in dB at sample `sample`.
-    fn at(&mut self, sample: u64) -> (ControlValues, f64);
-}
-
-impl<F: FnMut(u64) -> (ControlValues, f64)> ControlSource for F {
-    fn at(&mut self, sample: u64) -> (ControlValues, f64) {
-        self(sample)
-    }
-}
 
 pub struct ReferenceRender {
     /// The samples of the window, in order.
@@ -37,7 +25,7 @@ pub struct ReferenceRender {
 pub fn render(
     sample_rate: f64,
     config: ModelConfig,
-    controls: &mut impl ControlSource,
+    controls: &impl ControlSource,
     window: Range<u64>,
 ) -> ReferenceRender {
     let sample_rate = SAMPLE_RATE_HZ.sanitize(sample_rate);

@@ -7,8 +7,7 @@ use serde::Deserialize;
 
 use crate::automation::Automation;
 use crate::engine::config::{self, ControlValues, Range};
-use crate::engine::{Controls, DrainMode, ModelConfig};
-use crate::reference::ControlSource;
+use crate::engine::{ControlSource, Controls, DrainMode, ModelConfig};
 
 /// The built-in default scene: a full 300 ml bottle of water tilted from 90° to 135° over half a
 /// second and held until it stops pouring.
@@ -146,8 +145,8 @@ impl Scene {
     }
 }
 
-impl ControlSource for &Scene {
-    fn at(&mut self, sample: u64) -> (ControlValues, f64) {
+impl ControlSource for Scene {
+    fn at(&self, sample: u64) -> (ControlValues, f64) {
         self.values_at(sample)
     }
 }

@@ -14,7 +14,8 @@ use crate::engine::config::{self, ControlValues};
 use crate::engine::voices::MAX_PARTIALS;
 use crate::engine::{DrainMode, Engine, ModelConfig, VoiceBank};
 use crate::reference;
-use crate::timed_render::{self, ControlFn, RenderSpec, TimedRender};
+use crate::engine::ControlSource;
+use crate::timed_render::{self, RenderSpec, TimedRender};
 
 /// How long the cases render.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -167,7 +168,7 @@ fn run(
     sample_rate: f64,
     config: ModelConfig,
     seconds: f64,
-    inputs: &impl ControlFn,
+    inputs: &impl ControlSource,
     repeats: usize,
 ) -> Run {
     let mut best: Option<Run> = None;
@@ -615,7 +616,7 @@ fn switch_config(
     sample_rate: f64,
     config: ModelConfig,
     seconds: f64,
-    inputs: &impl ControlFn,
+    inputs: &impl ControlSource,
 ) -> Run {
     let mut engine = Engine::<VoiceBank>::with_synthesis(sample_rate, follow());
     let half = (seconds * sample_rate / 2.0).round() as u64;
@@ -715,8 +716,7 @@ pub fn long_render(scale: Scale) -> Vec<Outcome> {
     let run_ring = long_run(fs, ring.config, seconds, &controls, spec_span);
     let len = (seconds * fs) as u64;
     let window = len - fs as u64..len;
-    let mut source = |sample: u64| controls.at(sample);
-    let exact = reference::render(fs, ring.config, &mut source, window.clone()).samples;
+    let exact = reference::render(fs, ring.config, &controls, window.clone()).samples;
     let spec = RenderSpec {
         sample_rate: fs,
         config: ring.config,
@@ -753,7 +753,7 @@ fn long_run(
     sample_rate: f64,
     config: ModelConfig,
     seconds: f64,
-    inputs: &impl ControlFn,
+    inputs: &impl ControlSource,
     energy_span: u64,
 ) -> Run {
     let mut engine = Engine::<VoiceBank>::with_synthesis(sample_rate, config);

@@ -5,22 +5,10 @@
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
-use crate::engine::{ControlValues, Controls, Engine, Lane, ModelConfig, Synthesis};
+use crate::engine::{ControlSource, Controls, Engine, Lane, ModelConfig, Synthesis};
 
 /// Samples per `process` call: a typical host block.
 pub const BLOCK: usize = 4096;
-
-/// The model's inputs as a function of the sample index.
-pub trait ControlFn {
-    /// The inputs and the output gain (dB) at `sample`.
-    fn at(&self, sample: u64) -> (ControlValues, f64);
-}
-
-impl<F: Fn(u64) -> (ControlValues, f64)> ControlFn for F {
-    fn at(&self, sample: u64) -> (ControlValues, f64) {
-        self(sample)
-    }
-}
 
 /// What one render kept and cost.
 pub struct TimedRender {
@@ -54,7 +42,7 @@ pub struct RenderSpec<'a> {
 }
 
 /// Renders `spec.len` samples of `controls` on synthesis path `S` from a reset.
-pub fn render<S: Synthesis>(spec: &RenderSpec, controls: &impl ControlFn) -> TimedRender {
+pub fn render<S: Synthesis>(spec: &RenderSpec, controls: &impl ControlSource) -> TimedRender {
     let mut engine = Engine::<S>::with_synthesis(spec.sample_rate, spec.config);
     render_with(&mut engine, spec, controls)
 }
@@ -63,7 +51,7 @@ pub fn render<S: Synthesis>(spec: &RenderSpec, controls: &impl ControlFn) -> Tim
 pub fn render_with<S: Synthesis>(
     engine: &mut Engine<S>,
     spec: &RenderSpec,
-    controls: &impl ControlFn,
+    controls: &impl ControlSource,
 ) -> TimedRender {
     let mut lanes: [Vec<f64>; 5] = std::array::from_fn(|_| Vec::with_capacity(BLOCK));
     let mut out = vec![0.0f32; BLOCK];

@@ -2,6 +2,19 @@
 
 use super::config::{ControlValues, GAIN_DB};
 
+/// The model's inputs as a function of the sample index: how the reference and the timed
+/// renders read a scene, sample by sample.
+pub trait ControlSource {
+    /// The inputs and the output gain in dB at `sample`.
+    fn at(&self, sample: u64) -> (ControlValues, f64);
+}
+
+impl<F: Fn(u64) -> (ControlValues, f64)> ControlSource for F {
+    fn at(&self, sample: u64) -> (ControlValues, f64) {
+        self(sample)
+    }
+}
+
 /// One automatable input over a block.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Lane<'a> {

@@ -19,7 +19,7 @@ pub mod synthesis;
 pub mod voices;
 
 pub use config::{ControlValues, DrainMode, ModelConfig};
-pub use controls::{Controls, Lane};
+pub use controls::{ControlSource, Controls, Lane};
 pub use pour::{Pour, PourStats, UnitOnset};
 pub use recursive::{RecursiveF32, RecursiveF64};
 pub use synthesis::Synthesis;
