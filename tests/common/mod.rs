@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use sake_glug::engine::{ControlValues, Engine, ModelConfig, Pour, UnitOnset};
-use sake_glug::reference;
+use sake_glug::{accuracy, reference};
 use sake_glug::scene::{LaneBuffers, Scene};
 
 /// Renders `len` samples of `scene` on the default path, cutting time into blocks of the sizes
@@ -26,20 +26,13 @@ pub fn render_in_blocks(scene: &Scene, len: usize, block_sizes: &[usize]) -> Vec
 
 /// The f64 reference of the same scene.
 pub fn reference_render(scene: &Scene, len: usize) -> Vec<f64> {
-    let mut source = scene;
-    reference::render(scene.sample_rate as f64, scene.config, &mut source, 0..len as u64).samples
+    reference::render(scene.sample_rate as f64, scene.config, scene, 0..len as u64).samples
 }
 
 /// Largest absolute error relative to the reference's peak, in dB.
 pub fn error_db(fast: &[f32], reference: &[f64]) -> f64 {
-    assert_eq!(fast.len(), reference.len());
-    let peak = reference.iter().fold(0.0f64, |peak, y| peak.max(y.abs()));
-    assert!(peak > 0.0, "the reference is silent");
-    let error = fast
-        .iter()
-        .zip(reference)
-        .fold(0.0f64, |error, (x, y)| error.max((*x as f64 - y).abs()));
-    20.0 * (error / peak).max(1e-300).log10()
+    assert!(reference.iter().any(|y| *y != 0.0), "the reference is silent");
+    accuracy::error_db(fast, reference).0
 }
 
 /// Every unit a pour starts under constant controls over `seconds`, with the summed outflow
