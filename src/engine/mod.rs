@@ -147,10 +147,7 @@ impl<S: Synthesis> Engine<S> {
 
     /// Renders `out.len()` samples; `controls` give the inputs from the block's first sample.
     pub fn process(&mut self, controls: &Controls, out: &mut [f32]) {
-        if self.voices.is_empty()
-            && controls.pour_is_constant()
-            && self.resting_under == Some(controls.values_at(0))
-        {
+        if self.voices.is_empty() && self.rests_under(controls) {
             // Settled under the same controls: the block is silence, so it costs a fill and not
             // a walk over its grid periods. An empty bank only needs the last period start.
             out.fill(0.0);
@@ -186,10 +183,10 @@ impl<S: Synthesis> Engine<S> {
     }
 
     fn step_pour(&mut self, controls: &Controls, len: usize) {
-        let constant = controls.pour_is_constant().then(|| controls.values_at(0));
-        if constant.is_some() && self.resting_under == constant {
+        if self.rests_under(controls) {
             return;
         }
+        let constant = controls.pour_is_constant().then(|| controls.values_at(0));
         // Under constant controls they are read and sanitised once for the whole span.
         let held = constant.map(ControlValues::sanitized);
         let Self {
@@ -221,6 +218,12 @@ impl<S: Synthesis> Engine<S> {
             Some(step) if step.amount_ml == 0.0 && !step.refilled => constant,
             _ => None,
         };
+    }
+
+    /// Whether the pour rests under `controls`, the same constant ones as its last step: then
+    /// stepping it would change nothing.
+    fn rests_under(&self, controls: &Controls) -> bool {
+        controls.pour_is_constant() && self.resting_under == Some(controls.values_at(0))
     }
 
     /// Output gain, then the guarantees of MODEL.md §6: finite, within the ceiling, no denormal.
