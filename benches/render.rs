@@ -2,8 +2,8 @@
 //! by the sample rate), beside the memory limit: merely filling a buffer of the same length.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use sake_glug::render::render;
-use sake_glug::scene::Scene;
+use sake_glug::offline::render_scene;
+use sake_glug::offline::Scene;
 
 /// One hour of repeated pours at 48 kHz: every 10 s tilt up and pour 6 s, put the bottle
 /// upright, and refill it. A change of the fill level refills in simulate mode, so the level
@@ -12,8 +12,17 @@ fn hour_of_pours() -> Scene {
     let (mut tilt, mut fill) = (Vec::new(), Vec::new());
     for pour in 0..360 {
         let t = pour as f64 * 10.0;
-        tilt.push(format!("[{t}, 90.0], [{}, 135.0], [{}, 135.0], [{}, 0.0]", t + 0.5, t + 6.0, t + 6.5));
-        let (from, to) = if pour % 2 == 0 { (100.0, 99.9) } else { (99.9, 100.0) };
+        tilt.push(format!(
+            "[{t}, 90.0], [{}, 135.0], [{}, 135.0], [{}, 0.0]",
+            t + 0.5,
+            t + 6.0,
+            t + 6.5
+        ));
+        let (from, to) = if pour % 2 == 0 {
+            (100.0, 99.9)
+        } else {
+            (99.9, 100.0)
+        };
         fill.push(format!("[{}, {from}], [{}, {to}]", t + 9.0, t + 9.0));
     }
     let text = format!(
@@ -27,11 +36,11 @@ fn hour_of_pours() -> Scene {
 /// Renders into `out` (the sink a WAV writer would be), returning the sample count.
 fn render_into(scene: &Scene, out: &mut Vec<f32>) -> usize {
     out.clear();
-    render(
+    render_scene(
         scene,
         |block| {
             out.extend_from_slice(block);
-            Ok::<(), sake_glug::render::RenderError>(())
+            Ok::<(), sake_glug::offline::RenderError>(())
         },
         |_| {},
     )
@@ -40,7 +49,10 @@ fn render_into(scene: &Scene, out: &mut Vec<f32>) -> usize {
 }
 
 fn bench(c: &mut Criterion) {
-    for (name, scene) in [("default scene", Scene::default()), ("one hour of pours", hour_of_pours())] {
+    for (name, scene) in [
+        ("default scene", Scene::default()),
+        ("one hour of pours", hour_of_pours()),
+    ] {
         let mut out = Vec::new();
         let samples = render_into(&scene, &mut out);
         let mut group = c.benchmark_group(name);
@@ -49,13 +61,16 @@ fn bench(c: &mut Criterion) {
         group.bench_function(BenchmarkId::new("render", samples), |b| {
             b.iter(|| render_into(&scene, &mut out))
         });
-        group.bench_function(BenchmarkId::new("fill zeros (memory limit)", samples), |b| {
-            b.iter(|| {
-                out.clear();
-                out.resize(samples, 0.0);
-                out.len()
-            })
-        });
+        group.bench_function(
+            BenchmarkId::new("fill zeros (memory limit)", samples),
+            |b| {
+                b.iter(|| {
+                    out.clear();
+                    out.resize(samples, 0.0);
+                    out.len()
+                })
+            },
+        );
         group.finish();
         report_realtime_factors(name, &scene, samples, &mut out);
     }

@@ -44,7 +44,7 @@ impl Handling {
 }
 
 /// Renders `seconds` from a reset, block by block as a host would; returns units started.
-fn render(
+fn render_hours(
     engine: &mut Engine,
     handling: Handling,
     seconds: f64,
@@ -121,7 +121,7 @@ fn one_hour(c: &mut Criterion) {
         group.bench_function(name, |b| {
             b.iter_custom(|iters| {
                 timed(&medians, name, iters, || {
-                    render(&mut engine, handling, HOUR_S, &ramp, &mut out);
+                    render_hours(&mut engine, handling, HOUR_S, &ramp, &mut out);
                 })
             })
         });
@@ -158,7 +158,7 @@ fn cost_follows_units(c: &mut Criterion) {
         group.bench_function(BenchmarkId::new("5 s of pouring", seconds), |b| {
             b.iter_custom(|iters| {
                 timed(&medians, &key, iters, || {
-                    render(&mut engine, handling, seconds, &[], &mut out);
+                    render_hours(&mut engine, handling, seconds, &[], &mut out);
                 })
             })
         });
@@ -174,14 +174,14 @@ fn cost_follows_units(c: &mut Criterion) {
     let mut units = Vec::new();
     for pour_s in pours {
         let handling = Handling::PourFor { seconds: pour_s };
-        units.push(render(&mut engine, handling, 600.0, &[], &mut out));
+        units.push(render_hours(&mut engine, handling, 600.0, &[], &mut out));
         let key = format!("pour {pour_s} s");
         group.bench_function(
             BenchmarkId::new("10 min render, pouring for", pour_s),
             |b| {
                 b.iter_custom(|iters| {
                     timed(&medians, &key, iters, || {
-                        render(&mut engine, handling, 600.0, &[], &mut out);
+                        render_hours(&mut engine, handling, 600.0, &[], &mut out);
                     })
                 })
             },
@@ -229,7 +229,7 @@ fn idle_against_zeros(c: &mut Criterion) {
     group.bench_function("idle engine, 10 min", |b| {
         b.iter_custom(|iters| {
             timed(&medians, "idle", iters, || {
-                render(&mut engine, Handling::Idle, seconds, &[], &mut out);
+                render_hours(&mut engine, Handling::Idle, seconds, &[], &mut out);
             })
         })
     });

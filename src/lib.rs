@@ -1,224 +1,25 @@
-//! Sake Glug: the glug vibration of liquid poured from a Japanese sake bottle, as a CLAP/VST3
-//! plugin and an offline renderer that drive the same engine.
+//! Sake Glug: the glug vibration of liquid poured from a Japanese sake bottle.
+//!
+//! One engine, three products:
+//!
+//! - [`engine`]: the model of `docs/MODEL.md` (controls → pour → synthesis), shared by all;
+//! - [`plugin`]: the CLAP/VST3 plugin (feature `plugin`, its egui editor with `editor`);
+//! - [`offline`]: scene files, automation lanes, the offline renderer and its file writers, used
+//!   by the `sake-glug` command line (feature `cli`);
+//! - [`reports`]: the accuracy and stability reports the command line prints.
+//!
+//! [`device`] holds what a tilt device sends (the MIDI mapping), shared by the plugin and the
+//! offline renderer. Data flows one way: scene, take or host → controls → pour → synthesis →
+//! sinks (WAV, audio out).
+#![warn(missing_docs)]
 
-pub mod accuracy;
-pub mod automation;
+pub mod device;
 pub mod engine;
-pub mod reference;
-pub mod render;
-pub mod report_cli;
-pub mod scene;
-pub mod stability;
-pub mod timed_render;
-pub mod wav;
-pub mod midi;
-pub mod params;
-pub mod plugin_feed;
-pub mod plugin_render;
-pub mod plugin_transport;
+pub mod offline;
+#[cfg(feature = "plugin")]
+pub mod plugin;
+pub mod reports;
 
-#[cfg(feature = "editor")]
-pub mod editor;
-
-use std::num::NonZeroU32;
-use std::sync::Arc;
-
-use nice_plug::prelude::*;
-
-use params::GlugParams;
-use plugin_feed::Feed;
-use plugin_render::{MidiInput, Renderer, Settings};
-
-/// The plugin shell: parameters and lifecycle around [`Renderer`], which does the work.
-pub struct SakeGlug {
-    params: Arc<GlugParams>,
-    feed: Arc<Feed>,
-    /// Built in `initialize()`, where allocating is allowed.
-    renderer: Option<Renderer>,
-}
-
-impl Default for SakeGlug {
-    fn default() -> Self {
-        Self {
-            params: Arc::new(GlugParams::default()),
-            feed: Arc::new(Feed::default()),
-            renderer: None,
-        }
-    }
-}
-
-impl SakeGlug {
-    /// The parameters, as the host and the editor see them.
-    pub fn glug_params(&self) -> &Arc<GlugParams> {
-        &self.params
-    }
-
-    /// What the audio thread reports to the editor.
-    pub fn feed(&self) -> &Arc<Feed> {
-        &self.feed
-    }
-
-    /// The renderer, once the plugin has been initialised.
-    pub fn renderer(&self) -> Option<&Renderer> {
-        self.renderer.as_ref()
-    }
-}
-
-fn midi_input<S>(event: &NoteEvent<S>) -> Option<MidiInput> {
-    match *event {
-        NoteEvent::NoteOn { velocity, .. } if velocity > 0.0 => Some(MidiInput::Refill),
-        NoteEvent::MidiCC { channel, cc, value, .. } => Some(MidiInput::Cc {
-            channel,
-            cc,
-            value: (value.clamp(0.0, 1.0) * 127.0).round() as u8,
-        }),
-        _ => None,
-    }
-}
-
-impl Plugin for SakeGlug {
-    const NAME: &'static str = "Sake Glug";
-    const VENDOR: &'static str = "Sake Glug";
-    const URL: &'static str = "https://example.invalid/sake-glug";
-    const EMAIL: &'static str = "sake-glug@example.invalid";
-    const VERSION: &'static str = env!("CARGO_PKG_VERSION");
-
-    // A generator: no audio input; the same signal on every output channel.
-    const AUDIO_IO_LAYOUTS: &'static [AudioIOLayout] = &[
-        AudioIOLayout {
-            main_input_channels: None,
-            main_output_channels: NonZeroU32::new(2),
-            ..AudioIOLayout::const_default()
-        },
-        AudioIOLayout {
-            main_input_channels: None,
-            main_output_channels: NonZeroU32::new(1),
-            ..AudioIOLayout::const_default()
-        },
-    ];
-
-    // CCs from the tilt device need the full MIDI config.
-    const MIDI_INPUT: MidiConfig = MidiConfig::MidiCCs;
-    const SAMPLE_ACCURATE_AUTOMATION: bool = true;
-
-    #[cfg(feature = "editor")]
-    type Editor = nice_plug_egui::EguiEditor<editor::GlugEditor>;
-    #[cfg(not(feature = "editor"))]
-    type Editor = ();
-    type SysExMessage = ();
-    type BackgroundTask = ();
-
-    fn params(&self) -> Arc<dyn Params> {
-        self.params.clone()
-    }
-
-    #[cfg(feature = "editor")]
-    fn editor(&mut self, _async_executor: AsyncExecutor<Self>) -> Option<Self::Editor> {
-        editor::create(self.params.clone(), self.feed.clone())
-    }
-
-    fn activate(
-        &mut self,
-        _audio_io_layout: &AudioIOLayout,
-        buffer_config: &BufferConfig,
-        _context: &mut impl ActivateContext<Self>,
-    ) -> bool {
-        let sample_rate = buffer_config.sample_rate as f64;
-        let reusable = self
-            .renderer
-            .as_ref()
-            .is_some_and(|renderer| renderer.sample_rate() == sample_rate);
-        if !reusable {
-            self.renderer = Some(Renderer::new(sample_rate, self.params.model_config()));
-        }
-        true
-    }
-
-    fn reset(&mut self) {
-        if let Some(renderer) = &mut self.renderer {
-            renderer.reset(self.params.model_config());
-        }
-    }
-
-    fn process(
-        &mut self,
-        buffer: &mut Buffer,
-        _aux: &mut AuxiliaryBuffers,
-        context: &mut impl ProcessContext<Self>,
-    ) -> ProcessStatus {
-        let len = buffer.samples();
-        let channels = buffer.as_slice();
-        let Some(renderer) = &mut self.renderer else {
-            channels.iter_mut().for_each(|channel| channel.fill(0.0));
-            return ProcessStatus::Normal;
-        };
-        let settings = Settings::from_params(&self.params);
-        let transport = context.transport();
-        renderer.observe_transport(transport.playing, transport.pos_samples(), settings.config);
-
-        let Some((first, others)) = channels.split_first_mut() else {
-            return ProcessStatus::KeepAlive;
-        };
-        // Events split the block so that a note-on or CC acts on its own sample.
-        let mut next_event = context.next_event();
-        let mut position = 0;
-        loop {
-            while let Some(event) = next_event {
-                if event.timing() as usize > position && position < len {
-                    break;
-                }
-                if let Some(input) = midi_input(&event) {
-                    renderer.handle(input, &settings.midi);
-                }
-                next_event = context.next_event();
-            }
-            if position >= len {
-                break;
-            }
-            let end = next_event.map_or(len, |event| (event.timing() as usize).clamp(position + 1, len));
-            renderer.render(&settings, &mut first[position..end], &self.feed);
-            position = end;
-        }
-        for channel in others {
-            channel.copy_from_slice(first);
-        }
-        renderer.finish_block(len);
-        ProcessStatus::KeepAlive
-    }
-}
-
-impl ClapPlugin for SakeGlug {
-    const CLAP_ID: &'static str = "org.sake-glug.sake-glug";
-    const CLAP_DESCRIPTION: Option<&'static str> =
-        Some("The glug vibration of sake poured from a bottle, driven by its tilt");
-    const CLAP_MANUAL_URL: Option<&'static str> = None;
-    const CLAP_SUPPORT_URL: Option<&'static str> = None;
-    const CLAP_FEATURES: &'static [ClapFeature] = &[
-        ClapFeature::Instrument,
-        ClapFeature::Synthesizer,
-        ClapFeature::Mono,
-        ClapFeature::Stereo,
-    ];
-
-    fn remote_controls(&self, context: &mut impl RemoteControlsContext) {
-        let params = &self.params;
-        context.add_section("Pour", |section| {
-            section.add_page("Pour", |page| {
-                page.add_param(&params.tilt);
-                page.add_param(&params.viscosity);
-                page.add_param(&params.fill);
-                page.add_param(&params.pour_time);
-                page.add_param(&params.gain);
-            });
-        });
-    }
-}
-
-impl Vst3Plugin for SakeGlug {
-    const VST3_CLASS_ID: [u8; 16] = *b"SakeGlugPluginV1";
-    const VST3_SUBCATEGORIES: &'static [Vst3SubCategory] =
-        &[Vst3SubCategory::Instrument, Vst3SubCategory::Synth, Vst3SubCategory::Generator];
-}
-
-nice_export_clap!(SakeGlug);
-nice_export_vst3!(SakeGlug);
+/// The plugin type, at the crate's root for nice-plug's export macros.
+#[cfg(feature = "plugin")]
+pub use plugin::SakeGlug;

@@ -47,8 +47,10 @@ pub const FREQ_JITTER: Range = Range::new(0.0, 1.0, 0.05);
 pub const DECAY_SIGMA: Range = Range::new(0.0, 3.0, 0.35);
 pub const CEILING: Range = Range::new(0.001, 1.0, 1.0);
 
-/// How the residual volume evolves (MODEL.md §8).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// How the residual volume evolves (MODEL.md §8). Scenes name it in lower case (`"simulate"`,
+/// `"follow"`); the plugin's Drain mode parameter is this same type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum DrainMode {
     /// V drains by the outflow of §3.
     #[default]

@@ -1,32 +1,22 @@
-//! The glug model of MODEL.md as plain Rust: no plugin, GUI or file-format type in here.
+//! The engine: the glug model of MODEL.md as plain Rust, shared by the plugin, the offline
+//! renderer, the reports, the tests and the benches. No plugin, GUI or file-format type in here.
 //!
-//! Data flows one way: [`Controls`] (from a scene or a host) → [`Pour`] (bottle, onsets,
-//! randomness) → [`VoiceBank`] (wave units) → the caller's output buffer.
+//! Data flows one way: [`Controls`] (from a scene, a take or a host) → [`Pour`] (bottle, onsets,
+//! randomness: [`pour`]) → a [`Synthesis`] path ([`synthesis`]) → the caller's output buffer.
+//! [`Engine`] ties them together block by block.
 
-pub mod amplitude;
-pub mod bank;
-pub mod bottle;
-pub mod component;
+mod amplitude;
 pub mod config;
-pub mod controls;
-pub mod curves;
-pub mod onsets;
-pub mod partial;
+mod controls;
 pub mod pour;
-pub mod randomness;
-pub mod recursive;
 pub mod synthesis;
-pub mod voices;
 
-pub use config::{ControlValues, DrainMode, ModelConfig};
+pub(crate) use amplitude::db_to_gain;
+pub use amplitude::unit_amplitude;
+pub use config::{ControlValues, DrainMode, ModelConfig, Range};
 pub use controls::{ControlSource, Controls, Lane};
 pub use pour::{Pour, PourStats, UnitOnset};
-pub use recursive::{RecursiveF32, RecursiveF64};
-pub use synthesis::Synthesis;
-pub use voices::VoiceBank;
-pub 
-use amplitude::db_to_gain;
-use partial::GRID;
+pub use synthesis::{RecursiveF32, RecursiveF64, Synthesis, VoiceBank, GRID};
 
 /// Renders the model into caller-provided buffers; allocation-free after construction.
 ///
@@ -71,10 +61,12 @@ impl<S: Synthesis> Engine<S> {
         engine
     }
 
+    /// The sample rate in use (Hz), after sanitising the one asked for.
     pub fn sample_rate(&self) -> f64 {
         self.sample_rate
     }
 
+    /// The constants in force.
     pub fn config(&self) -> &ModelConfig {
         self.pour.config()
     }
@@ -101,10 +93,12 @@ impl<S: Synthesis> Engine<S> {
         self.resting_under = None;
     }
 
+    /// The residual volume V (ml).
     pub fn volume_ml(&self) -> f64 {
         self.pour.volume_ml()
     }
 
+    /// Units started and skipped since the reset.
     pub fn stats(&self) -> PourStats {
         self.pour.stats()
     }
@@ -176,7 +170,7 @@ impl<S: Synthesis> Engine<S> {
             self.advance_position(out.len());
             return;
         }
-        self.voices.render(self.sample, out);
+        self.voices.synthesize(self.sample, out);
         self.active_until = self.sample + out.len() as u64;
         self.apply_output_stage(controls, out);
         self.advance_position(out.len());
@@ -207,7 +201,9 @@ impl<S: Synthesis> Engine<S> {
                 // between calls, and the controls are the same.
                 Some(values) if index > 0 => pour.step_steady(sample, values.viscosity, start_unit),
                 Some(values) => pour.step_sanitized(sample, &values, start_unit),
-                None => pour.step_sanitized(sample, &controls.values_at(index).sanitized(), start_unit),
+                None => {
+                    pour.step_sanitized(sample, &controls.values_at(index).sanitized(), start_unit)
+                }
             };
             if step.amount_ml > 0.0 {
                 self.active_until = sample + 1;

@@ -17,7 +17,13 @@ fn main() -> nice_plug_xtask::Result<()> {
         Some("test") => {
             nice_plug_xtask::chdir_workspace_root()?;
             // The dev profile keeps debug assertions, which assert_process_allocs needs.
-            cargo(&["test", "--workspace", "--no-fail-fast", "--features", "assert_process_allocs"])?;
+            cargo(&[
+                "test",
+                "--workspace",
+                "--no-fail-fast",
+                "--features",
+                "assert_process_allocs",
+            ])?;
             build_release()?;
             host_tests()
         }
@@ -40,12 +46,25 @@ fn host_tests() -> nice_plug_xtask::Result<()> {
     if !Path::new(python).exists() {
         run("python3", &["-m", "venv", ".venv"])?;
     }
-    run(python, &["-m", "pip", "install", "--quiet", "-r", "tests/host/requirements.txt"])?;
+    run(
+        python,
+        &[
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "-r",
+            "tests/host/requirements.txt",
+        ],
+    )?;
     run(python, &["-m", "pytest", "tests/host", "-q"])
 }
 
 fn cargo(args: &[&str]) -> nice_plug_xtask::Result<()> {
-    run(&std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()), args)
+    run(
+        &std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()),
+        args,
+    )
 }
 
 fn run(program: &str, args: &[&str]) -> nice_plug_xtask::Result<()> {

@@ -1,0 +1,57 @@
+//! `sake-glug accuracy`: the error of every synthesis path against the f64 reference.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Args;
+
+use sake_glug::reports::accuracy::{self, SynthesisPath};
+
+#[derive(Args, Debug)]
+pub struct AccuracyArgs {
+    /// Render lengths in seconds.
+    #[arg(long, value_delimiter = ',', default_values_t = accuracy::LENGTHS_S)]
+    lengths: Vec<f64>,
+    /// Sample rate (Hz).
+    #[arg(long, default_value_t = 48_000.0)]
+    sample_rate: f64,
+    /// Also draw the work-precision diagram to this PNG file.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+/// Prints the accuracy table (Markdown) and draws the plot if asked; fails if the default path
+/// misses the budget of MODEL.md §9 at any length of an hour or more.
+pub fn run(args: AccuracyArgs) -> ExitCode {
+    let cases = accuracy::cases();
+    for case in &cases {
+        eprintln!("case {}: {}", case.name, case.purpose);
+    }
+    let rows = accuracy::measure(&cases, &args.lengths, args.sample_rate, |row| {
+        eprintln!(
+            "  {} / {} / {}: max {:.1} dB, rms {:.1} dB, {:.0}× real time",
+            row.case,
+            row.path.name(),
+            accuracy::length_label(row.length_s),
+            row.max_error_db,
+            row.rms_error_db,
+            row.times_real_time
+        );
+    });
+    print!("{}", accuracy::table(&rows));
+    if let Some(file) = &args.plot {
+        if let Err(error) = sake_glug::reports::draw_accuracy_plot(&rows, file) {
+            eprintln!("error: the plot could not be drawn: {error}");
+            return ExitCode::FAILURE;
+        }
+        eprintln!("plot written to {}", file.display());
+    }
+    let over_budget = rows.iter().any(|row| {
+        row.path == SynthesisPath::Default && row.length_s >= 3600.0 && row.max_error_db >= -100.0
+    });
+    if over_budget {
+        eprintln!("error: the default path is above −100 dB on an hour-long render");
+        return ExitCode::FAILURE;
+    }
+    ExitCode::SUCCESS
+}

@@ -1,0 +1,39 @@
+//! `sake-glug`: the offline renderer and the reports on the command line. One file per
+//! subcommand; the work is in the library, which knows nothing of `clap`.
+
+mod accuracy;
+mod render;
+mod stability;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "sake-glug",
+    version,
+    about = "The glug of a poured sake bottle, rendered offline"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Renders a scene file (or the built-in pour) to a mono WAV file.
+    Render(render::RenderArgs),
+    /// Error against run time of every synthesis path (MODEL.md §9); see docs/accuracy.md.
+    Accuracy(accuracy::AccuracyArgs),
+    /// Stiff and extreme cases: finite, bounded, no slow-down; see docs/stability.md.
+    Stability(stability::StabilityArgs),
+}
+
+fn main() -> ExitCode {
+    match Cli::parse().command {
+        Command::Render(args) => render::run(args),
+        Command::Accuracy(args) => accuracy::run(args),
+        Command::Stability(args) => stability::run(args),
+    }
+}

@@ -1,0 +1,46 @@
+//! Synthesis: the units the pour starts, voiced and summed (MODEL.md §5–6, §9).
+//!
+//! Three paths implement [`Synthesis`] and share the admission rules of [`bank`]: the default
+//! anchored path ([`VoiceBank`], real time, f32), and the recursive oscillators in f32 and f64
+//! ([`RecursiveF32`], [`RecursiveF64`]) that the accuracy report compares with it. [`reference`]
+//! is no path at all: the f64 closed form summed at every sample, the yardstick of the others.
+
+mod bank;
+mod component;
+mod partial;
+mod recursive;
+pub mod reference;
+mod voices;
+
+pub use bank::{MAX_PARTIALS, MAX_STARTS_PER_PERIOD};
+pub use component::SILENT_DECAY_EXPONENT;
+pub use partial::GRID;
+pub use recursive::{RecursiveF32, RecursiveF64, REANCHOR_SAMPLES};
+pub use voices::VoiceBank;
+
+use crate::engine::pour::UnitOnset;
+
+/// A bank of sounding wave-unit components. The engine renders spans that lie within one grid
+/// period of [`GRID`] samples and calls [`Synthesis::advance`] at each period's
+/// start, counted from the last reset (while the bank is empty and the pour rests, only at the
+/// last period start before it renders again); a path must give the same samples however spans
+/// are cut.
+pub trait Synthesis {
+    /// An empty bank for output at `sample_rate` (Hz); allocates, once.
+    fn new(sample_rate: f64) -> Self;
+    /// Silences every component.
+    fn clear(&mut self);
+    /// No component sounds.
+    fn is_empty(&self) -> bool;
+    /// Components sounding.
+    fn len(&self) -> usize;
+    /// Components given up because the bank was full.
+    fn given_up(&self) -> u64;
+    /// Voices a unit that starts during sample `onset.sample`.
+    fn start_unit(&mut self, onset: &UnitOnset);
+    /// Adds every component into `out`, which starts at absolute sample `span_start` and lies
+    /// within one grid period.
+    fn synthesize(&mut self, span_start: u64, out: &mut [f32]);
+    /// Steps every component to the period starting at `period_start`, dropping silent ones.
+    fn advance(&mut self, period_start: u64);
+}

@@ -1,0 +1,134 @@
+//! One component rendered on the default path, as `anchor · z^j` over a grid period of [`GRID`]
+//! samples.
+//!
+//! The anchor (the component's complex state at the period's first sample) advances in f64 once
+//! per period, and the powers z^j are tabled once per component in f32. Each output sample is then
+//! one f32 complex product: independent across samples (so it vectorises), about two f32 ulps from
+//! the exact value, and free of the drift of a per-sample recursion. Periods sit on an absolute
+//! sample grid, so how a host cuts time into blocks never changes a sample.
+
+use super::bank::Sounding;
+use super::component::{complex_exp, complex_mul, Component};
+
+/// Samples per grid period; the anchor advances in f64 once per period.
+pub const GRID: usize = 64;
+/// Powers below this are stored as zero: it is inside the error budget and keeps f32 denormals
+/// out of the render loop for very fast decays.
+const NEGLIGIBLE_POWER: f64 = 1e-7;
+/// The f64 anchor recursion is re-evaluated from the closed form this often, so nothing can
+/// drift however long a component rings (B = 0 rings for ever).
+const PERIODS_PER_DIRECT_ANCHOR: u32 = 1024;
+
+#[derive(Clone)]
+pub struct Partial {
+    powers_re: [f32; GRID],
+    powers_im: [f32; GRID],
+    /// State at `anchor_sample`, the first sample of the period being rendered.
+    anchor: [f32; 2],
+    anchor_sample: u64,
+    /// State at the first sample of the next period.
+    next_anchor: [f64; 2],
+    /// z^GRID in f64.
+    period_step: [f64; 2],
+    component: Component,
+    periods_since_direct: u32,
+    /// |anchor|², for choosing which component to give up when the bank is full (squared: only
+    /// the order matters, and it saves a hypot per component per period).
+    level: f32,
+}
+
+impl Sounding for Partial {
+    fn start(component: Component) -> Self {
+        let first_sample = component.first_sample();
+        let grid = GRID as f64;
+        let mut partial = Self {
+            powers_re: [0.0; GRID],
+            powers_im: [0.0; GRID],
+            anchor: [0.0; 2],
+            anchor_sample: first_sample,
+            next_anchor: [0.0; 2],
+            period_step: complex_exp(
+                -component.decay_per_sample * grid,
+                component.radians_per_sample * grid,
+            ),
+            component,
+            periods_since_direct: 0,
+            level: 0.0,
+        };
+        partial.set_anchor(component.state_at(first_sample));
+        let next_period = (first_sample / GRID as u64 + 1) * GRID as u64;
+        partial.next_anchor = component.state_at(next_period);
+        partial.fill_powers();
+        partial
+    }
+
+    fn level(&self) -> f64 {
+        self.level as f64
+    }
+}
+
+impl Partial {
+    /// Adds this component's samples for `out`, which starts at absolute sample `span_start` and
+    /// lies within one grid period.
+    #[inline]
+    pub fn synthesize(&self, span_start: u64, out: &mut [f32]) {
+        let first = self.anchor_sample.max(span_start);
+        let offset = (first - span_start) as usize;
+        if offset >= out.len() {
+            return;
+        }
+        let out = &mut out[offset..];
+        let power = (first - self.anchor_sample) as usize;
+        let re = &self.powers_re[power..power + out.len()];
+        let im = &self.powers_im[power..power + out.len()];
+        let [anchor_re, anchor_im] = self.anchor;
+        for ((y, &z_re), &z_im) in out.iter_mut().zip(re).zip(im) {
+            *y += anchor_re * z_im + anchor_im * z_re;
+        }
+    }
+
+    /// Moves to the period starting at `period_start`; returns false once the component is silent.
+    pub fn advance(&mut self, period_start: u64) -> bool {
+        if self.anchor_sample >= period_start {
+            // Started on this very boundary: its anchor already belongs to the new period.
+            return true;
+        }
+        if self.component.is_silent_at(period_start) {
+            return false;
+        }
+        self.set_anchor(self.next_anchor);
+        self.anchor_sample = period_start;
+        let following = period_start + GRID as u64;
+        self.periods_since_direct += 1;
+        self.next_anchor = if self.periods_since_direct == PERIODS_PER_DIRECT_ANCHOR {
+            self.periods_since_direct = 0;
+            self.component.state_at(following)
+        } else {
+            complex_mul(self.next_anchor, self.period_step)
+        };
+        true
+    }
+
+    fn set_anchor(&mut self, state: [f64; 2]) {
+        self.anchor = [state[0] as f32, state[1] as f32];
+        self.level = (state[0] * state[0] + state[1] * state[1]) as f32;
+    }
+
+    fn fill_powers(&mut self) {
+        let step = self.component.step();
+        // |z^j| = e^(−dj) falls below NEGLIGIBLE_POWER from j = ln(1/NEGLIGIBLE_POWER)/d on;
+        // counted up front rather than with a hypot per power, which made starts costly.
+        let audible = (-NEGLIGIBLE_POWER.ln() / self.component.decay_per_sample).ceil();
+        let count = if audible < GRID as f64 {
+            audible as usize
+        } else {
+            GRID
+        };
+        let mut power: [f64; 2] = [1.0, 0.0];
+        for j in 0..count {
+            self.powers_re[j] = power[0] as f32;
+            self.powers_im[j] = power[1] as f32;
+            power = complex_mul(power, step);
+        }
+    }
+}

@@ -1,0 +1,213 @@
+//! An automatable value of a scene: a constant, or `[time_s, value]` points joined linearly and
+//! held before the first and after the last (MODEL.md §10).
+
+use std::fmt;
+
+use serde::de::{self, Deserialize, Deserializer, SeqAccess, Visitor};
+
+use crate::engine::Lane;
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Automation {
+    Constant(f64),
+    /// Times in seconds, non-decreasing; two points at one time make a step.
+    Points(Vec<(f64, f64)>),
+}
+
+impl Automation {
+    pub fn value_at(&self, time_s: f64) -> f64 {
+        match self {
+            Automation::Constant(value) => *value,
+            Automation::Points(points) => {
+                let segment = segment_at(points, time_s);
+                if segment == 0 {
+                    points[0].1
+                } else if segment == points.len() {
+                    points[points.len() - 1].1
+                } else {
+                    let ((t0, v0), (t1, v1)) = (points[segment - 1], points[segment]);
+                    v0 + (v1 - v0) * (time_s - t0) / (t1 - t0)
+                }
+            }
+        }
+    }
+
+    /// The time of the last point: after it the value holds for ever.
+    pub fn last_time_s(&self) -> f64 {
+        match self {
+            Automation::Constant(_) => 0.0,
+            Automation::Points(points) => points.last().map_or(0.0, |point| point.0),
+        }
+    }
+
+    /// Every value, in scene order, for range checks.
+    pub fn values(&self) -> impl Iterator<Item = f64> + '_ {
+        let (constant, points) = match self {
+            Automation::Constant(value) => (Some(*value), &[][..]),
+            Automation::Points(points) => (None, &points[..]),
+        };
+        constant
+            .into_iter()
+            .chain(points.iter().map(|point| point.1))
+    }
+
+    /// The lane for the samples `first_sample .. first_sample + buffer.len()`: a constant when the
+    /// value cannot change over them (so the engine may skip work), else `buffer` filled.
+    pub fn lane<'a>(&self, first_sample: u64, sample_rate: f64, buffer: &'a mut [f64]) -> Lane<'a> {
+        let time_of = |index: usize| (first_sample + index as u64) as f64 / sample_rate;
+        if let Some(value) = self.constant_over(time_of(0), time_of(buffer.len().saturating_sub(1)))
+        {
+            return Lane::Constant(value);
+        }
+        for (index, value) in buffer.iter_mut().enumerate() {
+            *value = self.value_at(time_of(index));
+        }
+        Lane::Samples(buffer)
+    }
+
+    fn constant_over(&self, start_s: f64, end_s: f64) -> Option<f64> {
+        match self {
+            Automation::Constant(value) => Some(*value),
+            Automation::Points(points) => {
+                let segment = segment_at(points, start_s);
+                let flat = segment == 0
+                    || segment == points.len()
+                    || points[segment - 1].1 == points[segment].1;
+                (flat && segment == segment_at(points, end_s)).then(|| self.value_at(start_s))
+            }
+        }
+    }
+}
+
+/// The index of the first point later than `time_s`: 0 before the first, `len` after the last.
+fn segment_at(points: &[(f64, f64)], time_s: f64) -> usize {
+    points.partition_point(|point| point.0 <= time_s)
+}
+
+impl<'de> Deserialize<'de> for Automation {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_any(AutomationVisitor)
+    }
+}
+
+struct AutomationVisitor;
+
+impl<'de> Visitor<'de> for AutomationVisitor {
+    type Value = Automation;
+
+    fn expecting(&self, formatter: &mut fmt::Formatter) -> fmt::Result {
+        formatter.write_str("a number or a list of [time_s, value] points")
+    }
+
+    fn visit_f64<E: de::Error>(self, value: f64) -> Result<Automation, E> {
+        Ok(Automation::Constant(value))
+    }
+
+    fn visit_i64<E: de::Error>(self, value: i64) -> Result<Automation, E> {
+        Ok(Automation::Constant(value as f64))
+    }
+
+    fn visit_u64<E: de::Error>(self, value: u64) -> Result<Automation, E> {
+        Ok(Automation::Constant(value as f64))
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Automation, A::Error> {
+        let mut points = Vec::new();
+        while let Some(Point(time_s, value)) = seq.next_element()? {
+            points.push((time_s, value));
+        }
+        if points.is_empty() {
+            return Err(de::Error::invalid_length(
+                0,
+                &"at least one [time_s, value] point",
+            ));
+        }
+        Ok(Automation::Points(points))
+    }
+}
+
+/// One `[time_s, value]` pair, numbers either integer or float, nothing more.
+struct Point(f64, f64);
+
+impl<'de> Deserialize<'de> for Point {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct PointVisitor;
+        impl<'de> Visitor<'de> for PointVisitor {
+            type Value = Point;
+            fn expecting(&self, formatter: &mut fmt::Formatter) -> fmt::Result {
+                formatter.write_str("a [time_s, value] pair of numbers")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Point, A::Error> {
+                let pair_error =
+                    || de::Error::custom("each point must be a [time_s, value] pair of numbers");
+                let time_s: Number = seq.next_element()?.ok_or_else(pair_error)?;
+                let value: Number = seq.next_element()?.ok_or_else(pair_error)?;
+                if seq.next_element::<de::IgnoredAny>()?.is_some() {
+                    return Err(pair_error());
+                }
+                Ok(Point(time_s.0, value.0))
+            }
+        }
+        deserializer
+            .deserialize_seq(PointVisitor)
+            .map_err(|_: D::Error| {
+                de::Error::custom("each point must be a [time_s, value] pair of numbers")
+            })
+    }
+}
+
+struct Number(f64);
+
+impl<'de> Deserialize<'de> for Number {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct NumberVisitor;
+        impl Visitor<'_> for NumberVisitor {
+            type Value = Number;
+            fn expecting(&self, formatter: &mut fmt::Formatter) -> fmt::Result {
+                formatter.write_str("a number")
+            }
+            fn visit_f64<E: de::Error>(self, value: f64) -> Result<Number, E> {
+                Ok(Number(value))
+            }
+            fn visit_i64<E: de::Error>(self, value: i64) -> Result<Number, E> {
+                Ok(Number(value as f64))
+            }
+            fn visit_u64<E: de::Error>(self, value: u64) -> Result<Number, E> {
+                Ok(Number(value as f64))
+            }
+        }
+        deserializer.deserialize_any(NumberVisitor)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ramp() -> Automation {
+        Automation::Points(vec![(0.0, 90.0), (0.5, 135.0), (1.0, 135.0), (1.0, 0.0)])
+    }
+
+    #[test]
+    fn interpolates_holds_and_steps() {
+        let ramp = ramp();
+        assert_eq!(ramp.value_at(-1.0), 90.0);
+        assert_eq!(ramp.value_at(0.25), 112.5);
+        assert_eq!(ramp.value_at(0.75), 135.0);
+        assert_eq!(ramp.value_at(1.0), 0.0);
+        assert_eq!(ramp.value_at(9.0), 0.0);
+        assert_eq!(ramp.last_time_s(), 1.0);
+    }
+
+    #[test]
+    fn lanes_are_constant_exactly_where_the_value_cannot_change() {
+        let ramp = ramp();
+        let mut buffer = [0.0; 4];
+        assert!(matches!(ramp.lane(0, 8.0, &mut buffer), Lane::Samples(_)));
+        assert_eq!(buffer, [90.0, 101.25, 112.5, 123.75]);
+        assert_eq!(ramp.lane(4, 8.0, &mut buffer), Lane::Constant(135.0));
+        assert!(matches!(ramp.lane(6, 8.0, &mut buffer), Lane::Samples(_)));
+        assert_eq!(buffer, [135.0, 135.0, 0.0, 0.0]);
+        assert_eq!(ramp.lane(8, 8.0, &mut buffer), Lane::Constant(0.0));
+    }
+}

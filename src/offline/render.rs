@@ -1,0 +1,138 @@
+//! Offline rendering of a scene: scene → engine → a sink of sample blocks.
+
+use std::time::{Duration, Instant};
+
+use super::scene::{LaneBuffers, Scene, MAX_DURATION_S};
+use crate::engine::{DrainMode, Engine};
+
+/// Samples per engine call offline; any size gives the same samples.
+pub const BLOCK_SIZE: usize = 4096;
+
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    #[error(
+        "the scene never falls silent (it pours or rings for ever after its last automation \
+         point, or past {MAX_DURATION_S} s), so it has no natural end; give it a duration_s"
+    )]
+    NeverSettles,
+}
+
+/// What a finished render did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderSummary {
+    pub samples: u64,
+    pub sample_rate: u32,
+    pub units: u64,
+    /// Largest |sample|.
+    pub peak: f32,
+    pub elapsed: Duration,
+}
+
+impl RenderSummary {
+    pub fn duration_s(&self) -> f64 {
+        self.samples as f64 / self.sample_rate as f64
+    }
+
+    /// How many times faster than real time the render ran.
+    pub fn realtime_factor(&self) -> f64 {
+        self.duration_s() / self.elapsed.as_secs_f64().max(1e-9)
+    }
+}
+
+/// Renders `scene`, handing its samples to `sink` in blocks and the samples rendered so far to
+/// `progress`. A scene without a duration ends where pouring stopped and the last unit decayed
+/// (below −120 dB), a sample fixed by the model, not by how time was cut into blocks.
+pub fn render_scene<E: From<RenderError>>(
+    scene: &Scene,
+    mut sink: impl FnMut(&[f32]) -> Result<(), E>,
+    mut progress: impl FnMut(u64),
+) -> Result<RenderSummary, E> {
+    let started = Instant::now();
+    let sample_rate = scene.sample_rate as f64;
+    let mut engine = Engine::new(sample_rate, scene.config);
+    let mut lanes = LaneBuffers::default();
+    let mut block = vec![0.0f32; BLOCK_SIZE];
+    let total = scene.duration_samples();
+    let settle_from = (scene.last_automation_s() * sample_rate).ceil() as u64;
+    let give_up_at = (MAX_DURATION_S * sample_rate) as u64;
+    // Trailing zeros are held back until something follows them or the end is known.
+    let (mut written, mut held_zeros, mut peak) = (0u64, 0u64, 0.0f32);
+
+    loop {
+        let position = engine.position();
+        let len = match total {
+            Some(total) => BLOCK_SIZE.min((total - position) as usize),
+            None => BLOCK_SIZE,
+        };
+        if len == 0 {
+            break;
+        }
+        let controls = scene.controls(position, &mut lanes, len);
+        let block = &mut block[..len];
+        engine.process(&controls, block);
+        progress(engine.position());
+
+        match block.iter().rposition(|y| *y != 0.0) {
+            None => held_zeros += len as u64,
+            Some(last) => {
+                write_zeros(&mut sink, held_zeros)?;
+                sink(&block[..=last])?;
+                peak = block.iter().fold(peak, |peak, y| peak.max(y.abs()));
+                written = position + last as u64 + 1;
+                held_zeros = (len - last - 1) as u64;
+            }
+        }
+        if total.is_none() && position >= settle_from {
+            if engine.is_settled() {
+                break;
+            }
+            if endless(scene, &engine) || engine.position() >= give_up_at {
+                return Err(RenderError::NeverSettles.into());
+            }
+        }
+    }
+    let end = total.unwrap_or_else(|| engine.active_until().max(written));
+    write_zeros(&mut sink, end - written)?;
+    Ok(RenderSummary {
+        samples: end,
+        sample_rate: scene.sample_rate,
+        units: engine.stats().units_started,
+        peak,
+        elapsed: started.elapsed(),
+    })
+}
+
+/// Whether, with the controls held still for good, the scene can be seen never to fall silent:
+/// follow mode holds the volume, so a bottle still pouring pours for ever, and a decay rate of 0
+/// rings for ever.
+fn endless(scene: &Scene, engine: &Engine) -> bool {
+    let pours_for_ever = scene.config.drain == DrainMode::Follow && !engine.is_resting();
+    let rings_for_ever =
+        scene.config.decay_per_s.contains(&0.0) && engine.sounding_components() > 0;
+    pours_for_ever || rings_for_ever
+}
+
+fn write_zeros<E>(sink: &mut impl FnMut(&[f32]) -> Result<(), E>, count: u64) -> Result<(), E> {
+    const ZEROS: [f32; 1024] = [0.0; 1024];
+    let mut left = count;
+    while left > 0 {
+        let run = left.min(ZEROS.len() as u64) as usize;
+        sink(&ZEROS[..run])?;
+        left -= run as u64;
+    }
+    Ok(())
+}
+
+/// Renders a whole scene into memory.
+pub fn render_scene_to_vec(scene: &Scene) -> Result<(Vec<f32>, RenderSummary), RenderError> {
+    let mut samples = Vec::new();
+    let summary = render_scene(
+        scene,
+        |block| {
+            samples.extend_from_slice(block);
+            Ok::<(), RenderError>(())
+        },
+        |_| {},
+    )?;
+    Ok((samples, summary))
+}

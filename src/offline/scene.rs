@@ -1,0 +1,307 @@
+//! Scene files (MODEL.md §10): TOML in, a validated [`Scene`] out. Every key is optional; an
+//! unknown key, a wrong type or an out-of-range value is refused with an error naming it.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::automation::Automation;
+use crate::engine::config::{self, ControlValues, Range};
+use crate::engine::{ControlSource, Controls, DrainMode, ModelConfig};
+
+/// The built-in default scene: a full 300 ml bottle of water tilted from 90° to 135° over half a
+/// second and held until it stops pouring.
+pub const DEFAULT_SCENE: &str = r#"
+tilt_deg = [[0.0, 90.0], [0.5, 135.0]]
+"#;
+
+/// Longest render a scene may ask for (and the limit on one that never falls silent).
+pub const MAX_DURATION_S: f64 = 86_400.0;
+
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("cannot read scene file {}: {source}", path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("invalid scene: {0}")]
+    Syntax(String),
+    #[error("`{key}` = {value} is out of range: allowed {min} to {max}")]
+    OutOfRange {
+        key: &'static str,
+        value: f64,
+        min: f64,
+        max: f64,
+    },
+    #[error("`{key}`: point {index} is at {time_s} s; point times must be finite, at least 0 and in order")]
+    PointTime {
+        key: &'static str,
+        index: usize,
+        time_s: f64,
+    },
+}
+
+/// A validated scene, ready to render.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    pub sample_rate: u32,
+    /// `None`: until pouring stops and every unit has decayed.
+    pub duration_s: Option<f64>,
+    pub tilt_deg: Automation,
+    pub viscosity: Automation,
+    pub fill_percent: Automation,
+    pub pour_time_s: Automation,
+    pub gain_db: Automation,
+    /// Seed, spreads (zero if `deterministic`), drain mode and the other constants.
+    pub config: ModelConfig,
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Scene::parse(DEFAULT_SCENE).expect("the built-in scene is valid")
+    }
+}
+
+impl Scene {
+    pub fn load(path: &Path) -> Result<Self, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+            path: path.to_owned(),
+            source,
+        })?;
+        Self::parse(&text)
+    }
+
+    pub fn parse(text: &str) -> Result<Self, SceneError> {
+        let file: SceneFile =
+            toml::from_str(text).map_err(|error| SceneError::Syntax(error.to_string()))?;
+        file.validate()
+    }
+
+    /// The same scene at another sample rate.
+    pub fn with_sample_rate(self, sample_rate: f64) -> Result<Self, SceneError> {
+        let sample_rate = check("sample_rate", sample_rate, config::SAMPLE_RATE_HZ)?;
+        Ok(Self {
+            sample_rate: sample_rate as u32,
+            ..self
+        })
+    }
+
+    /// Samples to render, if the scene fixes its duration.
+    pub fn duration_samples(&self) -> Option<u64> {
+        self.duration_s
+            .map(|seconds| (seconds * self.sample_rate as f64).round() as u64)
+    }
+
+    /// Time of the last automation point: the controls hold still after it.
+    pub fn last_automation_s(&self) -> f64 {
+        self.lanes()
+            .iter()
+            .map(|lane| lane.last_time_s())
+            .fold(0.0, f64::max)
+    }
+
+    /// The inputs at one sample.
+    pub fn values_at(&self, sample: u64) -> (ControlValues, f64) {
+        let time_s = sample as f64 / self.sample_rate as f64;
+        let values = ControlValues {
+            tilt_deg: self.tilt_deg.value_at(time_s),
+            viscosity: self.viscosity.value_at(time_s),
+            fill_percent: self.fill_percent.value_at(time_s),
+            pour_time_s: self.pour_time_s.value_at(time_s),
+        };
+        (values, self.gain_db.value_at(time_s))
+    }
+
+    /// The engine's controls for `len` samples from `first_sample`, using `buffers` as storage.
+    pub fn controls<'a>(
+        &self,
+        first_sample: u64,
+        buffers: &'a mut LaneBuffers,
+        len: usize,
+    ) -> Controls<'a> {
+        let fs = self.sample_rate as f64;
+        let [tilt, viscosity, fill, pour_time, gain] = &mut buffers.0;
+        for buffer in [
+            &mut *tilt,
+            &mut *viscosity,
+            &mut *fill,
+            &mut *pour_time,
+            &mut *gain,
+        ] {
+            buffer.resize(len, 0.0);
+        }
+        Controls {
+            tilt_deg: self.tilt_deg.lane(first_sample, fs, tilt),
+            viscosity: self.viscosity.lane(first_sample, fs, viscosity),
+            fill_percent: self.fill_percent.lane(first_sample, fs, fill),
+            pour_time_s: self.pour_time_s.lane(first_sample, fs, pour_time),
+            gain_db: self.gain_db.lane(first_sample, fs, gain),
+        }
+    }
+
+    fn lanes(&self) -> [&Automation; 5] {
+        [
+            &self.tilt_deg,
+            &self.viscosity,
+            &self.fill_percent,
+            &self.pour_time_s,
+            &self.gain_db,
+        ]
+    }
+}
+
+impl ControlSource for Scene {
+    fn at(&self, sample: u64) -> (ControlValues, f64) {
+        self.values_at(sample)
+    }
+}
+
+/// Storage for the per-sample lanes of one block, reused from block to block.
+#[derive(Debug, Default)]
+pub struct LaneBuffers([Vec<f64>; 5]);
+
+// ---- The file as written: every key optional, nothing unknown. ----
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    sample_rate: Option<u32>,
+    duration_s: Option<f64>,
+    seed: Option<u64>,
+    deterministic: Option<bool>,
+    tilt_deg: Option<Automation>,
+    viscosity_c: Option<Automation>,
+    fill_percent: Option<Automation>,
+    pour_time_s: Option<Automation>,
+    #[serde(default)]
+    bottle: BottleSection,
+    #[serde(default)]
+    glug: GlugSection,
+    #[serde(default)]
+    output: OutputSection,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct BottleSection {
+    capacity_ml: Option<f64>,
+    pocket_ml: Option<f64>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct GlugSection {
+    f1_hz: Option<f64>,
+    f2_hz: Option<f64>,
+    b1_per_s: Option<f64>,
+    b2_per_s: Option<f64>,
+    timing_jitter: Option<f64>,
+    freq_jitter: Option<f64>,
+    decay_sigma: Option<f64>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct OutputSection {
+    gain_db: Option<Automation>,
+    drain: Option<DrainMode>,
+}
+
+impl SceneFile {
+    fn validate(self) -> Result<Scene, SceneError> {
+        let sample_rate = match self.sample_rate {
+            Some(rate) => check("sample_rate", rate as f64, config::SAMPLE_RATE_HZ)? as u32,
+            None => config::SAMPLE_RATE_HZ.default as u32,
+        };
+        let duration_s = self
+            .duration_s
+            .map(|seconds| {
+                let allowed = Range {
+                    min: 1.0 / sample_rate as f64,
+                    max: MAX_DURATION_S,
+                    default: 0.0,
+                };
+                check("duration_s", seconds, allowed)
+            })
+            .transpose()?;
+        let glug = &self.glug;
+        let mut config = ModelConfig {
+            capacity_ml: constant(
+                "bottle.capacity_ml",
+                self.bottle.capacity_ml,
+                config::CAPACITY_ML,
+            )?,
+            pocket_ml: constant("bottle.pocket_ml", self.bottle.pocket_ml, config::POCKET_ML)?,
+            frequency_hz: [
+                constant("glug.f1_hz", glug.f1_hz, config::F1_HZ)?,
+                constant("glug.f2_hz", glug.f2_hz, config::F2_HZ)?,
+            ],
+            decay_per_s: [
+                constant("glug.b1_per_s", glug.b1_per_s, config::B1_PER_S)?,
+                constant("glug.b2_per_s", glug.b2_per_s, config::B2_PER_S)?,
+            ],
+            timing_jitter: constant(
+                "glug.timing_jitter",
+                glug.timing_jitter,
+                config::TIMING_JITTER,
+            )?,
+            freq_jitter: constant("glug.freq_jitter", glug.freq_jitter, config::FREQ_JITTER)?,
+            decay_sigma: constant("glug.decay_sigma", glug.decay_sigma, config::DECAY_SIGMA)?,
+            seed: self.seed.unwrap_or(ModelConfig::default().seed),
+            drain: self.output.drain.unwrap_or_default(),
+            ceiling: config::CEILING.default,
+        };
+        if self.deterministic.unwrap_or(false) {
+            config = config.deterministic();
+        }
+        Ok(Scene {
+            sample_rate,
+            duration_s,
+            tilt_deg: automation("tilt_deg", self.tilt_deg, config::TILT_DEG)?,
+            viscosity: automation("viscosity_c", self.viscosity_c, config::VISCOSITY)?,
+            fill_percent: automation("fill_percent", self.fill_percent, config::FILL_PERCENT)?,
+            pour_time_s: automation("pour_time_s", self.pour_time_s, config::POUR_TIME_S)?,
+            gain_db: automation("output.gain_db", self.output.gain_db, config::GAIN_DB)?,
+            config,
+        })
+    }
+}
+
+fn check(key: &'static str, value: f64, range: Range) -> Result<f64, SceneError> {
+    if range.contains(value) {
+        Ok(value)
+    } else {
+        Err(SceneError::OutOfRange {
+            key,
+            value,
+            min: range.min,
+            max: range.max,
+        })
+    }
+}
+
+fn constant(key: &'static str, value: Option<f64>, range: Range) -> Result<f64, SceneError> {
+    check(key, value.unwrap_or(range.default), range)
+}
+
+fn automation(
+    key: &'static str,
+    value: Option<Automation>,
+    range: Range,
+) -> Result<Automation, SceneError> {
+    let automation = value.unwrap_or(Automation::Constant(range.default));
+    for value in automation.values() {
+        check(key, value, range)?;
+    }
+    if let Automation::Points(points) = &automation {
+        let mut previous = 0.0;
+        for (index, &(time_s, _)) in points.iter().enumerate() {
+            if !(time_s.is_finite() && time_s >= previous) {
+                return Err(SceneError::PointTime { key, index, time_s });
+            }
+            previous = time_s;
+        }
+    }
+    Ok(automation)
+}

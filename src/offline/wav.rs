@@ -1,0 +1,182 @@
+//! Writing renders to WAV files all or nothing: samples go to a temporary file beside the target,
+//! which replaces the target only once complete, so a failed render never leaves a partial file.
+
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use hound::{SampleFormat as HoundFormat, WavSpec, WavWriter};
+use tempfile::NamedTempFile;
+
+/// The sample format of a WAV file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SampleFormat {
+    /// 32-bit float.
+    #[default]
+    F32,
+    /// 24-bit integer.
+    S24,
+    /// 16-bit integer.
+    S16,
+}
+
+impl SampleFormat {
+    /// Every format, with the name the command line uses for it.
+    pub const ALL: [(SampleFormat, &'static str); 3] = [
+        (SampleFormat::F32, "f32"),
+        (SampleFormat::S24, "s24"),
+        (SampleFormat::S16, "s16"),
+    ];
+}
+
+impl std::str::FromStr for SampleFormat {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        Self::ALL
+            .iter()
+            .find(|(_, name)| *name == text)
+            .map(|(format, _)| *format)
+            .ok_or_else(|| format!("unknown sample format `{text}`: use f32, s24 or s16"))
+    }
+}
+
+/// Why a WAV file could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum WavError {
+    /// The file system refused.
+    #[error("cannot write {}: {source}", path.display())]
+    Io {
+        /// The file asked for.
+        path: PathBuf,
+        /// What the file system said.
+        source: std::io::Error,
+    },
+    /// The WAV encoder refused.
+    #[error("cannot write {}: {source}", path.display())]
+    Encode {
+        /// The file asked for.
+        path: PathBuf,
+        /// What the encoder said.
+        source: hound::Error,
+    },
+}
+
+/// A mono WAV file being written; it appears at its path only on [`WavFile::commit`].
+pub struct WavFile {
+    path: PathBuf,
+    temp: NamedTempFile,
+    writer: WavWriter<BufWriter<std::fs::File>>,
+    format: SampleFormat,
+}
+
+impl WavFile {
+    /// Starts a mono file of `format` at `sample_rate` (Hz), to appear at `path` when committed.
+    pub fn create(path: &Path, sample_rate: u32, format: SampleFormat) -> Result<Self, WavError> {
+        let io_error = |source| WavError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let directory = match path.parent() {
+            Some(parent) if !parent.as_os_str().is_empty() => parent,
+            _ => Path::new("."),
+        };
+        let temp = temp_file_builder()
+            .tempfile_in(directory)
+            .map_err(io_error)?;
+        let file = temp.reopen().map_err(io_error)?;
+        let (bits_per_sample, sample_format) = match format {
+            SampleFormat::F32 => (32, HoundFormat::Float),
+            SampleFormat::S24 => (24, HoundFormat::Int),
+            SampleFormat::S16 => (16, HoundFormat::Int),
+        };
+        let spec = WavSpec {
+            channels: 1,
+            sample_rate,
+            bits_per_sample,
+            sample_format,
+        };
+        let writer =
+            WavWriter::new(BufWriter::new(file), spec).map_err(|source| WavError::Encode {
+                path: path.to_owned(),
+                source,
+            })?;
+        Ok(Self {
+            path: path.to_owned(),
+            temp,
+            writer,
+            format,
+        })
+    }
+
+    /// Appends samples.
+    pub fn write(&mut self, samples: &[f32]) -> Result<(), WavError> {
+        let result = match self.format {
+            SampleFormat::F32 => samples
+                .iter()
+                .try_for_each(|&y| self.writer.write_sample(y)),
+            SampleFormat::S24 => samples
+                .iter()
+                .try_for_each(|&y| self.writer.write_sample(quantize(y, 23))),
+            SampleFormat::S16 => samples
+                .iter()
+                .try_for_each(|&y| self.writer.write_sample(quantize(y, 15) as i16)),
+        };
+        result.map_err(|source| self.encode_error(source))
+    }
+
+    /// Completes the file and moves it into place.
+    pub fn commit(self) -> Result<(), WavError> {
+        let Self {
+            path, temp, writer, ..
+        } = self;
+        writer.finalize().map_err(|source| WavError::Encode {
+            path: path.clone(),
+            source,
+        })?;
+        temp.persist(&path).map_err(|error| WavError::Io {
+            path,
+            source: error.error,
+        })?;
+        Ok(())
+    }
+
+    fn encode_error(&self, source: hound::Error) -> WavError {
+        WavError::Encode {
+            path: self.path.clone(),
+            source,
+        }
+    }
+}
+
+/// Temporary files are private by default; the finished WAV should get the permissions any new
+/// file gets (0o666 less the umask), as if it had been written in place.
+fn temp_file_builder() -> tempfile::Builder<'static, 'static> {
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder
+}
+
+/// Rounds a sample in [−1, 1] to a signed integer of `fraction_bits` + 1 bits, saturating.
+fn quantize(sample: f32, fraction_bits: u32) -> i32 {
+    let full_scale = (1i64 << fraction_bits) as f64;
+    (sample as f64 * full_scale)
+        .round()
+        .clamp(-full_scale, full_scale - 1.0) as i32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::quantize;
+
+    #[test]
+    fn quantize_rounds_and_saturates() {
+        assert_eq!(quantize(0.5, 15), 16_384);
+        assert_eq!(quantize(1.0, 15), 32_767);
+        assert_eq!(quantize(-1.0, 15), -32_768);
+        assert_eq!(quantize(-2.0, 23), -8_388_608);
+    }
+}

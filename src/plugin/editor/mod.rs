@@ -1,0 +1,131 @@
+//! The egui editor: the main group's controls, the bottle at its tilt with its residual volume,
+//! a scope of the output and the last units' envelopes. One concept per file.
+
+mod bottle;
+mod controls;
+mod envelopes;
+mod midi_settings;
+mod scope;
+
+use std::sync::Arc;
+
+use nice_plug::context::gui::GuiContext;
+use nice_plug::editor::dpi::LogicalSize;
+use nice_plug_egui::{
+    create_egui_editor, EguiEditor, EguiEditorState, EguiNiceSettings, NiceEguiApp, RepaintNotifier,
+};
+
+use crate::plugin::feed::Feed;
+use crate::plugin::params::GlugParams;
+
+pub const WIDTH: f64 = 760.0;
+pub const HEIGHT: f64 = 560.0;
+
+pub struct GlugEditor {
+    params: Arc<GlugParams>,
+    feed: Arc<Feed>,
+    gui: Option<GuiContext>,
+    repaint: RepaintNotifier,
+}
+
+pub fn create(params: Arc<GlugParams>, feed: Arc<Feed>) -> Option<EguiEditor<GlugEditor>> {
+    let repaint = RepaintNotifier::new();
+    let app = GlugEditor {
+        params,
+        feed,
+        gui: None,
+        repaint: repaint.clone(),
+    };
+    create_egui_editor(
+        EguiEditorState::from_size(LogicalSize::new(WIDTH, HEIGHT), 1.0),
+        repaint,
+        EguiNiceSettings::new().with_tile("Sake Glug"),
+        app,
+    )
+}
+
+impl NiceEguiApp for GlugEditor {
+    fn build(
+        &mut self,
+        _egui_ctx: egui::Context,
+        nice_gui_ctx: GuiContext,
+        _frame: &mut nice_plug_egui::Frame,
+    ) -> Result<(), nice_plug_egui::baseview::HandlerError> {
+        self.gui = Some(nice_gui_ctx);
+        Ok(())
+    }
+
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut nice_plug_egui::Frame) {
+        // The scope and the bottle move with the audio: draw every poll.
+        self.repaint.request_repaint();
+        let Some(gui) = &self.gui else {
+            return;
+        };
+        let setter = gui.param_setter();
+        ui.heading("Sake Glug");
+        ui.horizontal_top(|ui| {
+            ui.vertical(|ui| {
+                ui.set_width(300.0);
+                controls::show(ui, &self.params, &setter);
+                ui.separator();
+                midi_settings::show(ui, &self.params);
+            });
+            ui.vertical(|ui| {
+                bottle::show(ui, &self.feed, egui::vec2(420.0, 220.0));
+            });
+        });
+        ui.separator();
+        ui.horizontal_top(|ui| {
+            scope::show(ui, &self.feed, egui::vec2(370.0, 200.0));
+            envelopes::show(ui, &self.feed, egui::vec2(370.0, 200.0));
+        });
+    }
+
+    fn editor_closed(&mut self) {
+        self.gui = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::ModelConfig;
+
+    /// Runs the drawings in a headless egui frame; returns the number of shapes painted.
+    fn paint(feed: &Feed, params: &GlugParams) -> usize {
+        let ctx = egui::Context::default();
+        let mut output = ctx.run_ui(egui::RawInput::default(), |ui| {
+            bottle::show(ui, feed, egui::vec2(420.0, 220.0));
+            scope::show(ui, feed, egui::vec2(370.0, 200.0));
+            envelopes::show(ui, feed, egui::vec2(370.0, 200.0));
+            midi_settings::show(ui, params);
+        });
+        // Nothing uploads the font atlas here.
+        output.textures_delta.clear();
+        output.shapes.len()
+    }
+
+    #[test]
+    fn views_draw_a_pouring_bottle_its_scope_and_envelopes() {
+        use std::sync::atomic::Ordering::Relaxed;
+        let feed = Feed::default();
+        let params = GlugParams::default();
+        let idle = paint(&feed, &params);
+        assert!(idle > 5, "frames, outlines and labels: {idle}");
+
+        // Feed it a second of pouring, as the audio thread would.
+        let mut renderer = crate::plugin::RealtimeEngine::new(48_000.0, ModelConfig::default());
+        let mut settings = crate::plugin::Settings::from_params(&params);
+        settings.values.tilt_deg = 135.0;
+        let mut block = vec![0.0f32; 48_000];
+        renderer.process(&settings, &mut block, &feed);
+        assert!(feed.units().count() > 0);
+        assert_eq!(feed.tilt_deg.load(Relaxed), 135.0);
+        assert!(feed.volume_ml.load(Relaxed) < 300.0);
+        let busy = paint(&feed, &params);
+        assert!(
+            busy > idle + 8,
+            "scope columns and envelope curves: {busy} vs {idle}"
+        );
+    }
+}

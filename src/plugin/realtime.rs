@@ -1,0 +1,166 @@
+//! The plugin's real-time side without plugin-framework types: parameter values, MIDI and
+//! transport in; engine output and the editor's feed out. Allocation-free after `new()`.
+
+use crate::device::midi::{CcDecoder, MidiMap, Overrides};
+use crate::engine::{ControlValues, Controls, Engine, ModelConfig};
+use crate::plugin::feed::{Feed, ScopeWriter};
+use crate::plugin::params::GlugParams;
+use crate::plugin::transport::TransportWatch;
+
+/// The longest span rendered at once, so that the editor sees (nearly) every unit start; the
+/// engine's output does not depend on how time is cut.
+const FEED_SPAN: usize = 128;
+
+/// The parameters' values for one `process()` call.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Settings {
+    pub values: ControlValues,
+    pub gain_db: f64,
+    pub config: ModelConfig,
+    pub midi: MidiMap,
+}
+
+impl Settings {
+    pub fn from_params(params: &GlugParams) -> Self {
+        Self {
+            values: params.control_values(),
+            gain_db: params.gain_db(),
+            config: params.model_config(),
+            midi: params.midi_map(),
+        }
+    }
+}
+
+/// A MIDI message the plugin acts on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MidiInput {
+    /// A note-on: refill the bottle (MODEL.md §8).
+    Refill,
+    /// A control change, `value` 0–127, `channel` 0–15.
+    Cc { channel: u8, cc: u8, value: u8 },
+}
+
+pub struct RealtimeEngine {
+    engine: Engine,
+    config: ModelConfig,
+    decoder: CcDecoder,
+    overrides: Overrides,
+    transport: TransportWatch,
+    scope: ScopeWriter,
+    units_seen: u64,
+    /// Samples rendered since construction (the feed's clock; not reset with the bottle).
+    rendered: u64,
+}
+
+impl RealtimeEngine {
+    /// Allocates: call from `initialize()`.
+    pub fn new(sample_rate: f64, config: ModelConfig) -> Self {
+        Self {
+            engine: Engine::new(sample_rate, config),
+            config,
+            decoder: CcDecoder::default(),
+            overrides: Overrides::default(),
+            transport: TransportWatch::default(),
+            scope: ScopeWriter::new(sample_rate),
+            units_seen: 0,
+            rendered: 0,
+        }
+    }
+
+    pub fn sample_rate(&self) -> f64 {
+        self.engine.sample_rate()
+    }
+
+    pub fn engine(&self) -> &Engine {
+        &self.engine
+    }
+
+    /// The host's reset: the bottle's, and the transport is watched afresh.
+    pub fn reset(&mut self, config: ModelConfig) {
+        self.reset_bottle(config);
+        self.transport.reset();
+    }
+
+    /// Call once per `process()` before rendering; resets when the transport starts or jumps.
+    pub fn observe_transport(&mut self, playing: bool, position: Option<i64>, config: ModelConfig) {
+        if self.transport.observe(playing, position) {
+            self.reset_bottle(config);
+        }
+    }
+
+    /// MODEL.md §8 reset; MIDI overrides are dropped too, so a bounce starts from the parameters.
+    fn reset_bottle(&mut self, config: ModelConfig) {
+        self.apply_config(config);
+        self.engine.reset();
+        self.decoder.reset();
+        self.overrides.clear();
+        self.units_seen = 0;
+    }
+
+    /// Call once per `process()` after rendering `samples` samples.
+    pub fn finish_block(&mut self, samples: usize) {
+        self.transport.advance(samples);
+    }
+
+    pub fn handle(&mut self, input: MidiInput, map: &MidiMap) {
+        match input {
+            MidiInput::Refill => self.engine.refill(),
+            MidiInput::Cc { channel, cc, value } => {
+                if let Some((target, value)) = self.decoder.feed(map, channel, cc, value) {
+                    self.overrides.set(target, value);
+                }
+            }
+        }
+    }
+
+    fn apply_config(&mut self, config: ModelConfig) {
+        if config != self.config {
+            self.config = config;
+            self.engine.set_config(config);
+        }
+    }
+
+    /// Renders `out.len()` samples under `settings` (constant over the span).
+    pub fn process(&mut self, settings: &Settings, out: &mut [f32], feed: &Feed) {
+        self.apply_config(settings.config);
+        let params = settings.values;
+        let [tilt_deg, viscosity, fill_percent] =
+            self.overrides
+                .apply([params.tilt_deg, params.viscosity, params.fill_percent]);
+        let values = ControlValues {
+            tilt_deg,
+            viscosity,
+            fill_percent,
+            pour_time_s: params.pour_time_s,
+        };
+        let controls = Controls::constant(values, settings.gain_db);
+        let sample_rate = self.engine.sample_rate();
+        for span in out.chunks_mut(FEED_SPAN) {
+            self.engine.process(&controls, span);
+            let started = self.engine.stats().units_started;
+            if started != self.units_seen {
+                self.units_seen = started;
+                if let Some(unit) = self.engine.last_unit() {
+                    // The onset on the feed's clock: the span's end, minus how long ago it was.
+                    let since_reset_at_end = self.engine.position() as f64;
+                    let onset_since_reset = unit.sample as f64 + unit.fraction;
+                    let span_end = (self.rendered + span.len() as u64) as f64;
+                    let onset_s =
+                        (span_end - (since_reset_at_end - onset_since_reset)) / sample_rate;
+                    feed.push_unit(onset_s, unit);
+                }
+            }
+            self.rendered += span.len() as u64;
+            self.scope.write(feed, span);
+        }
+        use std::sync::atomic::Ordering::Relaxed;
+        feed.volume_ml
+            .store(self.engine.volume_ml() as f32, Relaxed);
+        feed.capacity_ml
+            .store(self.engine.config().capacity_ml as f32, Relaxed);
+        feed.tilt_deg.store(tilt_deg as f32, Relaxed);
+        feed.now_s
+            .store(self.rendered as f64 / sample_rate, Relaxed);
+        feed.units_started.store(self.units_seen, Relaxed);
+    }
+}

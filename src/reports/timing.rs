@@ -1,0 +1,137 @@
+//! Drives an [`Engine`] on any synthesis path from a control function of time, block by block,
+//! keeping only chosen windows of the output and timing the engine alone. Shared by the accuracy
+//! and stability reports so that both measure the same thing the same way.
+
+use std::ops::Range;
+use std::time::{Duration, Instant};
+
+use crate::engine::{ControlSource, Controls, Engine, Lane, ModelConfig, Synthesis};
+
+/// Samples per `process` call: a typical host block.
+pub const BLOCK: usize = 4096;
+
+/// What one render kept and cost.
+pub struct TimedRender {
+    /// The samples inside the requested windows, window after window.
+    pub kept: Vec<f32>,
+    /// Time spent inside `Engine::process` only (building the control lanes is not counted).
+    pub engine_time: Duration,
+    /// Largest |y| over the whole render.
+    pub peak: f32,
+    /// Whether every sample of the whole render was finite.
+    pub all_finite: bool,
+    /// Sum of y² over consecutive spans of `energy_span` samples (empty if not asked for).
+    pub energies: Vec<f64>,
+    /// Engine time spent up to the end of each energy span (the block that ends it).
+    pub span_times: Vec<Duration>,
+    /// The most components that sounded at the end of any block.
+    pub max_sounding: usize,
+    /// The sample after the one in which the last unit started (0 if none did).
+    pub last_onset_by: u64,
+}
+
+/// Options of [`timed_render`] besides the controls.
+pub struct RenderSpec<'a> {
+    pub sample_rate: f64,
+    pub config: ModelConfig,
+    pub len: u64,
+    /// Windows (ascending, disjoint) whose samples are kept.
+    pub keep: &'a [Range<u64>],
+    /// Span over which energies are summed; 0 for none.
+    pub energy_span: u64,
+}
+
+/// Renders `spec.len` samples of `controls` on synthesis path `S` from a reset.
+pub fn timed_render<S: Synthesis>(spec: &RenderSpec, controls: &impl ControlSource) -> TimedRender {
+    let mut engine = Engine::<S>::with_synthesis(spec.sample_rate, spec.config);
+    timed_render_on(&mut engine, spec, controls)
+}
+
+/// As [`timed_render`], on an engine the caller built (and may inspect afterwards).
+pub fn timed_render_on<S: Synthesis>(
+    engine: &mut Engine<S>,
+    spec: &RenderSpec,
+    controls: &impl ControlSource,
+) -> TimedRender {
+    let mut lanes: [Vec<f64>; 5] = std::array::from_fn(|_| Vec::with_capacity(BLOCK));
+    let mut out = vec![0.0f32; BLOCK];
+    let kept_len: u64 = spec
+        .keep
+        .iter()
+        .map(|w| w.end.min(spec.len) - w.start.min(spec.len))
+        .sum();
+    let mut result = TimedRender {
+        kept: Vec::with_capacity(kept_len as usize),
+        engine_time: Duration::ZERO,
+        peak: 0.0,
+        all_finite: true,
+        energies: Vec::new(),
+        span_times: Vec::new(),
+        max_sounding: 0,
+        last_onset_by: 0,
+    };
+    let mut energy = 0.0;
+    let mut start = 0u64;
+    while start < spec.len {
+        let len = (spec.len - start).min(BLOCK as u64) as usize;
+        for lane in &mut lanes {
+            lane.clear();
+        }
+        for sample in start..start + len as u64 {
+            let (values, gain_db) = controls.at(sample);
+            lanes[0].push(values.tilt_deg);
+            lanes[1].push(values.viscosity);
+            lanes[2].push(values.fill_percent);
+            lanes[3].push(values.pour_time_s);
+            lanes[4].push(gain_db);
+        }
+        let block = Controls {
+            tilt_deg: lane(&lanes[0]),
+            viscosity: lane(&lanes[1]),
+            fill_percent: lane(&lanes[2]),
+            pour_time_s: lane(&lanes[3]),
+            gain_db: lane(&lanes[4]),
+        };
+        let out = &mut out[..len];
+        let began = Instant::now();
+        engine.process(&block, out);
+        result.engine_time += began.elapsed();
+        result.max_sounding = result.max_sounding.max(engine.sounding_components());
+        result.last_onset_by = engine.last_unit().map_or(0, |unit| unit.sample + 1);
+
+        for (offset, &y) in out.iter().enumerate() {
+            let sample = start + offset as u64;
+            result.all_finite &= y.is_finite();
+            result.peak = result.peak.max(y.abs());
+            if spec.energy_span > 0 {
+                energy += y as f64 * y as f64;
+                if (sample + 1).is_multiple_of(spec.energy_span) {
+                    result.energies.push(energy);
+                    result.span_times.push(result.engine_time);
+                    energy = 0.0;
+                }
+            }
+        }
+        for window in spec.keep {
+            let from = window.start.max(start);
+            let to = window.end.min(start + len as u64);
+            if from < to {
+                result
+                    .kept
+                    .extend_from_slice(&out[(from - start) as usize..(to - start) as usize]);
+            }
+        }
+        start += len as u64;
+    }
+    result
+}
+
+/// A lane that is constant when its values are, so the engine can take its idle path.
+fn lane(values: &[f64]) -> Lane<'_> {
+    match values.first() {
+        Some(&first) if values.iter().all(|v| v.to_bits() == first.to_bits()) => {
+            Lane::Constant(first)
+        }
+        _ => Lane::Samples(values),
+    }
+}

@@ -1,0 +1,11 @@
+//! The engine against the model of MODEL.md: the drain and onsets (§2–4), the units (§5), the
+//! f64 reference (§9) and the work it skips.
+
+#[path = "../support/mod.rs"]
+mod support;
+
+mod drain;
+mod onsets;
+mod reference_match;
+mod units;
+mod work_skipped;

@@ -1,0 +1,148 @@
+//! The `sake-glug render` command as a user runs it.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn sake_glug(directory: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sake-glug"))
+        .current_dir(directory)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn files_in(directory: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(directory)
+        .unwrap()
+        .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn with_no_scene_it_renders_the_default_pour_to_pour_wav() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = sake_glug(directory.path(), &["render"]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let summary = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        summary.contains("pour.wav") && summary.contains("glug units"),
+        "{summary}"
+    );
+    assert!(
+        output.stderr.is_empty(),
+        "no progress bar when stderr is not a terminal"
+    );
+    let reader = hound::WavReader::open(directory.path().join("pour.wav")).unwrap();
+    let spec = reader.spec();
+    assert_eq!(
+        (spec.channels, spec.sample_rate, spec.bits_per_sample),
+        (1, 48_000, 32)
+    );
+    assert_eq!(spec.sample_format, hound::SampleFormat::Float);
+    let seconds = reader.duration() as f64 / 48_000.0;
+    assert!((5.0..5.6).contains(&seconds), "{seconds} s");
+    assert_eq!(files_in(directory.path()), ["pour.wav"]);
+    #[cfg(unix)]
+    {
+        // Readable like any new file, not private like the temporary file it was written as.
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(directory.path().join("pour.wav"))
+            .unwrap()
+            .permissions()
+            .mode();
+        assert_eq!(mode & 0o600, 0o600);
+        assert_ne!(mode & 0o044, 0, "mode {mode:o}");
+    }
+}
+
+#[test]
+fn integer_formats_and_sample_rate_override_are_written_as_asked() {
+    let directory = tempfile::tempdir().unwrap();
+    for (format, bits) in [("s16", 16), ("s24", 24)] {
+        let name = format!("{format}.wav");
+        let args = [
+            "render",
+            "-o",
+            &name,
+            "--format",
+            format,
+            "--sample-rate",
+            "96000",
+        ];
+        assert!(sake_glug(directory.path(), &args).status.success());
+        let mut reader = hound::WavReader::open(directory.path().join(&name)).unwrap();
+        let spec = reader.spec();
+        assert_eq!((spec.bits_per_sample, spec.sample_rate), (bits, 96_000));
+        let peak = reader
+            .samples::<i32>()
+            .map(|s| s.unwrap().abs())
+            .max()
+            .unwrap();
+        let full_scale = 1 << (bits - 1);
+        // The default pour peaks around −8 dBFS.
+        assert!(
+            peak > full_scale / 4 && peak < full_scale / 2,
+            "{format}: peak {peak}"
+        );
+    }
+}
+
+/// Renders `scene` from a file and checks that it is refused with `expected` in the message and
+/// that nothing but the scene is left in the directory.
+fn assert_refused(scene: &str, expected: &str) {
+    let directory = tempfile::tempdir().unwrap();
+    std::fs::write(directory.path().join("scene.toml"), scene).unwrap();
+    let output = sake_glug(directory.path(), &["render", "scene.toml", "-o", "out.wav"]);
+    assert_eq!(output.status.code(), Some(1), "{scene}");
+    let message = String::from_utf8_lossy(&output.stderr);
+    assert!(message.contains(expected), "{scene}: {message}");
+    assert_eq!(files_in(directory.path()), ["scene.toml"]);
+}
+
+#[test]
+fn a_bad_scene_is_refused_by_name_and_leaves_no_file() {
+    assert_refused(
+        "viscosity_c = 2.0\n",
+        "`viscosity_c` = 2 is out of range: allowed 0 to 1",
+    );
+}
+
+#[test]
+fn a_scene_that_never_falls_silent_is_refused_and_leaves_no_file() {
+    // Follow mode at a steady fill glugs for ever, and a decay of 0 rings for ever: without a
+    // duration the render cannot end.
+    assert_refused(
+        "tilt_deg = 135.0\n[output]\ndrain = \"follow\"\n",
+        "give it a duration_s",
+    );
+    assert_refused(
+        "tilt_deg = 135.0\n[glug]\nb1_per_s = 0.0\n",
+        "give it a duration_s",
+    );
+}
+
+#[test]
+fn bad_arguments_are_errors_not_panics() {
+    let directory = tempfile::tempdir().unwrap();
+    let cases: [&[&str]; 3] = [
+        &["render", "missing.toml"],
+        &["render", "--sample-rate", "10"],
+        &["render", "-o", "no/such/dir/out.wav"],
+    ];
+    for args in cases {
+        let output = sake_glug(directory.path(), args);
+        assert_eq!(output.status.code(), Some(1), "{args:?}");
+        let message = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            message.starts_with("error: ") && !message.contains("panicked"),
+            "{message}"
+        );
+    }
+    assert!(files_in(directory.path()).is_empty());
+}

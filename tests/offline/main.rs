@@ -1,0 +1,9 @@
+//! The offline renderer: scene files, the `sake-glug` command line, and the same samples on
+//! every run and at every block size.
+
+#[path = "../support/mod.rs"]
+mod support;
+
+mod cli;
+mod determinism;
+mod scene_files;

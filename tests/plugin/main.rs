@@ -1,0 +1,11 @@
+//! The plugin through nice-plug's real traits: parameters, MIDI, state, transport resets, every
+//! sample rate, and real-time safety.
+
+mod host;
+
+mod midi;
+mod nyquist;
+mod params;
+mod realtime;
+mod reset;
+mod state;

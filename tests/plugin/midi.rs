@@ -1,0 +1,148 @@
+//! MIDI from the tilt device: 14-bit and 7-bit CCs, channel filter, saved settings, and the rule
+//! that whichever moved last (the device or the host's parameter) decides.
+
+use std::sync::atomic::Ordering::Relaxed;
+
+use crate::host::{cc, note_on, Playhead, TestHost};
+use sake_glug::device::midi::{CcDecoder, MidiMap, Overrides, Target};
+
+#[test]
+fn fourteen_bit_tilt_assembles_msb_and_lsb() {
+    let map = MidiMap::default();
+    let mut decoder = CcDecoder::default();
+    let lsb = map.tilt_lsb.expect("14-bit by default");
+    assert_eq!(
+        decoder.feed(&map, 0, lsb, 5),
+        None,
+        "an LSB before any MSB only waits"
+    );
+    let (target, coarse) = decoder.feed(&map, 0, 16, 96).expect("tilt MSB");
+    assert_eq!(target, Target::Tilt);
+    assert_eq!(
+        coarse,
+        ((96 << 7) + 5) as f64 / 16383.0 * 180.0,
+        "the MSB applies with the last LSB"
+    );
+    let (_, fine) = decoder.feed(&map, 0, lsb, 64).expect("tilt LSB");
+    assert_eq!(fine, ((96 << 7) + 64) as f64 / 16383.0 * 180.0);
+    // A host that drops the unchanged LSB still gives the exact angle.
+    let (_, next) = decoder.feed(&map, 0, 16, 97).expect("tilt MSB");
+    assert_eq!(next, ((97 << 7) + 64) as f64 / 16383.0 * 180.0);
+    decoder.reset();
+    assert_eq!(
+        decoder.feed(&map, 0, lsb, 9),
+        None,
+        "a reset forgets the MSB"
+    );
+    let (_, top) = {
+        decoder.feed(&map, 0, 16, 127);
+        decoder.feed(&map, 0, lsb, 127).expect("tilt LSB")
+    };
+    assert_eq!(
+        top, 180.0,
+        "the full 14-bit value reaches the end of the range"
+    );
+}
+
+#[test]
+fn seven_bit_ccs_and_channel_filter() {
+    let map = MidiMap {
+        channel: Some(2),
+        tilt_lsb: None,
+        ..MidiMap::default()
+    };
+    let mut decoder = CcDecoder::default();
+    assert_eq!(decoder.feed(&map, 2, 16, 127), Some((Target::Tilt, 180.0)));
+    assert_eq!(decoder.feed(&map, 2, 17, 0), Some((Target::Viscosity, 0.0)));
+    assert_eq!(decoder.feed(&map, 2, 18, 127), Some((Target::Fill, 100.0)));
+    assert_eq!(
+        decoder.feed(&map, 3, 16, 64),
+        None,
+        "another channel is ignored"
+    );
+    assert_eq!(
+        decoder.feed(&map, 2, 48, 64),
+        None,
+        "no LSB mapped in 7-bit mode"
+    );
+    assert_eq!(
+        decoder.feed(&map, 2, 7, 64),
+        None,
+        "an unmapped CC is ignored"
+    );
+}
+
+#[test]
+fn saved_settings_round_trip_and_out_of_range_bytes_switch_off() {
+    let map = MidiMap {
+        channel: Some(15),
+        tilt_msb: Some(1),
+        tilt_lsb: Some(33),
+        viscosity: None,
+        fill: Some(0),
+    };
+    assert_eq!(MidiMap::from_raw(map.to_raw()), map);
+    let garbage = MidiMap::from_raw([16, 128, 200, 127, 255]);
+    assert_eq!(
+        garbage,
+        MidiMap {
+            channel: None,
+            tilt_msb: None,
+            tilt_lsb: None,
+            viscosity: Some(127),
+            fill: None
+        }
+    );
+}
+
+#[test]
+fn whichever_moved_last_wins() {
+    let mut overrides = Overrides::default();
+    assert_eq!(overrides.apply([90.0, 0.33, 100.0]), [90.0, 0.33, 100.0]);
+    overrides.set(Target::Tilt, 135.0);
+    assert_eq!(
+        overrides.apply([90.0, 0.33, 100.0]),
+        [135.0, 0.33, 100.0],
+        "the device moved last"
+    );
+    assert_eq!(
+        overrides.apply([90.0, 0.33, 100.0]),
+        [135.0, 0.33, 100.0],
+        "and stays in charge"
+    );
+    assert_eq!(
+        overrides.apply([100.0, 0.33, 100.0]),
+        [100.0, 0.33, 100.0],
+        "the host moved the parameter"
+    );
+}
+
+#[test]
+fn ccs_drive_the_plugin_and_a_note_on_refills() {
+    let mut host = TestHost::new(48_000.0, 2);
+    // Tilt 135° from the device, 14-bit: 135/180·16383 = 12287 = MSB 95, LSB 127.
+    host.process(
+        64,
+        vec![cc(0, 0, 16, 95), cc(1, 0, 48, 127)],
+        Playhead::default(),
+    );
+    let tilt = host.plugin.feed().tilt_deg.load(Relaxed);
+    assert!((tilt - 135.0).abs() < 0.02, "tilt from MIDI: {tilt}");
+    let out = host.render_mono(48_000 * 2, 512);
+    assert!(crate::host::peak(&out) > 0.05, "the device's tilt pours");
+    let drained = host.plugin.renderer().expect("active").engine().volume_ml();
+    host.process(64, vec![note_on(10)], Playhead::default());
+    let refilled = host.plugin.renderer().expect("active").engine().volume_ml();
+    assert!(
+        refilled > drained,
+        "note-on refills: {drained} -> {refilled}"
+    );
+    // Settings changed in the saved state take effect: the device on CC 1, 7-bit.
+    host.plugin.glug_params().set_midi_map(MidiMap {
+        tilt_msb: Some(1),
+        tilt_lsb: None,
+        ..MidiMap::default()
+    });
+    host.process(64, vec![cc(0, 9, 1, 0)], Playhead::default());
+    assert_eq!(host.plugin.feed().tilt_deg.load(Relaxed), 0.0);
+}

@@ -1,0 +1,116 @@
+//! process() is real-time safe: no allocation (checked by nice-plug's `assert_no_alloc` when
+//! built with `--features assert_process_allocs` in the dev profile), under every kind of input a
+//! host sends: odd block sizes, parameter changes, note-ons, CCs, transport starts and jumps.
+//!
+//! Run: `cargo test --features assert_process_allocs --test plugin_realtime`
+
+use nice_plug::prelude::Plugin;
+
+use crate::host::{cc, note_on, peak, Playhead, TestHost};
+
+#[cfg(all(debug_assertions, feature = "assert_process_allocs"))]
+fn no_alloc(f: &mut dyn FnMut()) {
+    nice_assert_no_alloc::assert_no_alloc(f)
+}
+
+#[cfg(not(all(debug_assertions, feature = "assert_process_allocs")))]
+fn no_alloc(f: &mut dyn FnMut()) {
+    f()
+}
+
+fn host(sample_rate: f32, channels: usize) -> TestHost {
+    let mut host = TestHost::new(sample_rate, channels);
+    host.guard = no_alloc;
+    host
+}
+
+#[test]
+fn process_does_not_allocate_under_a_busy_session() {
+    for (sample_rate, channels) in [(48_000.0, 2), (44_100.0, 1), (1_000.0, 2), (768_000.0, 1)] {
+        let mut host = host(sample_rate, channels);
+        host.set_text("tilt", "135");
+        let mut heard = 0.0f32;
+        let mut position = 0i64;
+        for (index, len) in [1usize, 7, 32, 512, 4096, 333, 64, 8192, 128]
+            .into_iter()
+            .cycle()
+            .take(60)
+            .enumerate()
+        {
+            // Parameter changes between blocks, as a wrapper applies them.
+            match index % 6 {
+                0 => host.set_normalized("visc", (index as f32 * 0.137) % 1.0),
+                1 => host.set_normalized("pour", (index as f32 * 0.291) % 1.0),
+                2 => host.set_normalized("f2", (index as f32 * 0.53) % 1.0),
+                3 => host.set_normalized("seed", (index as f32 * 0.07) % 1.0),
+                4 => host.set_normalized("drain", (index % 2) as f32),
+                _ => host.set_normalized("b1", (index as f32 * 0.77) % 1.0),
+            }
+            let last = len as u32 - 1;
+            let events = vec![
+                cc(0, 0, 16, 100),
+                cc(last / 2, 0, 48, 5),
+                cc(last, 3, 17, 64),
+                note_on(last / 3),
+                cc(last, 0, 18, 127),
+            ];
+            // Play, then jump, then stop now and then.
+            let playhead = match index % 10 {
+                9 => Playhead::default(),
+                5 => Playhead {
+                    playing: true,
+                    position: Some(1_000_000),
+                },
+                _ => Playhead {
+                    playing: true,
+                    position: Some(position),
+                },
+            };
+            let out = host.process(len, events, playhead);
+            position += len as i64;
+            for channel in &out {
+                assert!(channel.iter().all(|s| s.is_finite()));
+                assert_eq!(channel, &out[0], "every channel carries the mono signal");
+            }
+            heard = heard.max(peak(&out[0]));
+            // Hosts may call reset() from the audio thread at any time.
+            if index % 7 == 3 {
+                let plugin = &mut host.plugin;
+                no_alloc(&mut || plugin.reset());
+            }
+        }
+        assert!(
+            heard > 0.0,
+            "the session at {sample_rate} Hz must make sound"
+        );
+    }
+}
+
+/// Proves the check above is armed: an allocation inside the same guard aborts the process.
+/// Runs itself as a child process, because the abort cannot be caught.
+#[cfg(all(debug_assertions, feature = "assert_process_allocs"))]
+#[test]
+fn an_allocation_inside_the_guard_is_caught() {
+    if std::env::var_os("SAKE_GLUG_ALLOC_CANARY").is_some() {
+        no_alloc(&mut || {
+            let leaked = std::hint::black_box(vec![1u8; 64]);
+            std::hint::black_box(&leaked);
+        });
+        return;
+    }
+    let status = std::process::Command::new(std::env::current_exe().expect("test binary path"))
+        .args([
+            "--exact",
+            "an_allocation_inside_the_guard_is_caught",
+            "--nocapture",
+        ])
+        .env("SAKE_GLUG_ALLOC_CANARY", "1")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .expect("run the canary");
+    assert!(
+        !status.success(),
+        "an allocation inside assert_no_alloc went unnoticed"
+    );
+}

@@ -1,0 +1,68 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use sake_glug::engine::synthesis::reference;
+use sake_glug::engine::{ControlValues, Engine, ModelConfig, Pour, UnitOnset};
+use sake_glug::offline::{LaneBuffers, Scene};
+use sake_glug::reports::accuracy;
+
+/// Renders `len` samples of `scene` on the default path, cutting time into blocks of the sizes
+/// `block_sizes` yields (cycled).
+pub fn render_in_blocks(scene: &Scene, len: usize, block_sizes: &[usize]) -> Vec<f32> {
+    let mut engine = Engine::new(scene.sample_rate as f64, scene.config);
+    let mut lanes = LaneBuffers::default();
+    let mut out = vec![0.0f32; len];
+    let mut done = 0;
+    for &size in block_sizes.iter().cycle() {
+        if done == len {
+            break;
+        }
+        let size = size.min(len - done);
+        let controls = scene.controls(done as u64, &mut lanes, size);
+        engine.process(&controls, &mut out[done..done + size]);
+        done += size;
+    }
+    out
+}
+
+/// The f64 reference of the same scene.
+pub fn reference_render(scene: &Scene, len: usize) -> Vec<f64> {
+    reference::evaluate(scene.sample_rate as f64, scene.config, scene, 0..len as u64).samples
+}
+
+/// Largest absolute error relative to the reference's peak, in dB.
+pub fn error_db(fast: &[f32], reference: &[f64]) -> f64 {
+    assert!(
+        reference.iter().any(|y| *y != 0.0),
+        "the reference is silent"
+    );
+    accuracy::error_db(fast, reference).0
+}
+
+/// Every unit a pour starts under constant controls over `seconds`, with the summed outflow
+/// that left while the mouth was submerged.
+pub fn pour_onsets(
+    sample_rate: f64,
+    config: ModelConfig,
+    controls: impl Fn(u64) -> ControlValues,
+    seconds: f64,
+) -> (Vec<UnitOnset>, f64) {
+    let mut pour = Pour::new(sample_rate, config);
+    pour.reset();
+    let mut onsets = Vec::new();
+    let mut glugging_outflow = 0.0;
+    for sample in 0..(seconds * sample_rate) as u64 {
+        let outflow = pour.step(sample, controls(sample), |onset| onsets.push(*onset));
+        if outflow.submerged {
+            glugging_outflow += outflow.amount_ml;
+        }
+    }
+    (onsets, glugging_outflow)
+}
+
+pub fn tilt_only(tilt_deg: f64) -> ControlValues {
+    ControlValues {
+        tilt_deg,
+        ..ControlValues::default()
+    }
+}
