@@ -15,10 +15,13 @@ pub const OFF: u8 = 255;
 pub struct MidiMap {
     /// 0–15, or `None` for any channel.
     pub channel: Option<u8>,
+    /// CC number of tilt (its MSB when tilt is 14-bit), 0–127; `None` if unmapped.
     pub tilt_msb: Option<u8>,
     /// With an LSB CC, tilt is 14-bit; without, 7-bit.
     pub tilt_lsb: Option<u8>,
+    /// CC number of viscosity c (7-bit), 0–127; `None` if unmapped.
     pub viscosity: Option<u8>,
+    /// CC number of the fill level φ (7-bit), 0–127; `None` if unmapped.
     pub fill: Option<u8>,
 }
 
@@ -49,6 +52,8 @@ impl MidiMap {
         }
     }
 
+    /// The bytes saved with the state, `[channel, tilt MSB, tilt LSB, viscosity, fill]`, with
+    /// [`OFF`] for unmapped / any channel.
     pub fn to_raw(self) -> [u8; 5] {
         let byte = |value: Option<u8>| value.unwrap_or(OFF);
         [
@@ -68,8 +73,11 @@ impl MidiMap {
 /// The controls a CC can drive, in the order of [`Overrides`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Target {
+    /// Tilt θ (degrees).
     Tilt = 0,
+    /// Viscosity ratio c.
     Viscosity = 1,
+    /// Fill level φ (percent of capacity).
     Fill = 2,
 }
 
@@ -98,6 +106,7 @@ pub struct CcDecoder {
 }
 
 impl CcDecoder {
+    /// Forgets the last tilt MSB and LSB.
     pub fn reset(&mut self) {
         *self = Self::default();
     }
@@ -154,10 +163,12 @@ pub struct Overrides {
 }
 
 impl Overrides {
+    /// Makes `target` follow MIDI at `value` until the host changes its parameter.
     pub fn set(&mut self, target: Target, value: f64) {
         self.midi[target as usize] = Some(value);
     }
 
+    /// Drops every MIDI override: tilt, viscosity and fill follow their parameters again.
     pub fn clear(&mut self) {
         self.midi = [None; 3];
     }

@@ -4,8 +4,11 @@
 /// An input's allowed closed range and its default (MODEL.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Range {
+    /// Lowest allowed value.
     pub min: f64,
+    /// Highest allowed value.
     pub max: f64,
+    /// Value of a left-out input, and what NaN becomes.
     pub default: f64,
 }
 
@@ -14,6 +17,7 @@ impl Range {
         Self { min, max, default }
     }
 
+    /// Whether `value` lies in the closed range `[min, max]` (false for NaN).
     pub fn contains(&self, value: f64) -> bool {
         value >= self.min && value <= self.max
     }
@@ -29,22 +33,37 @@ impl Range {
     }
 }
 
+/// Sample rate fs of a render (Hz).
 pub const SAMPLE_RATE_HZ: Range = Range::new(1_000.0, 768_000.0, 48_000.0);
+/// Tilt θ of the bottle (degrees): 0 upright, 90 horizontal, 180 upside down.
 pub const TILT_DEG: Range = Range::new(0.0, 180.0, 0.0);
+/// Viscosity ratio c (dimensionless, 0…1): the share of the f1 component; water 0.33.
 pub const VISCOSITY: Range = Range::new(0.0, 1.0, 0.33);
+/// Fill level φ (percent of capacity C) that the bottle is (re)filled to.
 pub const FILL_PERCENT: Range = Range::new(0.0, 100.0, 100.0);
+/// Pour time T (s): how long a full bottle takes to empty at the reference tilt 135°.
 pub const POUR_TIME_S: Range = Range::new(0.01, 3600.0, 5.0);
+/// Output gain (dB): G = 10^(gain/20).
 pub const GAIN_DB: Range = Range::new(-120.0, 24.0, -6.0);
+/// Bottle capacity C (ml).
 pub const CAPACITY_ML: Range = Range::new(1.0, 100_000.0, 300.0);
+/// Mean volume b of the air pocket one glug lets in (ml).
 pub const POCKET_ML: Range = Range::new(0.001, 1_000.0, 5.0);
+/// Frequency f1 of the first component, the air pocket bouncing in the neck (Hz).
 pub const F1_HZ: Range = Range::new(0.0, 400_000.0, 80.0);
+/// Frequency f2 of the second component, the free pocket's Minnaert ring (Hz).
 pub const F2_HZ: Range = Range::new(0.0, 400_000.0, 300.0);
+/// Amplitude decay rate B1 of the first component (1/s).
 pub const B1_PER_S: Range = Range::new(0.0, 1e9, 45.0);
+/// Amplitude decay rate B2 of the second component (1/s).
 pub const B2_PER_S: Range = Range::new(0.0, 1e9, 40.0);
 /// Below 1 so that a pocket volume b·(1 + j·u) is always positive.
 pub const TIMING_JITTER: Range = Range::new(0.0, 0.95, 0.15);
+/// Relative spread j_f of each unit's f1, f2 (dimensionless): f·(1 + j_f·u), u in [−1, 1].
 pub const FREQ_JITTER: Range = Range::new(0.0, 1.0, 0.05);
+/// Log-normal spread σ of each unit's B1, B2 (dimensionless): B·exp(σ·z), z standard normal.
 pub const DECAY_SIGMA: Range = Range::new(0.0, 3.0, 0.35);
+/// Hard output ceiling (linear amplitude): every output sample stays within ±ceiling.
 pub const CEILING: Range = Range::new(0.001, 1.0, 1.0);
 
 /// How the residual volume evolves (MODEL.md §8). Scenes name it in lower case (`"simulate"`,
@@ -62,16 +81,23 @@ pub enum DrainMode {
 /// The constants of the model that do not change sample by sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ModelConfig {
+    /// Bottle capacity C (ml).
     pub capacity_ml: f64,
+    /// Mean air-pocket volume b per glug (ml).
     pub pocket_ml: f64,
     /// f1, f2 of §5.
     pub frequency_hz: [f64; 2],
     /// B1, B2 of §5 (amplitude decay rates).
     pub decay_per_s: [f64; 2],
+    /// Relative spread j_t of each unit's pocket volume (§7).
     pub timing_jitter: f64,
+    /// Relative spread j_f of each unit's f1, f2 (§7).
     pub freq_jitter: f64,
+    /// Log-normal spread σ of each unit's B1, B2 (§7).
     pub decay_sigma: f64,
+    /// Seed of the random generator of §7, applied again at every reset.
     pub seed: u64,
+    /// How the residual volume evolves: simulate or follow (§8).
     pub drain: DrainMode,
     /// The hard output ceiling of §6 (linear).
     pub ceiling: f64,
@@ -130,9 +156,13 @@ impl ModelConfig {
 /// The per-sample inputs of the model (MODEL.md §1), as one sample sees them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ControlValues {
+    /// Tilt θ (degrees).
     pub tilt_deg: f64,
+    /// Viscosity ratio c (0…1).
     pub viscosity: f64,
+    /// Fill level φ (percent of capacity).
     pub fill_percent: f64,
+    /// Pour time T of a full bottle at 135° (s).
     pub pour_time_s: f64,
 }
 
@@ -148,6 +178,7 @@ impl Default for ControlValues {
 }
 
 impl ControlValues {
+    /// Every value brought into its range (see [`Range::sanitize`]).
     #[inline]
     pub fn sanitized(self) -> Self {
         Self {

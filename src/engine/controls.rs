@@ -18,12 +18,14 @@ impl<F: Fn(u64) -> (ControlValues, f64)> ControlSource for F {
 /// One automatable input over a block.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Lane<'a> {
+    /// The same value at every sample of the block.
     Constant(f64),
     /// One value per sample of the block; a lane shorter than the block holds its last value.
     Samples(&'a [f64]),
 }
 
 impl Lane<'_> {
+    /// The value at sample `index` of the block.
     #[inline]
     pub fn at(&self, index: usize) -> f64 {
         match *self {
@@ -35,6 +37,7 @@ impl Lane<'_> {
         }
     }
 
+    /// Whether the lane is a [`Lane::Constant`].
     pub fn is_constant(&self) -> bool {
         matches!(self, Lane::Constant(_))
     }
@@ -43,10 +46,15 @@ impl Lane<'_> {
 /// The automatable inputs of the model for one block (MODEL.md §1, §5).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Controls<'a> {
+    /// Tilt θ (degrees).
     pub tilt_deg: Lane<'a>,
+    /// Viscosity ratio c.
     pub viscosity: Lane<'a>,
+    /// Fill level φ (percent of capacity).
     pub fill_percent: Lane<'a>,
+    /// Pour time T (s).
     pub pour_time_s: Lane<'a>,
+    /// Output gain (dB).
     pub gain_db: Lane<'a>,
 }
 

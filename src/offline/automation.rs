@@ -7,14 +7,17 @@ use serde::de::{self, Deserialize, Deserializer, SeqAccess, Visitor};
 
 use crate::engine::Lane;
 
+/// An automatable scene value: a constant or a list of `[time_s, value]` points.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Automation {
+    /// The same value at all times.
     Constant(f64),
     /// Times in seconds, non-decreasing; two points at one time make a step.
     Points(Vec<(f64, f64)>),
 }
 
 impl Automation {
+    /// The value at `time_s` (s): linear between points, held before the first and after the last.
     pub fn value_at(&self, time_s: f64) -> f64 {
         match self {
             Automation::Constant(value) => *value,

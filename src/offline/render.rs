@@ -8,8 +8,10 @@ use crate::engine::{DrainMode, Engine};
 /// Samples per engine call offline; any size gives the same samples.
 pub const BLOCK_SIZE: usize = 4096;
 
+/// Why a scene could not be rendered.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
+    /// The scene has no `duration_s` and cannot be seen to fall silent.
     #[error(
         "the scene never falls silent (it pours or rings for ever after its last automation \
          point, or past {MAX_DURATION_S} s), so it has no natural end; give it a duration_s"
@@ -20,15 +22,20 @@ pub enum RenderError {
 /// What a finished render did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderSummary {
+    /// Length of the render (samples).
     pub samples: u64,
+    /// Sample rate of the render (Hz).
     pub sample_rate: u32,
+    /// Wave units started.
     pub units: u64,
     /// Largest |sample|.
     pub peak: f32,
+    /// Wall-clock time the render took.
     pub elapsed: Duration,
 }
 
 impl RenderSummary {
+    /// Length of the render (s).
     pub fn duration_s(&self) -> f64 {
         self.samples as f64 / self.sample_rate as f64
     }

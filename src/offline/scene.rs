@@ -18,26 +18,41 @@ tilt_deg = [[0.0, 90.0], [0.5, 135.0]]
 /// Longest render a scene may ask for (and the limit on one that never falls silent).
 pub const MAX_DURATION_S: f64 = 86_400.0;
 
+/// Why a scene was refused.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
+    /// The scene file could not be read.
     #[error("cannot read scene file {}: {source}", path.display())]
     Read {
+        /// The file's path.
         path: PathBuf,
+        /// The I/O error.
         source: std::io::Error,
     },
+    /// Not valid TOML, an unknown key or a value of the wrong type: the parser's message.
     #[error("invalid scene: {0}")]
     Syntax(String),
+    /// A value outside its allowed range.
     #[error("`{key}` = {value} is out of range: allowed {min} to {max}")]
     OutOfRange {
+        /// The scene key.
         key: &'static str,
+        /// The value given.
         value: f64,
+        /// Lowest allowed value.
         min: f64,
+        /// Highest allowed value.
         max: f64,
     },
+    /// An automation point whose time is not finite, is negative or comes before the previous
+    /// point's.
     #[error("`{key}`: point {index} is at {time_s} s; point times must be finite, at least 0 and in order")]
     PointTime {
+        /// The scene key.
         key: &'static str,
+        /// Index of the point in the list, from 0.
         index: usize,
+        /// The point's time (s).
         time_s: f64,
     },
 }
@@ -45,13 +60,19 @@ pub enum SceneError {
 /// A validated scene, ready to render.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
+    /// Sample rate fs (Hz).
     pub sample_rate: u32,
     /// `None`: until pouring stops and every unit has decayed.
     pub duration_s: Option<f64>,
+    /// Tilt θ (degrees) over time.
     pub tilt_deg: Automation,
+    /// Viscosity ratio c over time.
     pub viscosity: Automation,
+    /// Fill level φ (percent of capacity) over time.
     pub fill_percent: Automation,
+    /// Pour time T (s) over time.
     pub pour_time_s: Automation,
+    /// Output gain (dB) over time.
     pub gain_db: Automation,
     /// Seed, spreads (zero if `deterministic`), drain mode and the other constants.
     pub config: ModelConfig,
@@ -64,6 +85,7 @@ impl Default for Scene {
 }
 
 impl Scene {
+    /// Reads and validates the scene file at `path`.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
             path: path.to_owned(),
@@ -72,6 +94,7 @@ impl Scene {
         Self::parse(&text)
     }
 
+    /// Parses and validates a scene from TOML `text`.
     pub fn parse(text: &str) -> Result<Self, SceneError> {
         let file: SceneFile =
             toml::from_str(text).map_err(|error| SceneError::Syntax(error.to_string()))?;

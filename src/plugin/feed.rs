@@ -10,6 +10,7 @@ use crate::engine::UnitOnset;
 
 /// Scope columns kept (each the min and max of [`SCOPE_COLUMN_S`] of output).
 pub const SCOPE_COLUMNS: usize = 600;
+/// Output time each scope column covers (s).
 pub const SCOPE_COLUMN_S: f64 = 0.001;
 /// Units whose envelopes are kept.
 pub const UNIT_SLOTS: usize = 8;
@@ -28,19 +29,27 @@ pub struct UnitSlot {
 pub struct UnitView {
     /// Seconds since the unit started.
     pub age_s: f64,
+    /// A1, A2: the components' amplitudes, before the output gain.
     pub amplitude: [f32; 2],
+    /// f1_i, f2_i (Hz).
     pub frequency_hz: [f32; 2],
+    /// B1_i, B2_i: amplitude decay rates (1/s).
     pub decay_per_s: [f32; 2],
+    /// V_i: the residual volume at the unit's onset (ml).
     pub volume_ml: f32,
 }
 
+/// What the audio thread publishes for the editor (see the module documentation).
 pub struct Feed {
+    /// Residual volume V at the end of the last `process()` (ml).
     pub volume_ml: AtomicF32,
+    /// Bottle capacity C (ml).
     pub capacity_ml: AtomicF32,
     /// The tilt the engine uses (the parameter's, or the MIDI device's).
     pub tilt_deg: AtomicF32,
     /// Seconds of output rendered since the plugin was activated.
     pub now_s: AtomicF64,
+    /// Units started since the bottle's last reset.
     pub units_started: AtomicU64,
     scope_min: Box<[AtomicF32]>,
     scope_max: Box<[AtomicF32]>,
@@ -68,6 +77,8 @@ impl Default for Feed {
 }
 
 impl Feed {
+    /// Records a unit that started at `onset_s` (s, on the clock of `now_s`), in place of the
+    /// oldest one kept.
     pub fn push_unit(&self, onset_s: f64, unit: &UnitOnset) {
         let index = self.units_written.load(Ordering::Relaxed);
         let slot = &self.units[index % UNIT_SLOTS];

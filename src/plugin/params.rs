@@ -18,11 +18,17 @@ use crate::engine::{ControlValues, DrainMode, ModelConfig};
 /// How one float parameter is ranged, shown and handed to the engine.
 #[derive(Debug, Clone, Copy)]
 pub struct Knob {
+    /// Parameter name shown by the host.
     pub name: &'static str,
+    /// Unit text shown after the value (with its leading space, if any).
     pub unit: &'static str,
+    /// Lowest value on the knob.
     pub min: f64,
+    /// Highest value on the knob.
     pub max: f64,
+    /// Default value.
     pub default: f64,
+    /// Decimals shown; the value snaps to steps of 10^−decimals.
     pub decimals: i32,
     /// `None` for a linear knob, else nice-plug's skew exponent (negative: finer at the bottom).
     pub skew: Option<f32>,
@@ -74,6 +80,7 @@ impl Knob {
         }
     }
 
+    /// The text for `value`: exactly `decimals` decimals, without the unit.
     pub fn format(&self, value: f32) -> String {
         format!("{:.*}", self.decimals as usize, self.exact(value))
     }
@@ -90,6 +97,7 @@ impl Knob {
         }
     }
 
+    /// The nice-plug parameter for this knob.
     pub fn param(&self) -> FloatParam {
         let knob = *self;
         FloatParam::new(self.name, self.default as f32, self.range())
@@ -114,8 +122,11 @@ pub fn parse_number(text: &str) -> Option<f32> {
 }
 
 // The main group. Tilt, viscosity and fill use the engine's full ranges.
+/// Tilt θ (degrees), 0–180.
 pub const TILT: Knob = Knob::from_range("Tilt", "°", config::TILT_DEG, 2);
+/// Viscosity ratio c, 0–1.
 pub const VISCOSITY: Knob = Knob::from_range("Viscosity", "", config::VISCOSITY, 3);
+/// Fill level φ (percent of capacity), 0–100.
 pub const FILL: Knob = Knob::from_range("Fill level", " %", config::FILL_PERCENT, 1);
 /// Narrower than the engine's 0.01–3600 s: below 0.1 s or above 2 minutes is no pour.
 pub const POUR_TIME: Knob = Knob::from_range("Pour time", " s", config::POUR_TIME_S, 2)
@@ -127,26 +138,35 @@ pub const GAIN: Knob =
 
 // The model group (MODEL.md §5, §7). Frequencies, decays, volumes: narrower than the engine's
 // ranges (which only guard against nonsense) but wide enough to reach past Nyquist at 44.1 kHz.
+/// Frequency f1 of the first component (Hz).
 pub const F1: Knob = Knob::from_range("f1", " Hz", config::F1_HZ, 1)
     .within(10.0, 24_000.0)
     .skewed(-2.0);
+/// Frequency f2 of the second component (Hz).
 pub const F2: Knob = Knob::from_range("f2", " Hz", config::F2_HZ, 1)
     .within(10.0, 24_000.0)
     .skewed(-2.0);
+/// Amplitude decay rate B1 of the first component (1/s).
 pub const B1: Knob = Knob::from_range("B1", " /s", config::B1_PER_S, 1)
     .within(1.0, 1_000.0)
     .skewed(-1.5);
+/// Amplitude decay rate B2 of the second component (1/s).
 pub const B2: Knob = Knob::from_range("B2", " /s", config::B2_PER_S, 1)
     .within(1.0, 1_000.0)
     .skewed(-1.5);
+/// Mean air-pocket volume b per glug (ml).
 pub const POCKET: Knob = Knob::from_range("Pocket volume", " ml", config::POCKET_ML, 2)
     .within(0.1, 100.0)
     .skewed(-1.5);
+/// Bottle capacity C (ml).
 pub const CAPACITY: Knob = Knob::from_range("Capacity", " ml", config::CAPACITY_ML, 0)
     .within(10.0, 5_000.0)
     .skewed(-1.5);
+/// Relative spread j_t of each unit's pocket volume, 0–0.95.
 pub const TIMING_JITTER: Knob = Knob::from_range("Timing spread", "", config::TIMING_JITTER, 3);
+/// Relative spread j_f of each unit's f1, f2, 0–1.
 pub const FREQ_JITTER: Knob = Knob::from_range("Frequency spread", "", config::FREQ_JITTER, 3);
+/// Log-normal spread σ of each unit's B1, B2, 0–3.
 pub const DECAY_SIGMA: Knob = Knob::from_range("Decay spread", "", config::DECAY_SIGMA, 3);
 /// The output ceiling in dB (0 dB = the engine's default ±1.0); −60 dB is the engine's 0.001.
 pub const CEILING_DB: Knob = Knob {
@@ -158,6 +178,7 @@ pub const CEILING_DB: Knob = Knob {
     decimals: 1,
     skew: None,
 };
+/// Largest value of the Seed parameter.
 pub const SEED_MAX: i32 = 999_999;
 
 /// The Drain mode parameter is the engine's own [`DrainMode`]; its IDs are the names scenes use.
@@ -185,59 +206,83 @@ impl Enum for DrainMode {
     }
 }
 
+/// Every parameter of the plugin, and its saved MIDI settings.
 #[derive(Params)]
 pub struct GlugParams {
+    /// Tilt θ (degrees), see [`TILT`].
     #[id = "tilt"]
     pub tilt: FloatParam,
+    /// Viscosity ratio c, see [`VISCOSITY`].
     #[id = "visc"]
     pub viscosity: FloatParam,
+    /// Fill level φ (percent of capacity), see [`FILL`].
     #[id = "fill"]
     pub fill: FloatParam,
+    /// Pour time T (s), see [`POUR_TIME`].
     #[id = "pour"]
     pub pour_time: FloatParam,
+    /// Output gain (dB), see [`GAIN`].
     #[id = "gain"]
     pub gain: FloatParam,
 
+    /// The Model group: the constants of MODEL.md §5, §7 and §8.
     #[nested(group = "Model")]
     pub model: ModelParams,
 
     /// MIDI settings of the tilt device (saved with the state, not automatable).
     #[persist = "midi_channel"]
     pub midi_channel: AtomicU8,
+    /// CC number of tilt (its MSB when tilt is 14-bit); 128 or more means unmapped.
     #[persist = "midi_cc_tilt"]
     pub midi_cc_tilt: AtomicU8,
+    /// CC number of tilt's LSB; 128 or more means 7-bit tilt.
     #[persist = "midi_cc_tilt_lsb"]
     pub midi_cc_tilt_lsb: AtomicU8,
+    /// CC number of viscosity; 128 or more means unmapped.
     #[persist = "midi_cc_viscosity"]
     pub midi_cc_viscosity: AtomicU8,
+    /// CC number of the fill level; 128 or more means unmapped.
     #[persist = "midi_cc_fill"]
     pub midi_cc_fill: AtomicU8,
 }
 
+/// The Model group of parameters (MODEL.md §5, §7, §8).
 #[derive(Params)]
 pub struct ModelParams {
+    /// Frequency f1 (Hz), see [`F1`].
     #[id = "f1"]
     pub f1: FloatParam,
+    /// Frequency f2 (Hz), see [`F2`].
     #[id = "f2"]
     pub f2: FloatParam,
+    /// Decay rate B1 (1/s), see [`B1`].
     #[id = "b1"]
     pub b1: FloatParam,
+    /// Decay rate B2 (1/s), see [`B2`].
     #[id = "b2"]
     pub b2: FloatParam,
+    /// Pocket volume b (ml), see [`POCKET`].
     #[id = "pocket"]
     pub pocket: FloatParam,
+    /// Capacity C (ml), see [`CAPACITY`].
     #[id = "cap"]
     pub capacity: FloatParam,
+    /// Timing spread j_t, see [`TIMING_JITTER`].
     #[id = "tjit"]
     pub timing_jitter: FloatParam,
+    /// Frequency spread j_f, see [`FREQ_JITTER`].
     #[id = "fjit"]
     pub freq_jitter: FloatParam,
+    /// Decay spread σ, see [`DECAY_SIGMA`].
     #[id = "dsig"]
     pub decay_sigma: FloatParam,
+    /// Seed of the random generator, 0 to [`SEED_MAX`].
     #[id = "seed"]
     pub seed: IntParam,
+    /// Drain mode: simulate or follow.
     #[id = "drain"]
     pub drain: EnumParam<DrainMode>,
+    /// Output ceiling (dB), see [`CEILING_DB`].
     #[id = "ceil"]
     pub ceiling: FloatParam,
 }
@@ -298,10 +343,12 @@ impl GlugParams {
         }
     }
 
+    /// The output gain as the engine receives it (dB).
     pub fn gain_db(&self) -> f64 {
         GAIN.exact(self.gain.value())
     }
 
+    /// The model's constants as the parameters set them, the ceiling converted to linear.
     pub fn model_config(&self) -> ModelConfig {
         let model = &self.model;
         ModelConfig {
@@ -329,6 +376,7 @@ impl GlugParams {
         ])
     }
 
+    /// Saves `map` as the MIDI settings.
     pub fn set_midi_map(&self, map: MidiMap) {
         let raw = map.to_raw();
         self.midi_channel.store(raw[0], Ordering::Relaxed);

@@ -14,13 +14,18 @@ const FEED_SPAN: usize = 128;
 /// The parameters' values for one `process()` call.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
+    /// Tilt, viscosity, fill level and pour time as the parameters set them (before MIDI).
     pub values: ControlValues,
+    /// Output gain (dB).
     pub gain_db: f64,
+    /// The model's constants.
     pub config: ModelConfig,
+    /// The tilt device's MIDI mapping.
     pub midi: MidiMap,
 }
 
 impl Settings {
+    /// The parameters' current values.
     pub fn from_params(params: &GlugParams) -> Self {
         Self {
             values: params.control_values(),
@@ -37,9 +42,18 @@ pub enum MidiInput {
     /// A note-on: refill the bottle (MODEL.md §8).
     Refill,
     /// A control change, `value` 0–127, `channel` 0–15.
-    Cc { channel: u8, cc: u8, value: u8 },
+    Cc {
+        /// MIDI channel, 0–15.
+        channel: u8,
+        /// Controller number, 0–127.
+        cc: u8,
+        /// Controller value, 0–127.
+        value: u8,
+    },
 }
 
+/// The engine as the plugin runs it, with MIDI overrides, transport resets and the editor's
+/// feed around it.
 pub struct RealtimeEngine {
     engine: Engine,
     config: ModelConfig,
@@ -67,10 +81,12 @@ impl RealtimeEngine {
         }
     }
 
+    /// Sample rate the engine runs at (Hz).
     pub fn sample_rate(&self) -> f64 {
         self.engine.sample_rate()
     }
 
+    /// The engine inside.
     pub fn engine(&self) -> &Engine {
         &self.engine
     }
@@ -102,6 +118,7 @@ impl RealtimeEngine {
         self.transport.advance(samples);
     }
 
+    /// Acts on one MIDI message: a note-on refills, a mapped CC overrides its control.
     pub fn handle(&mut self, input: MidiInput, map: &MidiMap) {
         match input {
             MidiInput::Refill => self.engine.refill(),

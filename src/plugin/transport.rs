@@ -5,6 +5,7 @@
 /// beats lose a sample to rounding.
 const JUMP_TOLERANCE_SAMPLES: i64 = 2;
 
+/// Watches the host's transport and tells when a MODEL.md §8 reset is due.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct TransportWatch {
     was_playing: bool,
@@ -15,6 +16,7 @@ pub struct TransportWatch {
 }
 
 impl TransportWatch {
+    /// Forgets the transport's state, as after activation.
     pub fn reset(&mut self) {
         *self = Self::default();
     }

@@ -28,9 +28,11 @@ const GAIN_DB: f64 = -6.0;
 /// A case of the accuracy set: constants and inputs as a function of time.
 #[derive(Clone, Copy)]
 pub struct Case {
+    /// Short name, as in the table.
     pub name: &'static str,
     /// What the case exercises.
     pub purpose: &'static str,
+    /// The model's constants.
     pub config: ModelConfig,
     /// The inputs at time t (s).
     pub inputs: fn(f64) -> ControlValues,
@@ -118,6 +120,7 @@ pub enum SynthesisPath {
 }
 
 impl SynthesisPath {
+    /// Every path, in table order.
     pub const ALL: [SynthesisPath; 4] = [
         SynthesisPath::Reference,
         SynthesisPath::Default,
@@ -125,6 +128,7 @@ impl SynthesisPath {
         SynthesisPath::RecursiveF32,
     ];
 
+    /// The path's name in the table.
     pub fn name(self) -> &'static str {
         match self {
             SynthesisPath::Reference => "reference (f64 direct)",
@@ -138,8 +142,11 @@ impl SynthesisPath {
 /// One row of the table.
 #[derive(Debug, Clone)]
 pub struct Measurement {
+    /// The case's name.
     pub case: &'static str,
+    /// The synthesis path measured.
     pub path: SynthesisPath,
+    /// Length of the render (s).
     pub length_s: f64,
     /// Largest |error| over the compared windows relative to the reference's peak there, in dB
     /// (−∞ when identical).

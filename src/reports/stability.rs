@@ -301,7 +301,9 @@ pub fn catalogue() -> String {
 pub struct Check {
     /// The property checked.
     pub what: Property,
+    /// Whether the property held.
     pub passed: bool,
+    /// The measurement behind the verdict.
     pub detail: String,
 }
 
@@ -310,17 +312,21 @@ pub struct Check {
 pub struct Outcome {
     /// The catalogue entry this case belongs to.
     pub group: StabilityCase,
+    /// The case's name within its group.
     pub name: String,
+    /// The properties checked.
     pub checks: Vec<Check>,
     /// Measurements worth reporting that are not checks.
     pub notes: String,
 }
 
 impl Outcome {
+    /// Whether every check passed.
     pub fn passed(&self) -> bool {
         self.checks.iter().all(|c| c.passed)
     }
 
+    /// One line: every check with its verdict and measurement, then the notes.
     pub fn summary(&self) -> String {
         let checks: Vec<String> = self
             .checks

@@ -32,8 +32,11 @@ pub struct TimedRender {
 
 /// Options of [`timed_render`] besides the controls.
 pub struct RenderSpec<'a> {
+    /// Sample rate (Hz).
     pub sample_rate: f64,
+    /// The model's constants.
     pub config: ModelConfig,
+    /// Samples to render.
     pub len: u64,
     /// Windows (ascending, disjoint) whose samples are kept.
     pub keep: &'a [Range<u64>],

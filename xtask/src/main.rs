@@ -1,7 +1,11 @@
 //! `cargo xtask`: nice-plug's bundler, plus the project's two everyday jobs.
 //!
 //! - `cargo xtask pour`: build the plugin bundles and render the built-in scene to `pour.wav`.
-//! - `cargo xtask test`: every test: the Rust suites, then the bundles in a real VST3 host.
+//! - `cargo xtask test`: every test: formatting and lints, the Rust suites, then the bundles in a
+//!   real VST3 host.
+//!
+//! Each product is built with only its features: the bundles with `editor` (which brings
+//! `plugin`), the command line with `cli`, so neither compiles the other's crates.
 
 use std::path::Path;
 use std::process::Command;
@@ -16,14 +20,19 @@ fn main() -> nice_plug_xtask::Result<()> {
         }
         Some("test") => {
             nice_plug_xtask::chdir_workspace_root()?;
-            // The dev profile keeps debug assertions, which assert_process_allocs needs.
+            cargo(&["fmt", "--all", "--check"])?;
             cargo(&[
-                "test",
+                "clippy",
                 "--workspace",
-                "--no-fail-fast",
-                "--features",
-                "assert_process_allocs",
+                "--all-targets",
+                "--all-features",
+                "--",
+                "-D",
+                "warnings",
             ])?;
+            // All features, assert_process_allocs among them: the dev profile keeps the debug
+            // assertions it needs.
+            cargo(&["test", "--workspace", "--no-fail-fast", "--all-features"])?;
             build_release()?;
             host_tests()
         }
@@ -35,9 +44,25 @@ fn main() -> nice_plug_xtask::Result<()> {
 fn build_release() -> nice_plug_xtask::Result<()> {
     nice_plug_xtask::main_with_args(
         "cargo xtask",
-        ["bundle", "sake_glug", "--release"].map(String::from),
+        [
+            "bundle",
+            "sake_glug",
+            "--release",
+            "--no-default-features",
+            "--features",
+            "editor",
+        ]
+        .map(String::from),
     )?;
-    cargo(&["build", "--release", "--bin", "sake-glug"])
+    cargo(&[
+        "build",
+        "--release",
+        "--bin",
+        "sake-glug",
+        "--no-default-features",
+        "--features",
+        "cli",
+    ])
 }
 
 /// The bundles loaded in pedalboard, in a virtual environment made on first use.

@@ -30,6 +30,7 @@ pub struct UnitOnset {
     pub amplitude: f64,
     /// c_i, clamped to [0, 1].
     pub viscosity: f64,
+    /// f1_i, f2_i, B1_i, B2_i as drawn for this unit (§7).
     pub shape: UnitShape,
 }
 
@@ -46,11 +47,14 @@ impl UnitOnset {
 /// Counts kept for reports and tests.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct PourStats {
+    /// Units whose onset came since the last reset, the skipped ones included.
     pub units_started: u64,
     /// Units not voiced because more started within one sample than the engine voices.
     pub units_skipped: u64,
 }
 
+/// The pour: bottle, onset accumulator and random draws, turning the controls, sample by
+/// sample, into unit onsets.
 pub struct Pour {
     config: ModelConfig,
     bottle: Bottle,
@@ -60,6 +64,8 @@ pub struct Pour {
 }
 
 impl Pour {
+    /// A pour at `sample_rate` (Hz) under `config` (brought into range); the bottle fills to the
+    /// fill level at the first step.
     pub fn new(sample_rate: f64, config: ModelConfig) -> Self {
         let config = config.sanitized();
         Self {
@@ -71,6 +77,7 @@ impl Pour {
         }
     }
 
+    /// The constants in use, brought into range.
     pub fn config(&self) -> &ModelConfig {
         &self.config
     }
@@ -93,10 +100,12 @@ impl Pour {
         self.bottle.refill();
     }
 
+    /// Residual volume V after the last step (ml).
     pub fn volume_ml(&self) -> f64 {
         self.bottle.volume_ml()
     }
 
+    /// The counts since the last reset.
     pub fn stats(&self) -> PourStats {
         self.stats
     }

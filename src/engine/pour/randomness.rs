@@ -12,7 +12,9 @@ use crate::engine::config::ModelConfig;
 /// The randomised constants of one wave unit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct UnitShape {
+    /// f1_i, f2_i: the unit's frequencies (Hz).
     pub frequency_hz: [f64; 2],
+    /// B1_i, B2_i: the unit's amplitude decay rates (1/s).
     pub decay_per_s: [f64; 2],
 }
 

@@ -14,6 +14,7 @@ use crate::engine::{ControlSource, ModelConfig, Pour, UnitOnset};
 /// any error budget, and keeps the evaluation finite in time.
 const NEGLIGIBLE_ENVELOPE: f64 = 1e-13;
 
+/// What [`evaluate`] returns: the reference's samples of one window, and the onsets behind them.
 pub struct ReferenceWindow {
     /// The samples of the window, in order.
     pub samples: Vec<f64>,
