@@ -3,6 +3,7 @@
 //! - `cargo xtask pour`: build the plugin bundles and render the built-in scene to `pour.wav`.
 //! - `cargo xtask test`: every test: formatting and lints, the Rust suites, then the bundles in a
 //!   real VST3 host.
+//! - `cargo xtask docs`: regenerates the generated blocks of docs/ from the current code.
 //!
 //! Each product is built with only its features: the bundles with `editor` (which brings
 //! `plugin`), the command line with `cli`, so neither compiles the other's crates.
@@ -36,6 +37,11 @@ fn main() -> nice_plug_xtask::Result<()> {
             build_release()?;
             host_tests()
         }
+        Some("docs") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            build_cli()?;
+            docs()
+        }
         _ => nice_plug_xtask::main(),
     }
 }
@@ -54,6 +60,11 @@ fn build_release() -> nice_plug_xtask::Result<()> {
         ]
         .map(String::from),
     )?;
+    build_cli()
+}
+
+/// The release command line alone, with only its features.
+fn build_cli() -> nice_plug_xtask::Result<()> {
     cargo(&[
         "build",
         "--release",
@@ -63,6 +74,35 @@ fn build_release() -> nice_plug_xtask::Result<()> {
         "--features",
         "cli",
     ])
+}
+
+/// Regenerates what docs/ shows from the code: each generated block is the output of a command
+/// of the release CLI, written between its markers.
+fn docs() -> nice_plug_xtask::Result<()> {
+    let catalogue = output("target/release/sake-glug", &["stability", "--catalogue"])?;
+    replace_block("docs/stability.md", "stability-catalogue", &catalogue)
+}
+
+/// Replaces the text between `<!-- generated:NAME:begin -->` and `<!-- generated:NAME:end -->`.
+fn replace_block(file: &str, name: &str, content: &str) -> nice_plug_xtask::Result<()> {
+    let text = std::fs::read_to_string(file)?;
+    let begin = format!("<!-- generated:{name}:begin -->\n");
+    let end = format!("<!-- generated:{name}:end -->");
+    let (Some(start), Some(stop)) = (text.find(&begin), text.find(&end)) else {
+        anyhow::bail!("{file} has no block {name}");
+    };
+    let updated = format!("{}{content}{}", &text[..start + begin.len()], &text[stop..]);
+    std::fs::write(file, updated)?;
+    println!("{file}: {name} regenerated");
+    Ok(())
+}
+
+fn output(program: &str, args: &[&str]) -> nice_plug_xtask::Result<String> {
+    let out = Command::new(program).args(args).output()?;
+    if !out.status.success() {
+        anyhow::bail!("`{program} {}` failed ({})", args.join(" "), out.status);
+    }
+    Ok(String::from_utf8(out.stdout)?)
 }
 
 /// The bundles loaded in pedalboard, in a virtual environment made on first use.
