@@ -42,7 +42,7 @@ fn render_into(scene: &Scene, out: &mut Vec<f32>) -> usize {
             out.extend_from_slice(block);
             Ok::<(), sake_glug::offline::RenderError>(())
         },
-        |_| {},
+        &mut |_| {},
     )
     .expect("renders");
     out.len()

@@ -141,6 +141,17 @@ impl<S: Synthesis> Engine<S> {
 
     /// Renders `out.len()` samples; `controls` give the inputs from the block's first sample.
     pub fn process(&mut self, controls: &Controls, out: &mut [f32]) {
+        self.process_observed(controls, out, &mut |_| {});
+    }
+
+    /// [`Engine::process`], telling `on_unit` of every unit that starts, in order: what the clip
+    /// writers need to know of the glugs. Watching changes no sample.
+    pub fn process_observed(
+        &mut self,
+        controls: &Controls,
+        out: &mut [f32],
+        on_unit: &mut impl FnMut(&UnitOnset),
+    ) {
         if self.voices.is_empty() && self.rests_under(controls) {
             // Settled under the same controls: the block is silence, so it costs a fill and not
             // a walk over its grid periods. An empty bank only needs the last period start.
@@ -157,15 +168,20 @@ impl<S: Synthesis> Engine<S> {
         while done < out.len() {
             let period_end = (self.sample / GRID as u64 + 1) * GRID as u64;
             let span = (out.len() - done).min((period_end - self.sample) as usize);
-            self.process_span(&controls.offset(done), &mut out[done..done + span]);
+            self.process_span(&controls.offset(done), &mut out[done..done + span], on_unit);
             done += span;
         }
     }
 
     /// Renders a span that lies within one grid period.
-    fn process_span(&mut self, controls: &Controls, out: &mut [f32]) {
+    fn process_span(
+        &mut self,
+        controls: &Controls,
+        out: &mut [f32],
+        on_unit: &mut impl FnMut(&UnitOnset),
+    ) {
         out.fill(0.0);
-        self.step_pour(controls, out.len());
+        self.step_pour(controls, out.len(), on_unit);
         if self.voices.is_empty() {
             self.advance_position(out.len());
             return;
@@ -176,7 +192,7 @@ impl<S: Synthesis> Engine<S> {
         self.advance_position(out.len());
     }
 
-    fn step_pour(&mut self, controls: &Controls, len: usize) {
+    fn step_pour(&mut self, controls: &Controls, len: usize, on_unit: &mut impl FnMut(&UnitOnset)) {
         if self.rests_under(controls) {
             return;
         }
@@ -195,6 +211,7 @@ impl<S: Synthesis> Engine<S> {
             let start_unit = |onset: &UnitOnset| {
                 voices.start_unit(onset);
                 *last_unit = Some(*onset);
+                on_unit(onset);
             };
             let step = match held {
                 // Nothing can have changed since the span's first sample: refills only happen

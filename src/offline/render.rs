@@ -3,7 +3,7 @@
 use std::time::{Duration, Instant};
 
 use super::scene::{LaneBuffers, Scene, MAX_DURATION_S};
-use crate::engine::{DrainMode, Engine};
+use crate::engine::{DrainMode, Engine, UnitOnset};
 
 /// Samples per engine call offline; any size gives the same samples.
 pub const BLOCK_SIZE: usize = 4096;
@@ -46,19 +46,45 @@ impl RenderSummary {
     }
 }
 
-/// Renders `scene`, handing its samples to `sink` in blocks and the samples rendered so far to
-/// `progress`. A scene without a duration ends where pouring stopped and the last unit decayed
-/// (below −120 dB), a sample fixed by the model, not by how time was cut into blocks.
+/// What a render tells besides its samples; every method has a default that ignores it. A
+/// closure `FnMut(u64)` is an observer of progress alone.
+pub trait RenderObserver {
+    /// `rendered` samples are done.
+    fn progress(&mut self, _rendered: u64) {}
+    /// A unit started (its onset is `(onset.sample + onset.fraction) / fs`).
+    fn unit_started(&mut self, _onset: &UnitOnset) {}
+    /// Samples between two [`RenderObserver::bottle`] reports, or `None` for none: the render
+    /// then cuts time at least this finely, which changes no sample.
+    fn bottle_every(&self) -> Option<usize> {
+        None
+    }
+    /// The residual volume (ml) after `position` samples.
+    fn bottle(&mut self, _position: u64, _volume_ml: f64) {}
+}
+
+impl<F: FnMut(u64)> RenderObserver for F {
+    fn progress(&mut self, rendered: u64) {
+        self(rendered)
+    }
+}
+
+/// Renders `scene`, handing its samples to `sink` in blocks and telling `observer` how far it
+/// got, which units started and how the bottle drained. A scene without a duration ends where
+/// pouring stopped and the last unit decayed (below −120 dB), a sample fixed by the model, not
+/// by how time was cut into blocks.
 pub fn render_scene<E: From<RenderError>>(
     scene: &Scene,
     mut sink: impl FnMut(&[f32]) -> Result<(), E>,
-    mut progress: impl FnMut(u64),
+    observer: &mut impl RenderObserver,
 ) -> Result<RenderSummary, E> {
     let started = Instant::now();
     let sample_rate = scene.sample_rate as f64;
     let mut engine = Engine::new(sample_rate, scene.config);
     let mut lanes = LaneBuffers::default();
-    let mut block = vec![0.0f32; BLOCK_SIZE];
+    let block_size = observer
+        .bottle_every()
+        .map_or(BLOCK_SIZE, |every| every.clamp(1, BLOCK_SIZE));
+    let mut block = vec![0.0f32; block_size];
     let total = scene.duration_samples();
     let settle_from = (scene.last_automation_s() * sample_rate).ceil() as u64;
     let give_up_at = (MAX_DURATION_S * sample_rate) as u64;
@@ -68,16 +94,19 @@ pub fn render_scene<E: From<RenderError>>(
     loop {
         let position = engine.position();
         let len = match total {
-            Some(total) => BLOCK_SIZE.min((total - position) as usize),
-            None => BLOCK_SIZE,
+            Some(total) => block_size.min((total - position) as usize),
+            None => block_size,
         };
         if len == 0 {
             break;
         }
         let controls = scene.controls(position, &mut lanes, len);
         let block = &mut block[..len];
-        engine.process(&controls, block);
-        progress(engine.position());
+        engine.process_observed(&controls, block, &mut |onset| observer.unit_started(onset));
+        observer.progress(engine.position());
+        if observer.bottle_every().is_some() {
+            observer.bottle(engine.position(), engine.volume_ml());
+        }
 
         match block.iter().rposition(|y| *y != 0.0) {
             None => held_zeros += len as u64,
@@ -139,7 +168,7 @@ pub fn render_scene_to_vec(scene: &Scene) -> Result<(Vec<f32>, RenderSummary), R
             samples.extend_from_slice(block);
             Ok::<(), RenderError>(())
         },
-        |_| {},
+        &mut |_| {},
     )?;
     Ok((samples, summary))
 }

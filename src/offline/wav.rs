@@ -51,6 +51,27 @@ pub enum WavError {
         /// What the file system said.
         source: std::io::Error,
     },
+    /// The render is longer than a WAV file can hold: its sizes are 32-bit byte counts.
+    #[error(
+        "{}: {samples} samples of {format:?} would pass the 4 GiB a WAV file can hold (at most \
+         {max_samples} samples, {max_hours:.2} h at {sample_rate} Hz); give the scene a shorter \
+         duration_s, write s16 or s24, or write a .csv instead",
+        path.display()
+    )]
+    TooLong {
+        /// The file asked for.
+        path: PathBuf,
+        /// Samples the render has or would have.
+        samples: u64,
+        /// The most samples a file of this format can hold.
+        max_samples: u64,
+        /// That many samples in hours.
+        max_hours: f64,
+        /// Sample rate (Hz).
+        sample_rate: u32,
+        /// Sample format.
+        format: SampleFormat,
+    },
     /// The WAV encoder refused.
     #[error("cannot write {}: {source}", path.display())]
     Encode {
@@ -67,9 +88,49 @@ pub struct WavFile {
     temp: NamedTempFile,
     writer: WavWriter<BufWriter<std::fs::File>>,
     format: SampleFormat,
+    sample_rate: u32,
+    /// Samples written so far, held against [`WavFile::max_samples`].
+    written: u64,
 }
 
+/// Bytes kept free of the 32-bit RIFF size for the headers: hound's largest header (the
+/// extensible format chunk) is well under this.
+const HEADER_ALLOWANCE_BYTES: u64 = 1024;
+
 impl WavFile {
+    /// The most samples a mono file of `format` can hold: the RIFF and data sizes are u32 byte
+    /// counts, so past about 4 GiB they would wrap and the file would be corrupt.
+    pub fn max_samples(format: SampleFormat) -> u64 {
+        let bytes_per_sample = match format {
+            SampleFormat::F32 => 4,
+            SampleFormat::S24 => 3,
+            SampleFormat::S16 => 2,
+        };
+        (u32::MAX as u64 - HEADER_ALLOWANCE_BYTES) / bytes_per_sample
+    }
+
+    /// Refuses a render of `samples` samples that a WAV file cannot hold, before anything is
+    /// written.
+    pub fn check_length(
+        path: &Path,
+        samples: u64,
+        sample_rate: u32,
+        format: SampleFormat,
+    ) -> Result<(), WavError> {
+        let max_samples = Self::max_samples(format);
+        if samples <= max_samples {
+            return Ok(());
+        }
+        Err(WavError::TooLong {
+            path: path.to_owned(),
+            samples,
+            max_samples,
+            max_hours: max_samples as f64 / sample_rate.max(1) as f64 / 3600.0,
+            sample_rate,
+            format,
+        })
+    }
+
     /// Starts a mono file of `format` at `sample_rate` (Hz), to appear at `path` when committed.
     pub fn create(path: &Path, sample_rate: u32, format: SampleFormat) -> Result<Self, WavError> {
         let io_error = |source| WavError::Io {
@@ -105,11 +166,17 @@ impl WavFile {
             temp,
             writer,
             format,
+            sample_rate,
+            written: 0,
         })
     }
 
-    /// Appends samples.
+    /// Appends samples; refuses (and so writes no file) once the file would pass the size a
+    /// WAV can hold, as a render whose length was not known up front may.
     pub fn write(&mut self, samples: &[f32]) -> Result<(), WavError> {
+        let written = self.written + samples.len() as u64;
+        Self::check_length(&self.path, written, self.sample_rate, self.format)?;
+        self.written = written;
         let result = match self.format {
             SampleFormat::F32 => samples
                 .iter()
@@ -124,8 +191,8 @@ impl WavFile {
         result.map_err(|source| self.encode_error(source))
     }
 
-    /// Completes the file and moves it into place.
-    pub fn commit(self) -> Result<(), WavError> {
+    /// Completes the file and moves it into place; returns its path.
+    pub fn commit(self) -> Result<PathBuf, WavError> {
         let Self {
             path, temp, writer, ..
         } = self;
@@ -134,10 +201,10 @@ impl WavFile {
             source,
         })?;
         temp.persist(&path).map_err(|error| WavError::Io {
-            path,
+            path: path.clone(),
             source: error.error,
         })?;
-        Ok(())
+        Ok(path)
     }
 
     fn encode_error(&self, source: hound::Error) -> WavError {
@@ -150,7 +217,7 @@ impl WavFile {
 
 /// Temporary files are private by default; the finished WAV should get the permissions any new
 /// file gets (0o666 less the umask), as if it had been written in place.
-fn temp_file_builder() -> tempfile::Builder<'static, 'static> {
+pub(crate) fn temp_file_builder() -> tempfile::Builder<'static, 'static> {
     let mut builder = tempfile::Builder::new();
     #[cfg(unix)]
     {
@@ -170,7 +237,22 @@ fn quantize(sample: f32, fraction_bits: u32) -> i32 {
 
 #[cfg(test)]
 mod tests {
-    use super::quantize;
+    use super::*;
+
+    #[test]
+    fn the_length_limit_sits_just_under_4_gib_of_data() {
+        let limit = |format| WavFile::max_samples(format) as f64;
+        // 4 GiB of f32 at 48 kHz is 6.2 h; at 768 kHz, 23 min.
+        assert!((limit(SampleFormat::F32) / 48_000.0 / 3600.0 - 6.21).abs() < 0.01);
+        assert!((limit(SampleFormat::F32) / 768_000.0 / 60.0 - 23.3).abs() < 0.1);
+        assert!(limit(SampleFormat::S16) > 2.0 * limit(SampleFormat::F32) - 1.0);
+        let path = Path::new("long.wav");
+        let max = WavFile::max_samples(SampleFormat::S24);
+        assert!(WavFile::check_length(path, max, 48_000, SampleFormat::S24).is_ok());
+        let error = WavFile::check_length(path, max + 1, 48_000, SampleFormat::S24).unwrap_err();
+        assert!(matches!(error, WavError::TooLong { .. }));
+        assert!(error.to_string().contains("4 GiB"), "{error}");
+    }
 
     #[test]
     fn quantize_rounds_and_saturates() {

@@ -5,5 +5,7 @@
 mod support;
 
 mod cli;
+mod clip_rules;
+mod clips_rendered;
 mod determinism;
 mod scene_files;

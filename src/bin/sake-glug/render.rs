@@ -1,93 +1,292 @@
-//! `sake-glug render`: a scene (or the built-in pour) to a WAV file, all or nothing.
+//! `sake-glug render`: scenes (or the built-in pour) to WAV, `.haptic`, `.ahap`, CSV and a plot,
+//! every file of a scene from one render pass, all or nothing.
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use sake_glug::offline::clips::HapticBand;
 use sake_glug::offline::{
-    render_scene, RenderError, SampleFormat, Scene, SceneError, WavError, WavFile,
+    render_to_files, OutputError, OutputFormat, OutputOptions, RenderReport, SampleFormat, Scene,
+    SceneError,
 };
 
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Scene file (TOML, see MODEL.md §10); without it, the built-in default pour.
-    scene: Option<PathBuf>,
-    /// Where to write the WAV file.
-    #[arg(short, long, default_value = "pour.wav")]
-    output: PathBuf,
-    /// Overrides the scene's sample rate (Hz).
+    /// Scene files (TOML, see MODEL.md §10); without any, the built-in default pour.
+    scenes: Vec<PathBuf>,
+    /// A file to write; its extension picks the format: .wav, .haptic, .ahap, .csv or .png (the
+    /// pour plot). Repeat for several files from the same render. Default: pour.wav.
+    #[arg(short, long = "output", value_name = "FILE")]
+    outputs: Vec<PathBuf>,
+    /// Writes DIR/<scene name>.<extension> for every scene and every one of --formats.
+    #[arg(long, value_name = "DIR", conflicts_with = "outputs")]
+    out_dir: Option<PathBuf>,
+    /// With --out-dir: the formats to write, by extension (wav, haptic, ahap, csv, png).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "wav",
+        requires = "out_dir"
+    )]
+    formats: Vec<String>,
+    /// Also draws the pour plot (waveform, clip envelope and onsets, V(t), tilt(t)) to this PNG.
+    #[arg(long, value_name = "FILE.png")]
+    plot: Option<PathBuf>,
+    /// The actuator band (Hz) that .haptic frequencies 0..1 map to, as LOW..HIGH.
+    #[arg(long, value_name = "LOW..HIGH", default_value_t = HapticBand::default())]
+    haptic_band: HapticBand,
+    /// Overrides the scenes' sample rate (Hz).
     #[arg(long)]
     sample_rate: Option<f64>,
-    /// Sample format of the WAV file: f32, s24 or s16.
+    /// Sample format of WAV files: f32, s24 or s16.
     #[arg(long, default_value = "f32")]
     format: SampleFormat,
 }
 
+/// One scene to render and the files it becomes.
+struct Job {
+    /// The scene file, or `None` for the built-in pour.
+    scene: Option<PathBuf>,
+    name: String,
+    outputs: Vec<PathBuf>,
+}
+
 #[derive(Debug, thiserror::Error)]
-enum RenderCommandError {
+enum JobError {
     #[error(transparent)]
     Scene(#[from] SceneError),
     #[error(transparent)]
-    Render(#[from] RenderError),
-    #[error(transparent)]
-    Wav(#[from] WavError),
+    Output(#[from] OutputError),
 }
 
-/// Runs the command; prints a one-line summary, or the error and exits 1.
+/// Runs the command: every scene is rendered, a bad one is reported and skipped; the exit
+/// status is 1 if any failed, 2 if the command line itself is wrong (nothing is rendered then).
 pub fn run(args: RenderArgs) -> ExitCode {
-    match render(args) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(error) => {
-            eprintln!("error: {error}");
-            ExitCode::FAILURE
+    let jobs = match plan(&args) {
+        Ok(jobs) => jobs,
+        Err(message) => {
+            eprintln!("error: {message}");
+            return ExitCode::from(2);
         }
+    };
+    if let Some(directory) = &args.out_dir {
+        if let Err(error) = std::fs::create_dir_all(directory) {
+            eprintln!("error: cannot create {}: {error}", directory.display());
+            return ExitCode::FAILURE;
+        }
+    }
+    let options = OutputOptions {
+        wav_format: args.format,
+        haptic_band: args.haptic_band,
+    };
+    let progress = BatchProgress::new(jobs.len());
+    let mut failed = 0;
+    for (index, job) in jobs.iter().enumerate() {
+        match render_job(job, &args, &options, |fraction| {
+            progress.set(index, fraction)
+        }) {
+            Ok(report) => progress.println(&summary(job, &report)),
+            Err(error) => {
+                failed += 1;
+                progress.println(&format!("error: {}: {error}", job.name));
+            }
+        }
+    }
+    progress.finish();
+    if failed > 0 {
+        if jobs.len() > 1 {
+            eprintln!("{failed} of {} scenes failed", jobs.len());
+        }
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
     }
 }
 
-fn render(args: RenderArgs) -> Result<(), RenderCommandError> {
-    let mut scene = match &args.scene {
+/// The jobs the arguments ask for; every output's format is checked here, before anything is
+/// rendered.
+fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
+    let scenes: Vec<Option<PathBuf>> = if args.scenes.is_empty() {
+        vec![None]
+    } else {
+        args.scenes.iter().cloned().map(Some).collect()
+    };
+    let name_of = |scene: &Option<PathBuf>| {
+        scene
+            .as_deref()
+            .and_then(Path::file_stem)
+            .map_or("default".to_string(), |stem| {
+                stem.to_string_lossy().into_owned()
+            })
+    };
+    let mut jobs = Vec::new();
+    if let Some(directory) = &args.out_dir {
+        let formats = args
+            .formats
+            .iter()
+            .map(|name| {
+                OutputFormat::of_extension(name.trim_start_matches('.')).ok_or_else(|| {
+                    format!(
+                        "unknown format `{name}` in --formats: use wav, haptic, ahap, csv or png"
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        if args.plot.is_some() {
+            return Err("with --out-dir, ask for the plot with --formats …,png".into());
+        }
+        for scene in scenes {
+            let name = name_of(&scene);
+            let outputs = formats
+                .iter()
+                .map(|format| directory.join(format!("{name}.{}", format.extension())))
+                .collect();
+            jobs.push(Job {
+                scene,
+                name,
+                outputs,
+            });
+        }
+        let mut names: Vec<&str> = jobs.iter().map(|job| job.name.as_str()).collect();
+        names.sort_unstable();
+        if let Some(pair) = names.windows(2).find(|pair| pair[0] == pair[1]) {
+            return Err(format!(
+                "two scenes are named `{}`: their files would overwrite each other in {}",
+                pair[0],
+                directory.display()
+            ));
+        }
+    } else {
+        if scenes.len() > 1 {
+            return Err("several scenes need --out-dir DIR (each writes DIR/<name>.<ext>)".into());
+        }
+        let mut outputs = args.outputs.clone();
+        if outputs.is_empty() {
+            outputs.push(PathBuf::from("pour.wav"));
+        }
+        outputs.extend(args.plot.iter().cloned());
+        let scene = scenes.into_iter().next().flatten();
+        jobs.push(Job {
+            name: name_of(&scene),
+            scene,
+            outputs,
+        });
+    }
+    for job in &jobs {
+        for output in &job.outputs {
+            OutputFormat::of_path(output).map_err(|error| error.to_string())?;
+        }
+        if let Some(plot) = &args.plot {
+            if !matches!(OutputFormat::of_path(plot), Ok(OutputFormat::Plot)) {
+                return Err(format!(
+                    "--plot {}: the plot is a .png file",
+                    plot.display()
+                ));
+            }
+        }
+    }
+    Ok(jobs)
+}
+
+fn render_job(
+    job: &Job,
+    args: &RenderArgs,
+    options: &OutputOptions,
+    mut progress: impl FnMut(f64),
+) -> Result<RenderReport, JobError> {
+    let mut scene = match &job.scene {
         Some(path) => Scene::load(path)?,
         None => Scene::default(),
     };
     if let Some(sample_rate) = args.sample_rate {
         scene = scene.with_sample_rate(sample_rate)?;
     }
-    let progress = progress_bar(scene.duration_samples());
-    let mut wav = WavFile::create(&args.output, scene.sample_rate, args.format)?;
-    let summary = render_scene(
-        &scene,
-        |block| wav.write(block).map_err(RenderCommandError::from),
-        |done| progress.set_position(done),
-    )?;
-    progress.finish_and_clear();
-    wav.commit()?;
-    println!(
-        "{}: {:.2} s at {} Hz, {} glug units, peak {:.1} dBFS, {:.0}× faster than real time",
-        args.output.display(),
+    let total = scene.duration_samples();
+    let report = render_to_files(&scene, &job.name, &job.outputs, options, |done| {
+        // A scene without a duration ends where it falls silent: its share is unknown.
+        if let Some(total) = total {
+            progress(done as f64 / total.max(1) as f64);
+        }
+    })?;
+    Ok(report)
+}
+
+/// The line printed for a finished scene.
+fn summary(job: &Job, report: &RenderReport) -> String {
+    let summary = &report.summary;
+    let files: Vec<String> = report
+        .files
+        .iter()
+        .map(|(path, bytes)| format!("{} ({})", path.display(), human_bytes(*bytes)))
+        .collect();
+    format!(
+        "{}: {:.2} s at {} Hz, {} glug units, peak {:.1} dBFS, {:.0}× faster than real time → {}",
+        job.name,
         summary.duration_s(),
         summary.sample_rate,
         summary.units,
         20.0 * (summary.peak.max(1e-12) as f64).log10(),
         summary.realtime_factor(),
-    );
-    Ok(())
+        files.join(", ")
+    )
 }
 
-/// A progress bar on a terminal; nothing at all when stderr is redirected.
-fn progress_bar(total_samples: Option<u64>) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
+fn human_bytes(bytes: u64) -> String {
+    match bytes {
+        0..1_000 => format!("{bytes} B"),
+        1_000..1_000_000 => format!("{:.1} kB", bytes as f64 / 1e3),
+        _ => format!("{:.1} MB", bytes as f64 / 1e6),
     }
-    let bar = match total_samples {
-        Some(total) => ProgressBar::new(total),
-        None => ProgressBar::new_spinner(),
-    };
-    bar.set_draw_target(ProgressDrawTarget::stderr());
-    if let Ok(style) = ProgressStyle::with_template("{bar:40} {percent:>3}% {msg}") {
-        bar.set_style(style);
+}
+
+/// One progress bar over the whole batch on a terminal; nothing when stderr is redirected.
+struct BatchProgress {
+    bar: ProgressBar,
+}
+
+/// Steps of the bar per scene.
+const STEPS_PER_SCENE: u64 = 1000;
+
+impl BatchProgress {
+    fn new(scenes: usize) -> Self {
+        if !std::io::stderr().is_terminal() {
+            return Self {
+                bar: ProgressBar::hidden(),
+            };
+        }
+        let bar = ProgressBar::new(scenes as u64 * STEPS_PER_SCENE);
+        bar.set_draw_target(ProgressDrawTarget::stderr());
+        if let Ok(style) = ProgressStyle::with_template("{bar:40} {percent:>3}% {msg}") {
+            bar.set_style(style);
+        }
+        Self { bar }
     }
-    bar
+
+    /// Scene `index` is `fraction` done.
+    fn set(&self, index: usize, fraction: f64) {
+        let within = (fraction.clamp(0.0, 1.0) * STEPS_PER_SCENE as f64) as u64;
+        self.bar
+            .set_position(index as u64 * STEPS_PER_SCENE + within);
+    }
+
+    /// Prints a line above the bar (or alone, without one).
+    fn println(&self, line: &str) {
+        if self.bar.is_hidden() {
+            if line.starts_with("error:") {
+                eprintln!("{line}");
+            } else {
+                println!("{line}");
+            }
+        } else {
+            self.bar.println(line);
+        }
+    }
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
 }
