@@ -80,7 +80,18 @@ fn build_cli() -> nice_plug_xtask::Result<()> {
 /// of the release CLI, written between its markers.
 fn docs() -> nice_plug_xtask::Result<()> {
     let catalogue = output("target/release/sake-glug", &["stability", "--catalogue"])?;
-    replace_block("docs/stability.md", "stability-catalogue", &catalogue)
+    replace_block("docs/stability.md", "stability-catalogue", &catalogue)?;
+    // The README's example of the pour plot: the default scene.
+    run(
+        "target/release/sake-glug",
+        &[
+            "render",
+            "-o",
+            "target/pour-plot.haptic",
+            "--plot",
+            "docs/pour-plot.png",
+        ],
+    )
 }
 
 /// Replaces the text between `<!-- generated:NAME:begin -->` and `<!-- generated:NAME:end -->`.
