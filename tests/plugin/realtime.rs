@@ -98,19 +98,23 @@ fn an_allocation_inside_the_guard_is_caught() {
         });
         return;
     }
+    // The test's name as the harness knows it: its module path without the crate's name.
+    let module = module_path!()
+        .split_once("::")
+        .map_or("", |(_, module)| module);
+    let name = format!("{module}::an_allocation_inside_the_guard_is_caught");
     let status = std::process::Command::new(std::env::current_exe().expect("test binary path"))
-        .args([
-            "--exact",
-            "an_allocation_inside_the_guard_is_caught",
-            "--nocapture",
-        ])
+        .args(["--exact", &name, "--nocapture"])
         .env("SAKE_GLUG_ALLOC_CANARY", "1")
-        .stdout(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::null())
-        .status()
+        .output()
         .expect("run the canary");
+    // The child must have run the canary (one test), not matched nothing and passed.
+    let listing = String::from_utf8_lossy(&status.stdout);
+    assert!(listing.contains("running 1 test"), "{listing}");
     assert!(
-        !status.success(),
+        !status.status.success(),
         "an allocation inside assert_no_alloc went unnoticed"
     );
 }
