@@ -70,6 +70,35 @@ impl MidiMap {
     }
 }
 
+/// A MIDI message the synth acts on, whether it comes from a host, the device, or a recorded
+/// take: everything else is dropped before it gets here.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MidiInput {
+    /// A note-on with a velocity above 0: refill the bottle (MODEL.md §8).
+    NoteOn {
+        /// 0–15.
+        channel: u8,
+    },
+    /// A control change.
+    Cc {
+        /// 0–15.
+        channel: u8,
+        /// The controller number, 0–127.
+        cc: u8,
+        /// 0–127.
+        value: u8,
+    },
+}
+
+/// What a MIDI message asks of the engine.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DeviceAction {
+    /// Refill the bottle to its fill level.
+    Refill,
+    /// Set a control to a value in its own unit, overriding its parameter or scene lane.
+    Set(Target, f64),
+}
+
 /// The controls a CC can drive, in the order of [`Overrides`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Target {
@@ -109,6 +138,19 @@ impl CcDecoder {
     /// Forgets the last tilt MSB and LSB.
     pub fn reset(&mut self) {
         *self = Self::default();
+    }
+
+    /// The one decoding of MIDI the plugin and the offline renderer share: a note-on on a channel
+    /// the map listens to refills, a mapped CC sets its control.
+    pub fn decode(&mut self, map: &MidiMap, input: MidiInput) -> Option<DeviceAction> {
+        match input {
+            MidiInput::NoteOn { channel } => {
+                map.listens_on(channel).then_some(DeviceAction::Refill)
+            }
+            MidiInput::Cc { channel, cc, value } => self
+                .feed(map, channel, cc, value)
+                .map(|(target, value)| DeviceAction::Set(target, value)),
+        }
     }
 
     /// One CC message (`value` 0–127); returns the control it sets, if it is mapped.

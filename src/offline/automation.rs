@@ -3,7 +3,9 @@
 
 use std::fmt;
 
-use serde::de::{self, Deserialize, Deserializer, SeqAccess, Visitor};
+use std::path::PathBuf;
+
+use serde::de::{self, Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
 
 use crate::engine::Lane;
 
@@ -87,34 +89,62 @@ fn segment_at(points: &[(f64, f64)], time_s: f64) -> usize {
     points.partition_point(|point| point.0 <= time_s)
 }
 
-impl<'de> Deserialize<'de> for Automation {
+/// An automatable value as a scene file writes it: inline, or read from a CSV take that is
+/// resolved against the scene's folder once the whole scene is read.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LaneSpec {
+    /// A constant or `[time_s, value]` points.
+    Inline(Automation),
+    /// `{ csv = "take.csv", column = "…" }` or `{ csv = …, accel = ["ax", "ay", "az"], axis = "+z" }`.
+    Csv(CsvLaneRef),
+}
+
+/// A lane read from a CSV file with a header row and a `time_s` column.
+#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CsvLaneRef {
+    /// The file, relative to the scene file.
+    pub csv: PathBuf,
+    /// The column that holds the value.
+    pub column: Option<String>,
+    /// Or, for tilt, the columns of an accelerometer's or gravity sensor's x, y and z.
+    pub accel: Option<[String; 3]>,
+    /// The sensor axis from the bottle's base to its mouth (`+z` if not given).
+    pub axis: Option<String>,
+}
+
+impl<'de> Deserialize<'de> for LaneSpec {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        deserializer.deserialize_any(AutomationVisitor)
+        deserializer.deserialize_any(LaneVisitor)
     }
 }
 
-struct AutomationVisitor;
+struct LaneVisitor;
 
-impl<'de> Visitor<'de> for AutomationVisitor {
-    type Value = Automation;
+impl<'de> Visitor<'de> for LaneVisitor {
+    type Value = LaneSpec;
 
     fn expecting(&self, formatter: &mut fmt::Formatter) -> fmt::Result {
-        formatter.write_str("a number or a list of [time_s, value] points")
+        formatter.write_str("a number, a list of [time_s, value] points or a { csv = … } table")
     }
 
-    fn visit_f64<E: de::Error>(self, value: f64) -> Result<Automation, E> {
-        Ok(Automation::Constant(value))
+    fn visit_f64<E: de::Error>(self, value: f64) -> Result<LaneSpec, E> {
+        Ok(LaneSpec::Inline(Automation::Constant(value)))
     }
 
-    fn visit_i64<E: de::Error>(self, value: i64) -> Result<Automation, E> {
-        Ok(Automation::Constant(value as f64))
+    fn visit_i64<E: de::Error>(self, value: i64) -> Result<LaneSpec, E> {
+        Ok(LaneSpec::Inline(Automation::Constant(value as f64)))
     }
 
-    fn visit_u64<E: de::Error>(self, value: u64) -> Result<Automation, E> {
-        Ok(Automation::Constant(value as f64))
+    fn visit_u64<E: de::Error>(self, value: u64) -> Result<LaneSpec, E> {
+        Ok(LaneSpec::Inline(Automation::Constant(value as f64)))
     }
 
-    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Automation, A::Error> {
+    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<LaneSpec, A::Error> {
+        CsvLaneRef::deserialize(de::value::MapAccessDeserializer::new(map)).map(LaneSpec::Csv)
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<LaneSpec, A::Error> {
         let mut points = Vec::new();
         while let Some(Point(time_s, value)) = seq.next_element()? {
             points.push((time_s, value));
@@ -125,7 +155,7 @@ impl<'de> Visitor<'de> for AutomationVisitor {
                 &"at least one [time_s, value] point",
             ));
         }
-        Ok(Automation::Points(points))
+        Ok(LaneSpec::Inline(Automation::Points(points)))
     }
 }
 

@@ -3,7 +3,9 @@
 use std::time::{Duration, Instant};
 
 use super::scene::{LaneBuffers, Scene, MAX_DURATION_S};
-use crate::engine::{DrainMode, Engine, UnitOnset};
+use crate::device::midi::{CcDecoder, DeviceAction, Target};
+use crate::device::midi_take::TimedInput;
+use crate::engine::{Controls, DrainMode, Engine, Lane, UnitOnset};
 
 /// Samples per engine call offline; any size gives the same samples.
 pub const BLOCK_SIZE: usize = 4096;
@@ -88,6 +90,7 @@ pub fn render_scene<E: From<RenderError>>(
     let total = scene.duration_samples();
     let settle_from = (scene.last_automation_s() * sample_rate).ceil() as u64;
     let give_up_at = (MAX_DURATION_S * sample_rate) as u64;
+    let mut take = TakePlayer::new(scene);
     // Trailing zeros are held back until something follows them or the end is known.
     let (mut written, mut held_zeros, mut peak) = (0u64, 0u64, 0.0f32);
 
@@ -100,7 +103,10 @@ pub fn render_scene<E: From<RenderError>>(
         if len == 0 {
             break;
         }
-        let controls = scene.controls(position, &mut lanes, len);
+        take.act_at(position, &mut engine);
+        let len = take.until_next(position).map_or(len, |next| len.min(next));
+        let mut controls = scene.controls(position, &mut lanes, len);
+        take.override_lanes(&mut controls);
         let block = &mut block[..len];
         engine.process_observed(&controls, block, &mut |onset| observer.unit_started(onset));
         observer.progress(engine.position());
@@ -136,6 +142,62 @@ pub fn render_scene<E: From<RenderError>>(
         peak,
         elapsed: started.elapsed(),
     })
+}
+
+/// A scene's MIDI take played into the engine: every message acts at its sample, before that
+/// sample renders, through the decoder the plugin uses, so a take renders offline as the plugin
+/// renders the same messages at the same offsets.
+struct TakePlayer<'a> {
+    events: &'a [TimedInput],
+    next: usize,
+    decoder: CcDecoder,
+    map: crate::device::midi::MidiMap,
+    /// Tilt, viscosity and fill as the take last set them: from then on they replace the
+    /// scene's lanes, as a CC overrides its parameter in the plugin.
+    held: [Option<f64>; 3],
+}
+
+impl<'a> TakePlayer<'a> {
+    fn new(scene: &'a Scene) -> Self {
+        Self {
+            events: scene.take.as_ref().map_or(&[], |take| &take.events),
+            next: 0,
+            decoder: CcDecoder::default(),
+            map: scene.midi,
+            held: [None; 3],
+        }
+    }
+
+    /// Acts on every message due at or before `position`.
+    fn act_at(&mut self, position: u64, engine: &mut Engine) {
+        while let Some(event) = self.events.get(self.next).filter(|e| e.sample <= position) {
+            match self.decoder.decode(&self.map, event.input) {
+                Some(DeviceAction::Refill) => engine.refill(),
+                Some(DeviceAction::Set(target, value)) => self.held[target as usize] = Some(value),
+                None => {}
+            }
+            self.next += 1;
+        }
+    }
+
+    /// Samples from `position` to the next message, if one is due later.
+    fn until_next(&self, position: u64) -> Option<usize> {
+        let next = self.events.get(self.next)?;
+        Some((next.sample - position) as usize)
+    }
+
+    fn override_lanes(&self, controls: &mut Controls) {
+        let lanes = [
+            (Target::Tilt, &mut controls.tilt_deg),
+            (Target::Viscosity, &mut controls.viscosity),
+            (Target::Fill, &mut controls.fill_percent),
+        ];
+        for (target, lane) in lanes {
+            if let Some(value) = self.held[target as usize] {
+                *lane = Lane::Constant(value);
+            }
+        }
+    }
 }
 
 /// Whether, with the controls held still for good, the scene can be seen never to fall silent:

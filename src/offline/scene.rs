@@ -5,7 +5,11 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use super::automation::Automation;
+use super::automation::{Automation, CsvLaneRef, LaneSpec};
+use crate::device::axis::Axis;
+use crate::device::csv_lane::{read_csv_lane, CsvLaneError, CsvLaneSpec};
+use crate::device::midi::MidiMap;
+use crate::device::midi_take::{read_midi_take, TakeError, TimedInput};
 use crate::engine::config::{self, ControlValues, Range};
 use crate::engine::{ControlSource, Controls, DrainMode, ModelConfig};
 
@@ -44,6 +48,30 @@ pub enum SceneError {
         /// Highest allowed value.
         max: f64,
     },
+    /// A CSV lane could not be read: the error names the file, line and column.
+    #[error("`{key}`: {source}")]
+    Csv {
+        /// The scene key.
+        key: &'static str,
+        /// What was wrong, and where.
+        source: CsvLaneError,
+    },
+    /// A CSV lane's table is not one of the two forms.
+    #[error("`{key}`: {message}")]
+    CsvForm {
+        /// The scene key.
+        key: &'static str,
+        /// What was wrong.
+        message: String,
+    },
+    /// The MIDI take could not be read.
+    #[error("midi take {}: {source}", path.display())]
+    Take {
+        /// The take's path.
+        path: PathBuf,
+        /// What was wrong.
+        source: TakeError,
+    },
     /// An automation point whose time is not finite, is negative or comes before the previous
     /// point's.
     #[error("`{key}`: point {index} is at {time_s} s; point times must be finite, at least 0 and in order")]
@@ -76,6 +104,43 @@ pub struct Scene {
     pub gain_db: Automation,
     /// Seed, spreads (zero if `deterministic`), drain mode and the other constants.
     pub config: ModelConfig,
+    /// A recorded MIDI take from the tilt device, if the scene names one.
+    pub take: Option<MidiTake>,
+    /// How the take's messages map to controls (the plugin's MIDI settings).
+    pub midi: MidiMap,
+}
+
+/// A recorded Standard MIDI File take: its bytes, and its messages at the scene's sample rate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MidiTake {
+    /// Where it was read from.
+    pub path: PathBuf,
+    bytes: Vec<u8>,
+    /// Every note-on and CC, at the first sample at or after its time.
+    pub events: Vec<TimedInput>,
+}
+
+impl MidiTake {
+    /// Reads the take at `path` for a render at `sample_rate` (Hz).
+    pub fn load(path: &Path, sample_rate: u32) -> Result<Self, SceneError> {
+        let bytes = std::fs::read(path).map_err(|source| SceneError::Read {
+            path: path.to_owned(),
+            source,
+        })?;
+        Self::from_bytes(path, bytes, sample_rate)
+    }
+
+    fn from_bytes(path: &Path, bytes: Vec<u8>, sample_rate: u32) -> Result<Self, SceneError> {
+        let events = read_midi_take(&bytes, sample_rate).map_err(|source| SceneError::Take {
+            path: path.to_owned(),
+            source,
+        })?;
+        Ok(Self {
+            path: path.to_owned(),
+            bytes,
+            events,
+        })
+    }
 }
 
 impl Default for Scene {
@@ -85,29 +150,48 @@ impl Default for Scene {
 }
 
 impl Scene {
-    /// Reads and validates the scene file at `path`.
+    /// Reads and validates the scene file at `path`; the files it names (CSV lanes, a MIDI
+    /// take) are found relative to its folder.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
             path: path.to_owned(),
             source,
         })?;
-        Self::parse(&text)
+        let folder = path.parent().unwrap_or(Path::new(""));
+        Self::parse_in(&text, folder)
     }
 
-    /// Parses and validates a scene from TOML `text`.
+    /// Parses and validates a scene from TOML `text`; files it names are relative to the
+    /// current folder.
     pub fn parse(text: &str) -> Result<Self, SceneError> {
+        Self::parse_in(text, Path::new(""))
+    }
+
+    /// Parses and validates a scene from TOML `text` whose files are relative to `folder`.
+    pub fn parse_in(text: &str, folder: &Path) -> Result<Self, SceneError> {
         let file: SceneFile =
             toml::from_str(text).map_err(|error| SceneError::Syntax(error.to_string()))?;
-        file.validate()
+        file.validate(folder)
     }
 
-    /// The same scene at another sample rate.
+    /// The same scene at another sample rate (a take's messages move to their new samples).
     pub fn with_sample_rate(self, sample_rate: f64) -> Result<Self, SceneError> {
-        let sample_rate = check("sample_rate", sample_rate, config::SAMPLE_RATE_HZ)?;
+        let sample_rate = check("sample_rate", sample_rate, config::SAMPLE_RATE_HZ)? as u32;
+        let take = match self.take {
+            Some(take) => Some(MidiTake::from_bytes(&take.path, take.bytes, sample_rate)?),
+            None => None,
+        };
         Ok(Self {
-            sample_rate: sample_rate as u32,
+            sample_rate,
+            take,
             ..self
         })
+    }
+
+    /// The same scene driven by the MIDI take at `path` (which replaces the scene's own).
+    pub fn with_midi_take(self, path: &Path) -> Result<Self, SceneError> {
+        let take = Some(MidiTake::load(path, self.sample_rate)?);
+        Ok(Self { take, ..self })
     }
 
     /// Samples to render, if the scene fixes its duration.
@@ -116,12 +200,17 @@ impl Scene {
             .map(|seconds| (seconds * self.sample_rate as f64).round() as u64)
     }
 
-    /// Time of the last automation point: the controls hold still after it.
+    /// Time of the last automation point or take message: the controls hold still after it.
     pub fn last_automation_s(&self) -> f64 {
+        let last_message_s = self
+            .take
+            .as_ref()
+            .and_then(|take| take.events.last())
+            .map_or(0.0, |event| event.sample as f64 / self.sample_rate as f64);
         self.lanes()
             .iter()
             .map(|lane| lane.last_time_s())
-            .fold(0.0, f64::max)
+            .fold(last_message_s, f64::max)
     }
 
     /// The inputs at one sample.
@@ -193,10 +282,13 @@ struct SceneFile {
     duration_s: Option<f64>,
     seed: Option<u64>,
     deterministic: Option<bool>,
-    tilt_deg: Option<Automation>,
-    viscosity_c: Option<Automation>,
-    fill_percent: Option<Automation>,
-    pour_time_s: Option<Automation>,
+    tilt_deg: Option<LaneSpec>,
+    viscosity_c: Option<LaneSpec>,
+    fill_percent: Option<LaneSpec>,
+    pour_time_s: Option<LaneSpec>,
+    midi_take: Option<PathBuf>,
+    #[serde(default)]
+    midi: MidiSection,
     #[serde(default)]
     bottle: BottleSection,
     #[serde(default)]
@@ -227,12 +319,62 @@ struct GlugSection {
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct OutputSection {
-    gain_db: Option<Automation>,
+    gain_db: Option<LaneSpec>,
     drain: Option<DrainMode>,
 }
 
+/// The `[midi]` table: the plugin's saved MIDI settings, by the same names and values (0–127,
+/// a channel 0–15; 255 for "not mapped" or "any channel").
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct MidiSection {
+    midi_channel: Option<u8>,
+    midi_cc_tilt: Option<u8>,
+    midi_cc_tilt_lsb: Option<u8>,
+    midi_cc_viscosity: Option<u8>,
+    midi_cc_fill: Option<u8>,
+}
+
+impl MidiSection {
+    /// The map, each field checked: a CC above 127 or a channel above 15 that is not 255 is
+    /// refused rather than silently unmapped.
+    fn map(&self) -> Result<MidiMap, SceneError> {
+        let defaults = MidiMap::default().to_raw();
+        let field = |key: &'static str, value: Option<u8>, default: u8, max: u8| {
+            let value = value.unwrap_or(default);
+            if value <= max || value == crate::device::midi::OFF {
+                Ok(value)
+            } else {
+                Err(SceneError::OutOfRange {
+                    key,
+                    value: value as f64,
+                    min: 0.0,
+                    max: max as f64,
+                })
+            }
+        };
+        Ok(MidiMap::from_raw([
+            field("midi.midi_channel", self.midi_channel, defaults[0], 15)?,
+            field("midi.midi_cc_tilt", self.midi_cc_tilt, defaults[1], 127)?,
+            field(
+                "midi.midi_cc_tilt_lsb",
+                self.midi_cc_tilt_lsb,
+                defaults[2],
+                127,
+            )?,
+            field(
+                "midi.midi_cc_viscosity",
+                self.midi_cc_viscosity,
+                defaults[3],
+                127,
+            )?,
+            field("midi.midi_cc_fill", self.midi_cc_fill, defaults[4], 127)?,
+        ]))
+    }
+}
+
 impl SceneFile {
-    fn validate(self) -> Result<Scene, SceneError> {
+    fn validate(self, folder: &Path) -> Result<Scene, SceneError> {
         let sample_rate = match self.sample_rate {
             Some(rate) => check("sample_rate", rate as f64, config::SAMPLE_RATE_HZ)? as u32,
             None => config::SAMPLE_RATE_HZ.default as u32,
@@ -278,17 +420,72 @@ impl SceneFile {
         if self.deterministic.unwrap_or(false) {
             config = config.deterministic();
         }
+        let lane = |key, spec, range| automation(key, resolve(key, spec, folder)?, range);
+        let take = self
+            .midi_take
+            .map(|path| MidiTake::load(&folder.join(path), sample_rate))
+            .transpose()?;
         Ok(Scene {
             sample_rate,
             duration_s,
-            tilt_deg: automation("tilt_deg", self.tilt_deg, config::TILT_DEG)?,
-            viscosity: automation("viscosity_c", self.viscosity_c, config::VISCOSITY)?,
-            fill_percent: automation("fill_percent", self.fill_percent, config::FILL_PERCENT)?,
-            pour_time_s: automation("pour_time_s", self.pour_time_s, config::POUR_TIME_S)?,
-            gain_db: automation("output.gain_db", self.output.gain_db, config::GAIN_DB)?,
+            tilt_deg: lane("tilt_deg", self.tilt_deg, config::TILT_DEG)?,
+            viscosity: lane("viscosity_c", self.viscosity_c, config::VISCOSITY)?,
+            fill_percent: lane("fill_percent", self.fill_percent, config::FILL_PERCENT)?,
+            pour_time_s: lane("pour_time_s", self.pour_time_s, config::POUR_TIME_S)?,
+            gain_db: lane("output.gain_db", self.output.gain_db, config::GAIN_DB)?,
             config,
+            take,
+            midi: self.midi.map()?,
         })
     }
+}
+
+/// A lane as the scene wrote it, with a CSV take read into points (relative to `folder`).
+fn resolve(
+    key: &'static str,
+    spec: Option<LaneSpec>,
+    folder: &Path,
+) -> Result<Option<Automation>, SceneError> {
+    let reference = match spec {
+        None => return Ok(None),
+        Some(LaneSpec::Inline(automation)) => return Ok(Some(automation)),
+        Some(LaneSpec::Csv(reference)) => reference,
+    };
+    let form = |message: &str| SceneError::CsvForm {
+        key,
+        message: message.to_string(),
+    };
+    let CsvLaneRef {
+        csv,
+        column,
+        accel,
+        axis,
+    } = reference;
+    let spec = match (column, accel) {
+        (Some(column), None) if axis.is_none() => CsvLaneSpec::Column(column),
+        (None, Some(columns)) if key == "tilt_deg" => {
+            let axis: Axis =
+                axis.as_deref().unwrap_or("+z").parse().map_err(
+                    |error: crate::device::axis::AxisParseError| form(&error.to_string()),
+                )?;
+            CsvLaneSpec::Gravity { columns, axis }
+        }
+        (None, Some(_)) => return Err(form("`accel` gives a tilt: only tilt_deg takes it")),
+        (Some(_), None) => return Err(form("`axis` goes with `accel`, not with `column`")),
+        _ => {
+            return Err(form(
+                "give either `column` or `accel` (with `axis`), not both",
+            ))
+        }
+    };
+    let path = folder.join(&csv);
+    let text = std::fs::read_to_string(&path).map_err(|source| SceneError::Read {
+        path: path.clone(),
+        source,
+    })?;
+    let points =
+        read_csv_lane(&text, &path, &spec).map_err(|source| SceneError::Csv { key, source })?;
+    Ok(Some(Automation::Points(points)))
 }
 
 fn check(key: &'static str, value: f64, range: Range) -> Result<f64, SceneError> {

@@ -11,7 +11,7 @@ mod editor;
 
 pub use feed::{Feed, UnitView, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
 pub use params::{parse_number, GlugParams, Knob, ModelParams};
-pub use realtime::{MidiInput, RealtimeEngine, Settings};
+pub use realtime::{RealtimeEngine, Settings};
 pub use transport::TransportWatch;
 
 /// Every float knob, for tests and docs that walk the parameters.
@@ -26,6 +26,8 @@ use std::num::NonZeroU32;
 use std::sync::Arc;
 
 use nice_plug::prelude::*;
+
+use crate::device::midi::{MidiInput, MidiMap};
 
 /// The plugin shell: parameters and lifecycle around [`RealtimeEngine`], which does the work.
 pub struct SakeGlug {
@@ -62,9 +64,15 @@ impl SakeGlug {
     }
 }
 
-fn midi_input<S>(event: &NoteEvent<S>) -> Option<MidiInput> {
+/// The MIDI message a host event carries, if the synth acts on it. A note-on on a wildcard
+/// channel (CLAP's "every channel") counts as one on the channel the map listens to.
+fn midi_input<S>(event: &NoteEvent<S>, map: &MidiMap) -> Option<MidiInput> {
     match *event {
-        NoteEvent::NoteOn { velocity, .. } if velocity > 0.0 => Some(MidiInput::Refill),
+        NoteEvent::NoteOn {
+            channel, velocity, ..
+        } if velocity > 0.0 => Some(MidiInput::NoteOn {
+            channel: channel.number().or(map.channel).unwrap_or(0),
+        }),
         NoteEvent::MidiCC {
             channel, cc, value, ..
         } => Some(MidiInput::Cc {
@@ -167,7 +175,7 @@ impl Plugin for SakeGlug {
                 if event.timing() as usize > position && position < len {
                     break;
                 }
-                if let Some(input) = midi_input(&event) {
+                if let Some(input) = midi_input(&event, &settings.midi) {
                     renderer.handle(input, &settings.midi);
                 }
                 next_event = context.next_event();

@@ -1,7 +1,7 @@
 //! The plugin's real-time side without plugin-framework types: parameter values, MIDI and
 //! transport in; engine output and the editor's feed out. Allocation-free after `new()`.
 
-use crate::device::midi::{CcDecoder, MidiMap, Overrides};
+use crate::device::midi::{CcDecoder, DeviceAction, MidiInput, MidiMap, Overrides};
 use crate::engine::{ControlValues, Controls, Engine, ModelConfig};
 use crate::plugin::feed::{Feed, ScopeWriter};
 use crate::plugin::params::GlugParams;
@@ -34,22 +34,6 @@ impl Settings {
             midi: params.midi_map(),
         }
     }
-}
-
-/// A MIDI message the plugin acts on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MidiInput {
-    /// A note-on: refill the bottle (MODEL.md §8).
-    Refill,
-    /// A control change, `value` 0–127, `channel` 0–15.
-    Cc {
-        /// MIDI channel, 0–15.
-        channel: u8,
-        /// Controller number, 0–127.
-        cc: u8,
-        /// Controller value, 0–127.
-        value: u8,
-    },
 }
 
 /// The engine as the plugin runs it, with MIDI overrides, transport resets and the editor's
@@ -120,13 +104,10 @@ impl RealtimeEngine {
 
     /// Acts on one MIDI message: a note-on refills, a mapped CC overrides its control.
     pub fn handle(&mut self, input: MidiInput, map: &MidiMap) {
-        match input {
-            MidiInput::Refill => self.engine.refill(),
-            MidiInput::Cc { channel, cc, value } => {
-                if let Some((target, value)) = self.decoder.feed(map, channel, cc, value) {
-                    self.overrides.set(target, value);
-                }
-            }
+        match self.decoder.decode(map, input) {
+            Some(DeviceAction::Refill) => self.engine.refill(),
+            Some(DeviceAction::Set(target, value)) => self.overrides.set(target, value),
+            None => {}
         }
     }
 

@@ -9,3 +9,4 @@ mod clip_rules;
 mod clips_rendered;
 mod determinism;
 mod scene_files;
+mod takes;

@@ -9,3 +9,4 @@ mod params;
 mod realtime;
 mod reset;
 mod state;
+mod take;

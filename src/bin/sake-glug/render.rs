@@ -39,6 +39,10 @@ pub struct RenderArgs {
     /// The actuator band (Hz) that .haptic frequencies 0..1 map to, as LOW..HIGH.
     #[arg(long, value_name = "LOW..HIGH", default_value_t = HapticBand::default())]
     haptic_band: HapticBand,
+    /// A recorded take (Standard MIDI File) that drives the scene, read with the plugin's
+    /// mapping (or the scene's [midi] table); replaces a take the scene names.
+    #[arg(long, value_name = "TAKE.mid")]
+    midi: Option<PathBuf>,
     /// Overrides the scenes' sample rate (Hz).
     #[arg(long)]
     sample_rate: Option<f64>,
@@ -202,6 +206,9 @@ fn render_job(
         Some(path) => Scene::load(path)?,
         None => Scene::default(),
     };
+    if let Some(take) = &args.midi {
+        scene = scene.with_midi_take(take)?;
+    }
     if let Some(sample_rate) = args.sample_rate {
         scene = scene.with_sample_rate(sample_rate)?;
     }
