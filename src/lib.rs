@@ -20,6 +20,6 @@ pub mod offline;
 pub mod plugin;
 pub mod reports;
 
-/// The plugin type, at the crate's root for nice-plug's export macros.
+/// The plugin types, at the crate's root for nice-plug's export macros.
 #[cfg(feature = "plugin")]
-pub use plugin::SakeGlug;
+pub use plugin::{SakeGlug, SakeGlugVst3};

@@ -30,14 +30,25 @@ use nice_plug::prelude::*;
 use crate::device::midi::{MidiInput, MidiMap};
 
 /// The plugin shell: parameters and lifecycle around [`RealtimeEngine`], which does the work.
-pub struct SakeGlug {
+///
+/// `RAW_MIDI` says whether the format passes the device's CCs as raw MIDI. CLAP does, with no
+/// cost. VST3 has no raw CCs: nice-plug would register 16 × 130 hidden MIDI-mapping parameters
+/// for them (2,097 in all, 51 s to load in pedalboard, an assertion per parameter in Carla), so
+/// the VST3 export takes note-ons only and the device reaches Tilt by the host's MIDI learn
+/// (README, "Connect your tilt device").
+pub struct SakeGlugPlugin<const RAW_MIDI: bool> {
     params: Arc<GlugParams>,
     feed: Arc<Feed>,
     /// Built in `initialize()`, where allocating is allowed.
     renderer: Option<RealtimeEngine>,
 }
 
-impl Default for SakeGlug {
+/// The CLAP plugin, with raw MIDI from the device.
+pub type SakeGlug = SakeGlugPlugin<true>;
+/// The VST3 plugin: the same parameters, state and sound, note-ons as its only MIDI.
+pub type SakeGlugVst3 = SakeGlugPlugin<false>;
+
+impl<const RAW_MIDI: bool> Default for SakeGlugPlugin<RAW_MIDI> {
     fn default() -> Self {
         Self {
             params: Arc::new(GlugParams::default()),
@@ -47,7 +58,7 @@ impl Default for SakeGlug {
     }
 }
 
-impl SakeGlug {
+impl<const RAW_MIDI: bool> SakeGlugPlugin<RAW_MIDI> {
     /// The parameters, as the host and the editor see them.
     pub fn glug_params(&self) -> &Arc<GlugParams> {
         &self.params
@@ -84,7 +95,7 @@ fn midi_input<S>(event: &NoteEvent<S>, map: &MidiMap) -> Option<MidiInput> {
     }
 }
 
-impl Plugin for SakeGlug {
+impl<const RAW_MIDI: bool> Plugin for SakeGlugPlugin<RAW_MIDI> {
     const NAME: &'static str = "Sake Glug";
     const VENDOR: &'static str = "Sake Glug";
     const URL: &'static str = "https://example.invalid/sake-glug";
@@ -105,8 +116,12 @@ impl Plugin for SakeGlug {
         },
     ];
 
-    // CCs from the tilt device need the full MIDI config.
-    const MIDI_INPUT: MidiConfig = MidiConfig::MidiCCs;
+    // CCs from the tilt device need the full MIDI config where the format passes raw MIDI.
+    const MIDI_INPUT: MidiConfig = if RAW_MIDI {
+        MidiConfig::MidiCCs
+    } else {
+        MidiConfig::Basic
+    };
     const SAMPLE_ACCURATE_AUTOMATION: bool = true;
 
     #[cfg(feature = "editor")]
@@ -224,7 +239,7 @@ impl ClapPlugin for SakeGlug {
     }
 }
 
-impl Vst3Plugin for SakeGlug {
+impl Vst3Plugin for SakeGlugVst3 {
     const VST3_CLASS_ID: [u8; 16] = *b"SakeGlugPluginV1";
     const VST3_SUBCATEGORIES: &'static [Vst3SubCategory] = &[
         Vst3SubCategory::Instrument,
@@ -234,4 +249,4 @@ impl Vst3Plugin for SakeGlug {
 }
 
 nice_export_clap!(SakeGlug);
-nice_export_vst3!(SakeGlug);
+nice_export_vst3!(SakeGlugVst3);

@@ -108,16 +108,30 @@ impl Knob {
     }
 }
 
-/// Reads the number at the start of a parameter text, ignoring a unit after it.
+/// Reads what a person types into a parameter: a number, with an exponent (`1e3`) or a decimal
+/// comma (`5,5`) if they like, then optionally a unit (`135 °`, `-6.5 dB`). Anything else is
+/// refused (`None`) rather than cut short: `1-2` or `1,000.5` is not read as 1.
 pub fn parse_number(text: &str) -> Option<f32> {
     let text = text.trim();
     let end = text
         .char_indices()
-        .find(|&(index, c)| {
-            !(c.is_ascii_digit() || c == '.' || (index == 0 && (c == '-' || c == '+')))
-        })
+        .find(|&(_, c)| !(c.is_ascii_digit() || matches!(c, '.' | ',' | '-' | '+' | 'e' | 'E')))
         .map_or(text.len(), |(index, _)| index);
-    let value: f32 = text[..end].parse().ok()?;
+    let (number, unit) = text.split_at(end);
+    // A unit is letters and symbols after the number, never more digits or signs.
+    if unit
+        .chars()
+        .any(|c| c.is_ascii_digit() || matches!(c, '.' | ',' | '-' | '+'))
+    {
+        return None;
+    }
+    // One comma and no point is a decimal comma; a comma beside a point is ambiguous.
+    let number = match (number.matches(',').count(), number.contains('.')) {
+        (0, _) => number.to_string(),
+        (1, false) => number.replace(',', "."),
+        _ => return None,
+    };
+    let value: f32 = number.parse().ok()?;
     value.is_finite().then_some(value)
 }
 
@@ -398,7 +412,20 @@ mod tests {
         assert_eq!(parse_number("+3"), Some(3.0));
         assert_eq!(parse_number("dB"), None);
         assert_eq!(parse_number(""), None);
-        assert_eq!(parse_number("1-2"), Some(1.0));
+        assert_eq!(parse_number("1-2"), None, "never cut short");
+        assert_eq!(parse_number("1e3"), Some(1000.0));
+        assert_eq!(parse_number("2.5E-1 s"), Some(0.25));
+        assert_eq!(parse_number("5,5"), Some(5.5));
+        assert_eq!(parse_number("5,5 %"), Some(5.5));
+        assert_eq!(
+            parse_number("1,000.5"),
+            None,
+            "a comma beside a point is ambiguous"
+        );
+        assert_eq!(parse_number("1.2.3"), None);
+        assert_eq!(parse_number("12 dB 3"), None);
+        assert_eq!(parse_number("e5"), None);
+        assert_eq!(parse_number("1e999"), None, "not finite");
     }
 
     #[test]
