@@ -11,7 +11,7 @@ mod editor;
 
 pub use feed::{Feed, UnitView, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
 pub use params::{parse_number, GlugParams, Knob, ModelParams};
-pub use realtime::{RealtimeEngine, Settings};
+pub use realtime::{RealtimeEngine, Settings, FADE_S};
 pub use transport::TransportWatch;
 
 /// Every float knob, for tests and docs that walk the parameters.

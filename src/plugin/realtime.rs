@@ -11,6 +11,10 @@ use crate::plugin::transport::TransportWatch;
 /// engine's output does not depend on how time is cut.
 const FEED_SPAN: usize = 128;
 
+/// How long units that ring across a transport reset take to fade out (s): short enough that
+/// the new bounce is clean after it, long enough that the fade makes no click.
+pub const FADE_S: f64 = 0.005;
+
 /// The parameters' values for one `process()` call.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
@@ -40,6 +44,14 @@ impl Settings {
 /// feed around it.
 pub struct RealtimeEngine {
     engine: Engine,
+    /// The units that were sounding when the transport reset the bottle, fading out over
+    /// [`FADE_S`] instead of being cut (a click); the new pour starts in `engine` meanwhile.
+    tail: Engine,
+    /// Samples of the fade still to go; 0 while the tail is silent.
+    fade_left: usize,
+    fade_len: usize,
+    /// The tail's samples of one span, allocated once.
+    tail_span: Box<[f32]>,
     config: ModelConfig,
     decoder: CcDecoder,
     overrides: Overrides,
@@ -53,8 +65,14 @@ pub struct RealtimeEngine {
 impl RealtimeEngine {
     /// Allocates: call from `initialize()`.
     pub fn new(sample_rate: f64, config: ModelConfig) -> Self {
+        let engine = Engine::new(sample_rate, config);
+        let fade_len = ((engine.sample_rate() * FADE_S).round() as usize).max(1);
         Self {
-            engine: Engine::new(sample_rate, config),
+            tail: Engine::new(sample_rate, config),
+            fade_left: 0,
+            fade_len,
+            tail_span: vec![0.0; FEED_SPAN].into_boxed_slice(),
+            engine,
             config,
             decoder: CcDecoder::default(),
             overrides: Overrides::default(),
@@ -75,25 +93,37 @@ impl RealtimeEngine {
         &self.engine
     }
 
-    /// The host's reset: the bottle's, and the transport is watched afresh.
+    /// The host's reset: everything silent at once (nothing plays after it), the device's
+    /// values forgotten, and the transport watched afresh.
     pub fn reset(&mut self, config: ModelConfig) {
+        self.tail.reset();
+        self.fade_left = 0;
         self.reset_bottle(config);
+        self.decoder.reset();
+        self.overrides.clear();
         self.transport.reset();
     }
 
     /// Call once per `process()` before rendering; resets when the transport starts or jumps.
+    /// Units that were sounding fade out over [`FADE_S`] while the new pour starts, and the
+    /// device keeps its last values: a bottle held tilted stays tilted.
     pub fn observe_transport(&mut self, playing: bool, position: Option<i64>, config: ModelConfig) {
         if self.transport.observe(playing, position) {
+            if self.engine.sounding_components() > 0 {
+                // The old pour becomes the tail (a swap: nothing is allocated).
+                std::mem::swap(&mut self.engine, &mut self.tail);
+                self.fade_left = self.fade_len;
+            }
             self.reset_bottle(config);
         }
     }
 
-    /// MODEL.md §8 reset; MIDI overrides are dropped too, so a bounce starts from the parameters.
+    /// MODEL.md §8 reset of the bottle that plays.
     fn reset_bottle(&mut self, config: ModelConfig) {
-        self.apply_config(config);
+        // After a swap `engine` may hold older constants than `self.config`: set them anyway.
+        self.config = config;
+        self.engine.set_config(config);
         self.engine.reset();
-        self.decoder.reset();
-        self.overrides.clear();
         self.units_seen = 0;
     }
 
@@ -118,6 +148,21 @@ impl RealtimeEngine {
         }
     }
 
+    /// Adds the tail, fading linearly to silence, and keeps the sum within the ceiling.
+    fn add_fading_tail(&mut self, controls: &Controls, span: &mut [f32]) {
+        let tail = &mut self.tail_span[..span.len()];
+        self.tail.process(controls, tail);
+        let ceiling = self.config.ceiling as f32;
+        for (y, ringing) in span.iter_mut().zip(tail.iter()) {
+            let gain = self.fade_left as f32 / self.fade_len as f32;
+            *y = (*y + ringing * gain).clamp(-ceiling, ceiling);
+            self.fade_left = self.fade_left.saturating_sub(1);
+        }
+        if self.fade_left == 0 {
+            self.tail.reset();
+        }
+    }
+
     /// Renders `out.len()` samples under `settings` (constant over the span).
     pub fn process(&mut self, settings: &Settings, out: &mut [f32], feed: &Feed) {
         self.apply_config(settings.config);
@@ -133,8 +178,19 @@ impl RealtimeEngine {
         };
         let controls = Controls::constant(values, settings.gain_db);
         let sample_rate = self.engine.sample_rate();
+        // The tail stands upright: it only rings out, nothing new starts in it.
+        let tail_controls = Controls::constant(
+            ControlValues {
+                tilt_deg: 0.0,
+                ..values
+            },
+            settings.gain_db,
+        );
         for span in out.chunks_mut(FEED_SPAN) {
             self.engine.process(&controls, span);
+            if self.fade_left > 0 {
+                self.add_fading_tail(&tail_controls, span);
+            }
             let started = self.engine.stats().units_started;
             if started != self.units_seen {
                 self.units_seen = started;

@@ -4,8 +4,9 @@
 
 use nice_plug::prelude::Plugin;
 
-use crate::host::{note_on, peak, Playhead, TestHost};
+use crate::host::{cc, note_on, peak, Playhead, TestHost};
 use sake_glug::engine::{Controls, Engine};
+use sake_glug::plugin::FADE_S;
 
 const RATE: f32 = 48_000.0;
 
@@ -68,11 +69,70 @@ fn every_transport_start_begins_the_same_bounce() {
     let stopped = host.process(512, Vec::new(), Playhead::default());
     assert!(stopped[0].iter().all(|s| s.is_finite()));
     let second = play(&mut host, 0, 60);
-    assert_eq!(first, second);
+    // The units that rang when play was pressed fade out over the first FADE_S; after it
+    // both bounces are the offline render's samples.
+    let fade = (48_000.0 * FADE_S) as usize;
+    let offline = engine_render(&host, first.len());
+    assert_eq!(first[fade..], second[fade..]);
     assert_eq!(
-        first,
-        engine_render(&host, first.len()),
+        first[fade..],
+        offline[fade..],
         "a bounce equals the offline render"
+    );
+    assert_ne!(
+        first[..fade],
+        offline[..fade],
+        "the old units ring into the fade"
+    );
+}
+
+#[test]
+fn a_bounce_from_silence_equals_the_offline_render_from_its_first_sample() {
+    let mut host = pouring_host();
+    let first = play(&mut host, 0, 60);
+    assert_eq!(first, engine_render(&host, first.len()));
+}
+
+/// The largest step between neighbouring samples.
+fn largest_step(samples: &[f32]) -> f32 {
+    samples
+        .windows(2)
+        .map(|pair| (pair[1] - pair[0]).abs())
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn a_transport_start_with_ringing_units_makes_no_click() {
+    let mut host = pouring_host();
+    // Pour live for a second with the transport stopped, then press play in mid-ring.
+    let live = host.render_mono(48_000, 512);
+    let usual = largest_step(&live);
+    let last = *live.last().unwrap();
+    assert!(last.abs() > 0.01, "units ring when play is pressed: {last}");
+    let mut bounce = vec![last];
+    bounce.extend(play(&mut host, 0, 4));
+    let at_start = largest_step(&bounce[..(48_000.0 * FADE_S) as usize + 2]);
+    println!("largest step: {at_start:.4} at the transport start, {usual:.4} while pouring");
+    assert!(
+        at_start <= usual,
+        "a step of {at_start} at the start against {usual} while pouring"
+    );
+}
+
+#[test]
+fn the_device_keeps_its_tilt_across_a_transport_start() {
+    let mut host = TestHost::new(48_000.0, 1);
+    // The device tilts the bottle to 135° (14-bit: CC 16 = 96, CC 48 = 0) with the transport
+    // stopped; the Tilt parameter stays at 0°.
+    host.process(
+        64,
+        vec![cc(0, 0, 16, 96), cc(1, 0, 48, 0)],
+        Playhead::default(),
+    );
+    let bounce = play(&mut host, 0, 100);
+    assert!(
+        peak(&bounce) > 0.05,
+        "the bottle still pours after play is pressed"
     );
 }
 
@@ -85,9 +145,10 @@ fn a_playhead_jump_resets_and_continuous_play_does_not() {
     // A locate while playing: the bottle starts again from full.
     jumped.extend(play(&mut host, 96_000, 20));
     assert_eq!(&jumped[..20 * 512], &straight[..20 * 512]);
-    assert_eq!(
-        &jumped[20 * 512..],
-        &straight[..20 * 512],
+    // After the jump the bounce restarts; the units that rang fade out over FADE_S.
+    let fade = (48_000.0 * FADE_S) as usize;
+    assert!(
+        jumped[20 * 512 + fade..] == straight[fade..20 * 512],
         "after the jump the bounce restarts"
     );
 }
