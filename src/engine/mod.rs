@@ -9,6 +9,7 @@ mod amplitude;
 pub mod config;
 mod controls;
 pub mod pour;
+mod presets;
 pub mod synthesis;
 
 pub(crate) use amplitude::db_to_gain;
@@ -16,6 +17,7 @@ pub use amplitude::unit_amplitude;
 pub use config::{ControlValues, DrainMode, ModelConfig, Range};
 pub use controls::{ControlSource, Controls, Lane};
 pub use pour::{Pour, PourStats, UnitOnset};
+pub use presets::{Preset, PRESETS};
 pub use synthesis::{RecursiveF32, RecursiveF64, Synthesis, VoiceBank, GRID};
 
 /// Renders the model into caller-provided buffers; allocation-free after construction.

@@ -11,7 +11,7 @@ use crate::device::csv_lane::{read_csv_lane, CsvLaneError, CsvLaneSpec};
 use crate::device::midi::MidiMap;
 use crate::device::midi_take::{read_midi_take, TakeError, TimedInput};
 use crate::engine::config::{self, ControlValues, Range};
-use crate::engine::{ControlSource, Controls, DrainMode, ModelConfig};
+use crate::engine::{ControlSource, Controls, DrainMode, ModelConfig, Preset};
 
 /// The built-in default scene: a full 300 ml bottle of water tilted from 90° to 135° over half a
 /// second and held until it stops pouring.
@@ -186,6 +186,29 @@ impl Scene {
             take,
             ..self
         })
+    }
+
+    /// The scene file of a preset: the default pour (tilted from 90° to 135° over half a
+    /// second) with the preset's liquid and bottle. `cargo xtask docs` writes these to
+    /// `presets/<id>.toml`.
+    pub fn preset_toml(preset: &Preset) -> String {
+        let [f1, f2] = preset.frequency_hz;
+        let [b1, b2] = preset.decay_per_s;
+        format!(
+            "# {name}: {description}.\n\
+             # Written by `cargo xtask docs` from src/engine/presets.rs: edit the preset there.\n\
+             tilt_deg = [[0.0, 90.0], [0.5, 135.0]]\n\
+             viscosity_c = {viscosity:?}\n\
+             pour_time_s = {pour_time:?}\n\
+             \n[bottle]\ncapacity_ml = {capacity:?}\npocket_ml = {pocket:?}\n\
+             \n[glug]\nf1_hz = {f1:?}\nf2_hz = {f2:?}\nb1_per_s = {b1:?}\nb2_per_s = {b2:?}\n",
+            name = preset.name,
+            description = preset.description,
+            viscosity = preset.viscosity,
+            pour_time = preset.pour_time_s,
+            capacity = preset.capacity_ml,
+            pocket = preset.pocket_ml,
+        )
     }
 
     /// The same scene driven by the MIDI take at `path` (which replaces the scene's own).

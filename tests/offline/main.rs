@@ -8,5 +8,6 @@ mod cli;
 mod clip_rules;
 mod clips_rendered;
 mod determinism;
+mod presets;
 mod scene_files;
 mod takes;

@@ -81,6 +81,14 @@ fn build_cli() -> nice_plug_xtask::Result<()> {
 fn docs() -> nice_plug_xtask::Result<()> {
     let catalogue = output("target/release/sake-glug", &["stability", "--catalogue"])?;
     replace_block("docs/stability.md", "stability-catalogue", &catalogue)?;
+    // The presets as scene files, from the presets the plugin's menu offers.
+    std::fs::create_dir_all("presets")?;
+    for line in output("target/release/sake-glug", &["presets"])?.lines() {
+        let id = line.split_whitespace().next().unwrap_or_default();
+        let scene = output("target/release/sake-glug", &["presets", id])?;
+        std::fs::write(format!("presets/{id}.toml"), scene)?;
+        println!("presets/{id}.toml written");
+    }
     // The README's example of the pour plot: the default scene.
     run(
         "target/release/sake-glug",

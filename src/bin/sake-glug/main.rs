@@ -2,6 +2,7 @@
 //! subcommand; the work is in the library, which knows nothing of `clap`.
 
 mod accuracy;
+mod presets;
 mod render;
 mod stability;
 
@@ -28,6 +29,8 @@ enum Command {
     Accuracy(accuracy::AccuracyArgs),
     /// Stiff and extreme cases: finite, bounded, no slow-down; see docs/stability.md.
     Stability(stability::StabilityArgs),
+    /// Lists the presets, or prints one as a scene file.
+    Presets(presets::PresetsArgs),
 }
 
 fn main() -> ExitCode {
@@ -35,5 +38,6 @@ fn main() -> ExitCode {
         Command::Render(args) => render::run(args),
         Command::Accuracy(args) => accuracy::run(args),
         Command::Stability(args) => stability::run(args),
+        Command::Presets(args) => presets::run(args),
     }
 }

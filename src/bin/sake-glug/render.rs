@@ -8,6 +8,7 @@ use std::process::ExitCode;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use sake_glug::engine::{Preset, PRESETS};
 use sake_glug::offline::clips::HapticBand;
 use sake_glug::offline::{
     render_to_files, OutputError, OutputFormat, OutputOptions, RenderReport, SampleFormat, Scene,
@@ -39,6 +40,10 @@ pub struct RenderArgs {
     /// The actuator band (Hz) that .haptic frequencies 0..1 map to, as LOW..HIGH.
     #[arg(long, value_name = "LOW..HIGH", default_value_t = HapticBand::default())]
     haptic_band: HapticBand,
+    /// Renders a preset (water, thin, sake, thick, syrup, small-bottle, large-bottle) instead of
+    /// a scene file: the default pour with that liquid and bottle.
+    #[arg(long, value_name = "NAME", conflicts_with = "scenes")]
+    preset: Option<String>,
     /// A recorded take (Standard MIDI File) that drives the scene, read with the plugin's
     /// mapping (or the scene's [midi] table); replaces a take the scene names.
     #[arg(long, value_name = "TAKE.mid")]
@@ -114,16 +119,26 @@ pub fn run(args: RenderArgs) -> ExitCode {
 /// The jobs the arguments ask for; every output's format is checked here, before anything is
 /// rendered.
 fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
+    if let Some(name) = &args.preset {
+        if Preset::find(name).is_none() {
+            let names: Vec<&str> = PRESETS.iter().map(|preset| preset.id).collect();
+            return Err(format!(
+                "no preset `{name}`: choose one of {}",
+                names.join(", ")
+            ));
+        }
+    }
     let scenes: Vec<Option<PathBuf>> = if args.scenes.is_empty() {
         vec![None]
     } else {
         args.scenes.iter().cloned().map(Some).collect()
     };
     let name_of = |scene: &Option<PathBuf>| {
+        let built_in = args.preset.as_deref().unwrap_or("default");
         scene
             .as_deref()
             .and_then(Path::file_stem)
-            .map_or("default".to_string(), |stem| {
+            .map_or(built_in.to_string(), |stem| {
                 stem.to_string_lossy().into_owned()
             })
     };
@@ -202,9 +217,10 @@ fn render_job(
     options: &OutputOptions,
     mut progress: impl FnMut(f64),
 ) -> Result<RenderReport, JobError> {
-    let mut scene = match &job.scene {
-        Some(path) => Scene::load(path)?,
-        None => Scene::default(),
+    let mut scene = match (&job.scene, args.preset.as_deref().and_then(Preset::find)) {
+        (Some(path), _) => Scene::load(path)?,
+        (None, Some(preset)) => Scene::parse(&Scene::preset_toml(preset))?,
+        (None, None) => Scene::default(),
     };
     if let Some(take) = &args.midi {
         scene = scene.with_midi_take(take)?;

@@ -5,6 +5,7 @@ mod bottle;
 mod controls;
 mod envelopes;
 mod midi_settings;
+mod presets;
 mod scope;
 
 use std::sync::Arc;
@@ -26,6 +27,8 @@ pub struct GlugEditor {
     feed: Arc<Feed>,
     gui: Option<GuiContext>,
     repaint: RepaintNotifier,
+    /// The preset last picked in the menu (its label).
+    preset: usize,
 }
 
 pub fn create(params: Arc<GlugParams>, feed: Arc<Feed>) -> Option<EguiEditor<GlugEditor>> {
@@ -35,6 +38,7 @@ pub fn create(params: Arc<GlugParams>, feed: Arc<Feed>) -> Option<EguiEditor<Glu
         feed,
         gui: None,
         repaint: repaint.clone(),
+        preset: 0,
     };
     create_egui_editor(
         EguiEditorState::from_size(LogicalSize::new(WIDTH, HEIGHT), 1.0),
@@ -66,6 +70,7 @@ impl NiceEguiApp for GlugEditor {
         ui.horizontal_top(|ui| {
             ui.vertical(|ui| {
                 ui.set_width(300.0);
+                presets::show(ui, &self.params, &setter, &mut self.preset);
                 controls::show(ui, &self.params, &setter);
                 ui.separator();
                 midi_settings::show(ui, &self.params);

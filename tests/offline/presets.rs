@@ -1,0 +1,43 @@
+//! The presets as scene files: `presets/<id>.toml` is the code's own text for each preset (so
+//! the files cannot drift from the plugin's menu), and it renders that preset.
+
+use std::path::Path;
+
+use sake_glug::engine::{ControlValues, ModelConfig, PRESETS};
+use sake_glug::offline::Scene;
+
+#[test]
+fn every_preset_file_is_the_presets_own_scene() {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("presets");
+    for preset in &PRESETS {
+        let path = folder.join(format!("{}.toml", preset.id));
+        let text = std::fs::read_to_string(&path)
+            .unwrap_or_else(|error| panic!("{}: {error} (run `cargo xtask docs`)", path.display()));
+        assert_eq!(
+            text,
+            Scene::preset_toml(preset),
+            "{} is stale",
+            path.display()
+        );
+        let scene = Scene::load(&path).unwrap();
+        assert_eq!(scene.config, preset.config(ModelConfig::default()));
+        let (values, _) = scene.values_at(48_000);
+        let tilted = ControlValues {
+            tilt_deg: 135.0,
+            ..ControlValues::default()
+        };
+        assert_eq!(values, preset.controls(tilted));
+    }
+    let files = std::fs::read_dir(&folder).unwrap().count();
+    assert_eq!(files, PRESETS.len(), "no file without a preset");
+}
+
+#[test]
+fn presets_differ_where_they_should() {
+    let viscosity = |id: &str| PRESETS.iter().find(|p| p.id == id).unwrap().viscosity;
+    assert_eq!(viscosity("water"), 0.33);
+    assert_eq!(viscosity("thin"), 0.29);
+    assert_eq!(viscosity("thick"), 0.42);
+    let capacity = |id: &str| PRESETS.iter().find(|p| p.id == id).unwrap().capacity_ml;
+    assert!(capacity("small-bottle") < 300.0 && capacity("large-bottle") > 300.0);
+}
