@@ -306,6 +306,7 @@ struct Observer<P> {
 }
 
 impl<P> Observer<P> {
+    #[cfg(feature = "plot")]
     /// The volume at the start: the fill level, as a reset fills the bottle (MODEL.md §8).
     fn first_volume(&self, scene: &Scene) -> f64 {
         scene.config.capacity_ml * scene.fill_percent.value_at(0.0) / 100.0

@@ -56,6 +56,33 @@ pub struct Feed {
     scope_written: AtomicUsize,
     units: Box<[UnitSlot]>,
     units_written: AtomicUsize,
+    /// Asks the editor's window to redraw; the audio thread calls it (a relaxed atomic store,
+    /// real-time safe) only when something it shows has changed, so an idle editor costs
+    /// nothing.
+    #[cfg(feature = "editor")]
+    pub repaint: nice_plug_egui::RepaintNotifier,
+}
+
+/// What the editor shows, in a form cheap to compare block by block: when it is unchanged,
+/// the editor is not redrawn.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Visible {
+    /// Units started (new envelopes, a new glug on the bottle).
+    pub units: u64,
+    /// The residual volume (ml), as drawn.
+    pub volume_ml: f32,
+    /// The tilt (degrees), as drawn.
+    pub tilt_deg: f32,
+    /// Whether the output was sounding: the scope moves.
+    pub sounding: bool,
+}
+
+impl Visible {
+    /// Whether the editor must be redrawn to show `self` after having shown `before`: when
+    /// anything it draws moved, or while the output sounds (the scope scrolls).
+    pub fn needs_redraw_after(self, before: Visible) -> bool {
+        self != before || self.sounding
+    }
 }
 
 impl Default for Feed {
@@ -72,11 +99,22 @@ impl Default for Feed {
             scope_written: AtomicUsize::new(0),
             units: (0..UNIT_SLOTS).map(|_| UnitSlot::default()).collect(),
             units_written: AtomicUsize::new(0),
+            #[cfg(feature = "editor")]
+            repaint: nice_plug_egui::RepaintNotifier::new(),
         }
     }
 }
 
 impl Feed {
+    /// Called by the audio thread after each block with what the editor would now show, and
+    /// what it showed after the last block: asks for a redraw only if it must.
+    pub fn publish(&self, now: Visible, before: Visible) {
+        if now.needs_redraw_after(before) {
+            #[cfg(feature = "editor")]
+            self.repaint.request_repaint();
+        }
+    }
+
     /// Records a unit that started at `onset_s` (s, on the clock of `now_s`), in place of the
     /// oldest one kept.
     pub fn push_unit(&self, onset_s: f64, unit: &UnitOnset) {

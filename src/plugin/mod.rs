@@ -9,7 +9,7 @@ mod transport;
 #[cfg(feature = "editor")]
 mod editor;
 
-pub use feed::{Feed, UnitView, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
+pub use feed::{Feed, UnitView, Visible, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
 pub use params::{parse_number, GlugParams, Knob, ModelParams};
 pub use realtime::{RealtimeEngine, Settings, FADE_S};
 pub use transport::TransportWatch;

@@ -3,7 +3,7 @@
 
 use crate::device::midi::{CcDecoder, DeviceAction, MidiInput, MidiMap, Overrides};
 use crate::engine::{ControlValues, Controls, Engine, ModelConfig};
-use crate::plugin::feed::{Feed, ScopeWriter};
+use crate::plugin::feed::{Feed, ScopeWriter, Visible};
 use crate::plugin::params::GlugParams;
 use crate::plugin::transport::TransportWatch;
 
@@ -60,6 +60,8 @@ pub struct RealtimeEngine {
     units_seen: u64,
     /// Samples rendered since construction (the feed's clock; not reset with the bottle).
     rendered: u64,
+    /// What the editor was last shown, so that it is redrawn only when that changes.
+    shown: Visible,
 }
 
 impl RealtimeEngine {
@@ -80,12 +82,18 @@ impl RealtimeEngine {
             scope: ScopeWriter::new(sample_rate),
             units_seen: 0,
             rendered: 0,
+            shown: Visible::default(),
         }
     }
 
     /// Sample rate the engine runs at (Hz).
     pub fn sample_rate(&self) -> f64 {
         self.engine.sample_rate()
+    }
+
+    /// What the editor was shown after the last block.
+    pub fn visible(&self) -> Visible {
+        self.shown
     }
 
     /// The engine inside.
@@ -216,5 +224,13 @@ impl RealtimeEngine {
         feed.now_s
             .store(self.rendered as f64 / sample_rate, Relaxed);
         feed.units_started.store(self.units_seen, Relaxed);
+        let shown = Visible {
+            units: self.units_seen,
+            volume_ml: self.engine.volume_ml() as f32,
+            tilt_deg: tilt_deg as f32,
+            sounding: self.engine.sounding_components() > 0 || self.fade_left > 0,
+        };
+        feed.publish(shown, self.shown);
+        self.shown = shown;
     }
 }

@@ -181,3 +181,26 @@ fn note_on_refills_without_reseeding_and_fill_drain_is_visible() {
     let mut fresh = pouring_host();
     assert_ne!(refilled, fresh.render_mono(24_000, 512));
 }
+
+#[test]
+fn the_editor_is_redrawn_only_while_something_it_shows_changes() {
+    let mut host = TestHost::new(RATE, 1);
+    // Upright and silent: block after block, nothing the editor draws changes.
+    host.render_mono(4096, 512);
+    let idle = host.plugin.renderer().unwrap().visible();
+    host.render_mono(512, 512);
+    let still = host.plugin.renderer().unwrap().visible();
+    assert!(!still.needs_redraw_after(idle), "{still:?} after {idle:?}");
+    // Pouring: the bottle drains and the scope moves.
+    host.set_text("tilt", "135");
+    host.render_mono(512, 512);
+    let pouring = host.plugin.renderer().unwrap().visible();
+    assert!(pouring.needs_redraw_after(still));
+    host.render_mono(512, 512);
+    assert!(host
+        .plugin
+        .renderer()
+        .unwrap()
+        .visible()
+        .needs_redraw_after(pouring));
+}

@@ -13,7 +13,7 @@ use std::sync::Arc;
 use nice_plug::context::gui::GuiContext;
 use nice_plug::editor::dpi::LogicalSize;
 use nice_plug_egui::{
-    create_egui_editor, EguiEditor, EguiEditorState, EguiNiceSettings, NiceEguiApp, RepaintNotifier,
+    create_egui_editor, EguiEditor, EguiEditorState, EguiNiceSettings, NiceEguiApp,
 };
 
 use crate::plugin::feed::Feed;
@@ -26,18 +26,17 @@ pub struct GlugEditor {
     params: Arc<GlugParams>,
     feed: Arc<Feed>,
     gui: Option<GuiContext>,
-    repaint: RepaintNotifier,
     /// The preset last picked in the menu (its label).
     preset: usize,
 }
 
 pub fn create(params: Arc<GlugParams>, feed: Arc<Feed>) -> Option<EguiEditor<GlugEditor>> {
-    let repaint = RepaintNotifier::new();
+    // The audio thread asks for redraws through the feed, when what it shows changes.
+    let repaint = feed.repaint.clone();
     let app = GlugEditor {
         params,
         feed,
         gui: None,
-        repaint: repaint.clone(),
         preset: 0,
     };
     create_egui_editor(
@@ -60,8 +59,6 @@ impl NiceEguiApp for GlugEditor {
     }
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut nice_plug_egui::Frame) {
-        // The scope and the bottle move with the audio: draw every poll.
-        self.repaint.request_repaint();
         let Some(gui) = &self.gui else {
             return;
         };
