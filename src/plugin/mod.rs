@@ -10,7 +10,7 @@ mod transport;
 mod editor;
 
 pub use feed::{Feed, UnitView, Visible, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
-pub use params::{parse_number, GlugParams, Knob, ModelParams};
+pub use params::{migrate_state, parse_number, GlugParams, Knob, ModelParams, STATE_VERSION};
 pub use realtime::{RealtimeEngine, Settings, FADE_S};
 pub use transport::TransportWatch;
 
@@ -130,6 +130,10 @@ impl<const RAW_MIDI: bool> Plugin for SakeGlugPlugin<RAW_MIDI> {
     type Editor = ();
     type SysExMessage = ();
     type BackgroundTask = ();
+
+    fn filter_state(state: &mut PluginState) {
+        migrate_state(state);
+    }
 
     fn params(&self) -> Arc<dyn Params> {
         self.params.clone()

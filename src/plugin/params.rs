@@ -258,6 +258,32 @@ pub struct GlugParams {
     /// CC number of the fill level; 128 or more means unmapped.
     #[persist = "midi_cc_fill"]
     pub midi_cc_fill: AtomicU8,
+    /// The layout of the saved state ([`STATE_VERSION`]); older states are brought up to date
+    /// by [`migrate_state`] before they load.
+    #[persist = "state_version"]
+    pub state_version: AtomicU8,
+}
+
+/// The saved state's layout. 0: before states carried a version (the parameters and MIDI
+/// fields of 0.1.0). 1: the same, with this version field.
+pub const STATE_VERSION: u8 = 1;
+
+/// Brings a saved state up to [`STATE_VERSION`], one version at a time, before it loads; a
+/// state from a newer version loads as it is (its unknown fields are ignored).
+pub fn migrate_state(state: &mut PluginState) {
+    let saved = state
+        .fields
+        .get("state_version")
+        .and_then(|text| text.parse::<u8>().ok())
+        .unwrap_or(0);
+    if saved > STATE_VERSION {
+        return;
+    }
+    // 0 → 1: nothing was renamed or rescaled; the state only gains its version. A later change
+    // to a parameter's ID, range or unit adds its step here.
+    state
+        .fields
+        .insert("state_version".into(), STATE_VERSION.to_string());
 }
 
 /// The Model group of parameters (MODEL.md §5, §7, §8).
@@ -316,6 +342,7 @@ impl Default for GlugParams {
             midi_cc_tilt_lsb: AtomicU8::new(midi[2]),
             midi_cc_viscosity: AtomicU8::new(midi[3]),
             midi_cc_fill: AtomicU8::new(midi[4]),
+            state_version: AtomicU8::new(STATE_VERSION),
         }
     }
 }

@@ -3,6 +3,8 @@
 
 mod host;
 
+mod clap_state;
+
 mod midi;
 mod nyquist;
 mod params;
