@@ -28,6 +28,9 @@ pub struct GlugEditor {
     gui: Option<GuiContext>,
     /// The preset last picked in the menu (its label).
     preset: usize,
+    /// The MIDI settings were edited and the host is not told yet (it is, once the mouse is
+    /// let go, not at every step of a drag).
+    midi_edited: bool,
 }
 
 pub fn create(params: Arc<GlugParams>, feed: Arc<Feed>) -> Option<EguiEditor<GlugEditor>> {
@@ -38,6 +41,7 @@ pub fn create(params: Arc<GlugParams>, feed: Arc<Feed>) -> Option<EguiEditor<Glu
         feed,
         gui: None,
         preset: 0,
+        midi_edited: false,
     };
     create_egui_editor(
         EguiEditorState::from_size(LogicalSize::new(WIDTH, HEIGHT), 1.0),
@@ -70,12 +74,16 @@ impl NiceEguiApp for GlugEditor {
                 presets::show(ui, &self.params, &setter, &mut self.preset);
                 controls::show(ui, &self.params, &setter);
                 ui.separator();
-                midi_settings::show(ui, &self.params);
+                self.midi_edited |= midi_settings::show(ui, &self.params);
             });
             ui.vertical(|ui| {
                 bottle::show(ui, &self.feed, egui::vec2(420.0, 220.0));
             });
         });
+        if self.midi_edited && !ui.input(|input| input.pointer.any_down()) {
+            self.midi_edited = false;
+            midi_settings::tell_host(gui);
+        }
         ui.separator();
         ui.horizontal_top(|ui| {
             scope::show(ui, &self.feed, egui::vec2(370.0, 200.0));
