@@ -213,14 +213,12 @@ fn numpy_synthesis(scene: &Scene, samples: usize) -> Result<(f64, f64), String> 
 /// imports in it.
 fn python_with_numpy() -> Option<PathBuf> {
     let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
-    [venv, PathBuf::from("python3")]
-        .into_iter()
-        .find(|python| {
-            Command::new(python)
-                .args(["-c", "import numpy"])
-                .output()
-                .is_ok_and(|out| out.status.success())
-        })
+    [venv, PathBuf::from("python3")].into_iter().find(|python| {
+        Command::new(python)
+            .args(["-c", "import numpy"])
+            .output()
+            .is_ok_and(|out| out.status.success())
+    })
 }
 
 /// Writes the report with the commit it measured to `<target>/bench-render.md` (the target
