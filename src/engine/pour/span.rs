@@ -60,7 +60,7 @@ impl PlainRun {
         if state.drain == DrainMode::Simulate {
             // The outflow is the full k only while V − r·C ≥ k; below that each sample differs.
             let max_outflow = levels.max_outflow_per_sample_ml;
-            if !(volume - levels.rest_ml >= max_outflow) {
+            if volume - levels.rest_ml < max_outflow {
                 return None;
             }
             let steps = BinadeSteps::of(volume, max_outflow, Direction::Down)?;

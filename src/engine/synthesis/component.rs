@@ -53,14 +53,14 @@ impl Component {
     /// The first sample from which [`Component::is_silent_at`] holds (it then holds for good), or
     /// `u64::MAX` if it never does: found once, so that a sounding component compares integers.
     pub fn silent_from(&self) -> u64 {
-        if !(self.decay_per_sample > 0.0) {
+        if self.decay_per_sample.is_nan() || self.decay_per_sample <= 0.0 {
             return u64::MAX;
         }
         let guess = self.onset_sample as f64
             + self.onset_fraction
             + SILENT_DECAY_EXPONENT / self.decay_per_sample;
         // Beyond any render (and any u64).
-        if !(guess < 1e19) {
+        if guess.is_nan() || guess >= 1e19 {
             return u64::MAX;
         }
         // The guess is off by a sample at most; the test itself decides.
