@@ -58,6 +58,16 @@ impl Default for SpanLevels {
 }
 
 impl SpanLevels {
+    /// r·C, s·C and k/fs of sample `index`.
+    #[inline]
+    pub fn of(&self, index: usize) -> (f64, f64, f64) {
+        (
+            self.rest_ml[index],
+            self.submerged_ml[index],
+            self.max_outflow_ml[index],
+        )
+    }
+
     /// The levels of sample `index`, whose controls give `key`.
     #[inline]
     pub fn at(&self, index: usize, key: [f64; 3]) -> Levels {
@@ -120,6 +130,23 @@ impl Bottle {
         !self.refill_pending
             && controls.fill_percent == self.last_fill_percent
             && [controls.tilt_deg, controls.pour_time_s, capacity_ml] == self.levels.key
+    }
+
+    /// Whether no sample of a span with these fill levels refills the bottle: no refill is
+    /// pending, and in simulate mode the fill level stays the last one.
+    pub fn refills_none_of(&self, fill_percents: &[f64], drain: DrainMode) -> bool {
+        !self.refill_pending
+            && (drain == DrainMode::Follow
+                || fill_percents
+                    .iter()
+                    .fold(true, |same, &fill| same & (fill == self.last_fill_percent)))
+    }
+
+    /// Takes the state after a span stepped elsewhere, sample by sample with the arithmetic of
+    /// [`Bottle::step_with`] (see `Pour::advance_varying`): V, and the last fill level seen.
+    pub fn end_span(&mut self, volume_ml: f64, last_fill_percent: f64) {
+        self.volume_ml = volume_ml;
+        self.last_fill_percent = last_fill_percent;
     }
 
     /// Fills the bottle to the fill level that the next sample carries.

@@ -46,13 +46,24 @@ impl TiltCurve {
         };
         self.at_in(first, segment);
         let piece = segment.0;
-        if !tilts.iter().all(|&tilt| self.contains(piece, tilt)) {
+        let points = self.points;
+        // The piece's bounds as `contains` reads them, checked for every tilt without a branch
+        // (NaN fails both comparisons, as it fails `contains`).
+        let above = if piece == 0 {
+            f64::NEG_INFINITY
+        } else {
+            points[piece - 1].0
+        };
+        let up_to = points.get(piece).map_or(f64::INFINITY, |point| point.0);
+        let inside = tilts.iter().fold(true, |inside, &tilt| {
+            inside & ((tilt > above || piece == 0) & (tilt <= up_to || piece == points.len()))
+        });
+        if !inside {
             for (value, &tilt) in values.iter_mut().zip(tilts) {
                 *value = self.at_in(tilt, segment);
             }
             return;
         }
-        let points = self.points;
         if piece == 0 || piece == points.len() {
             values.fill(self.at_in(first, segment));
             return;

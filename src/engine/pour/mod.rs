@@ -15,7 +15,7 @@ pub use randomness::UnitShape;
 
 use crate::engine::amplitude::unit_amplitude;
 use crate::engine::config::{
-    ControlValues, ModelConfig, Range, FILL_PERCENT, POUR_TIME_S, TILT_DEG, VISCOSITY,
+    ControlValues, DrainMode, ModelConfig, Range, FILL_PERCENT, POUR_TIME_S, TILT_DEG, VISCOSITY,
 };
 use crate::engine::controls::{Controls, Lane};
 use bottle::{Bottle, SpanLevels, SPAN};
@@ -342,31 +342,97 @@ impl Pour {
                 &mut levels,
             );
             self.config_changed = false;
-            for index in 0..len {
-                let sample = first_sample + (start + index) as u64;
-                let key = [
-                    inputs.tilt_deg[index],
-                    inputs.pour_time_s[index],
-                    capacity_ml,
-                ];
-                let outflow = self.bottle.step_with(
-                    inputs.fill_percent[index],
-                    &levels.at(index, key),
-                    &self.config,
+            let fills = &inputs.fill_percent[..len];
+            let first = first_sample + start as u64;
+            if self.bottle.refills_none_of(fills, self.config.drain) {
+                self.step_span_without_refill(
+                    first,
+                    &inputs,
+                    &levels,
+                    len,
+                    &mut advanced,
+                    &mut emit,
                 );
-                if outflow.refilled {
-                    self.onsets.clear();
+            } else {
+                for index in 0..len {
+                    let sample = first + index as u64;
+                    let key = [
+                        inputs.tilt_deg[index],
+                        inputs.pour_time_s[index],
+                        capacity_ml,
+                    ];
+                    let outflow =
+                        self.bottle
+                            .step_with(fills[index], &levels.at(index, key), &self.config);
+                    if outflow.refilled {
+                        self.onsets.clear();
+                    }
+                    let outflow =
+                        self.count_onsets(sample, inputs.viscosity[index], outflow, &mut emit);
+                    if outflow.amount_ml > 0.0 {
+                        advanced.flowed_until = Some(sample + 1);
+                    }
+                    advanced.last = outflow;
                 }
-                let outflow =
-                    self.count_onsets(sample, inputs.viscosity[index], outflow, &mut emit);
-                if outflow.amount_ml > 0.0 {
-                    advanced.flowed_until = Some(sample + 1);
-                }
-                advanced.last = outflow;
             }
             start += len;
         }
         advanced
+    }
+
+    /// The samples of a span that refills nothing, with the arithmetic of [`Bottle::step_with`]
+    /// and of the onset detector, but V and g kept in registers: a sample that starts a unit
+    /// goes through the detector itself, from the state before it.
+    fn step_span_without_refill(
+        &mut self,
+        first_sample: u64,
+        inputs: &SpanInputs,
+        levels: &SpanLevels,
+        len: usize,
+        advanced: &mut Advanced,
+        emit: &mut impl FnMut(&UnitOnset),
+    ) {
+        let simulate = self.config.drain == DrainMode::Simulate;
+        let capacity_ml = self.config.capacity_ml;
+        let mut volume = self.bottle.volume_ml();
+        let mut accumulated = self.onsets.accumulated_ml();
+        let mut pocket = self.draws.next_pocket_ml(&self.config);
+        for index in 0..len {
+            if !simulate {
+                volume = inputs.fill_percent[index] / 100.0 * capacity_ml;
+            }
+            let (rest_ml, submerged_ml, max_outflow_ml) = levels.of(index);
+            let volume_before_ml = volume;
+            let amount_ml = max_outflow_ml.min((volume - rest_ml).max(0.0));
+            let submerged = volume > submerged_ml;
+            if simulate {
+                volume = volume_before_ml - amount_ml;
+            }
+            let outflow = Outflow {
+                volume_before_ml,
+                amount_ml,
+                submerged,
+                refilled: false,
+            };
+            let sample = first_sample + index as u64;
+            if amount_ml > 0.0 {
+                advanced.flowed_until = Some(sample + 1);
+                if submerged {
+                    let sum = accumulated + amount_ml;
+                    if sum >= pocket {
+                        self.onsets.set_accumulated_ml(accumulated);
+                        self.count_onsets(sample, inputs.viscosity[index], outflow, &mut *emit);
+                        accumulated = self.onsets.accumulated_ml();
+                        pocket = self.draws.next_pocket_ml(&self.config);
+                    } else {
+                        accumulated = sum;
+                    }
+                }
+            }
+            advanced.last = outflow;
+        }
+        self.onsets.set_accumulated_ml(accumulated);
+        self.bottle.end_span(volume, inputs.fill_percent[len - 1]);
     }
 
     fn state(&self) -> PourState<'_> {
