@@ -209,14 +209,25 @@ impl Bottle {
         SUBMERGED.fill(tilts, &mut levels.submerged_ml[..len], submerged);
         FLOW.fill(tilts, &mut levels.max_outflow_ml[..len], flow);
         let sample_rate = self.sample_rate;
-        for ((rest, submerged), (flow, pour_time)) in levels.rest_ml[..len]
+        for (rest, submerged) in levels.rest_ml[..len]
             .iter_mut()
             .zip(&mut levels.submerged_ml[..len])
-            .zip(levels.max_outflow_ml[..len].iter_mut().zip(pour_times))
         {
             *rest *= capacity_ml;
             *submerged *= capacity_ml;
-            *flow = capacity_ml / pour_time * *flow / sample_rate;
+        }
+        let flows = levels.max_outflow_ml[..len].iter_mut();
+        let first_pour_time = pour_times.first().copied().unwrap_or(f64::NAN);
+        if pour_times.iter().all(|&time| time == first_pour_time) {
+            // C/T once for the span: the same quotient at every sample.
+            let rate_scale = capacity_ml / first_pour_time;
+            for flow in flows {
+                *flow = rate_scale * *flow / sample_rate;
+            }
+        } else {
+            for (flow, pour_time) in flows.zip(pour_times) {
+                *flow = capacity_ml / pour_time * *flow / sample_rate;
+            }
         }
         if let Some(last) = len.checked_sub(1) {
             self.levels = levels.at(last, [tilts[last], pour_times[last], capacity_ml]);

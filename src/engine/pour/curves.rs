@@ -7,9 +7,10 @@ pub struct TiltCurve {
 
 /// Which piece of a [`TiltCurve`] a tilt falls in, remembered from one evaluation to the next:
 /// piece 0 holds the first value (θ ≤ θ_0), piece i interpolates over (θ_(i−1), θ_i], the last
-/// piece holds the last value.
+/// piece holds the last value. The piece before it is kept too, so that a tilt going back and
+/// forth between two pieces finds both without a search.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct CurveSegment(usize);
+pub struct CurveSegment(usize, usize);
 
 impl TiltCurve {
     /// Linear interpolation between breakpoints, held constant beyond the ends.
@@ -23,10 +24,15 @@ impl TiltCurve {
     pub fn at_in(&self, tilt_deg: f64, segment: &mut CurveSegment) -> f64 {
         let points = self.points;
         if !self.contains(segment.0, tilt_deg) {
-            segment.0 = points
-                .iter()
-                .position(|&(tilt, _)| tilt_deg <= tilt)
-                .unwrap_or(points.len());
+            let piece = if self.contains(segment.1, tilt_deg) {
+                segment.1
+            } else {
+                points
+                    .iter()
+                    .position(|&(tilt, _)| tilt_deg <= tilt)
+                    .unwrap_or(points.len())
+            };
+            *segment = CurveSegment(piece, segment.0);
         }
         match segment.0 {
             0 => points[0].1,
