@@ -14,6 +14,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn main() -> nice_plug_xtask::Result<()> {
+    // Read before nice-plug's bundler runs: it clears cargo's variables for its own builds.
+    TARGET_DIR.get_or_init(|| {
+        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| PathBuf::from("target"), PathBuf::from)
+    });
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         Some("pour") => {
@@ -79,9 +83,11 @@ fn build_cli() -> nice_plug_xtask::Result<()> {
     ])
 }
 
-/// Where cargo builds: `$CARGO_TARGET_DIR`, else `target/`.
+/// Where cargo builds: `$CARGO_TARGET_DIR` as the xtask started with it, else `target/`.
+static TARGET_DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+
 fn target_dir() -> PathBuf {
-    std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| PathBuf::from("target"), PathBuf::from)
+    TARGET_DIR.get_or_init(|| PathBuf::from("target")).clone()
 }
 
 /// The release command line that `build_cli` built.
@@ -98,12 +104,13 @@ fn docs() -> nice_plug_xtask::Result<()> {
     let catalogue = output(&cli(), &["stability", "--catalogue"])?;
     replace_block("docs/stability.md", "stability-catalogue", &catalogue)?;
     // The README's example of the pour plot: the default scene.
+    let clip = target_dir().join("pour-plot.haptic");
     run(
         &cli(),
         &[
             "render",
             "-o",
-            "target/pour-plot.haptic",
+            &clip.to_string_lossy(),
             "--plot",
             "docs/pour-plot.png",
         ],

@@ -354,16 +354,16 @@ impl Pour {
                     &mut emit,
                 );
             } else {
-                for index in 0..len {
+                for (index, &fill) in fills.iter().enumerate() {
                     let sample = first + index as u64;
                     let key = [
                         inputs.tilt_deg[index],
                         inputs.pour_time_s[index],
                         capacity_ml,
                     ];
-                    let outflow =
-                        self.bottle
-                            .step_with(fills[index], &levels.at(index, key), &self.config);
+                    let outflow = self
+                        .bottle
+                        .step_with(fill, &levels.at(index, key), &self.config);
                     if outflow.refilled {
                         self.onsets.clear();
                     }
