@@ -1,9 +1,22 @@
-//! Render speed of the default path, as × real time (criterion's throughput in samples/s divided
-//! by the sample rate), beside the memory limit: merely filling a buffer of the same length.
+//! Render speed of the default path as × real time, on one core (the engine is single-threaded),
+//! for three scenes: the default scene, one hour of repeated pours and one hour of continuous
+//! pouring in follow mode. Beside each, measured in the same run: the memory limit (merely
+//! filling a buffer of the same length) and the same glug train synthesised unit by unit with
+//! NumPy (`benches/numpy_glug.py`, when a Python with NumPy is found: the project's `.venv`, then
+//! `python3`).
+//!
+//! Criterion reports its own statistics; the lines the project quotes are printed after each
+//! scene and written to `<target>/bench-render.md`, which `cargo xtask docs` copies into
+//! docs/scaling.md.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use sake_glug::offline::render_scene;
-use sake_glug::offline::Scene;
+use sake_glug::engine::UnitOnset;
+use sake_glug::offline::{render_scene, RenderError, RenderObserver, Scene};
 
 /// One hour of repeated pours at 48 kHz: every 10 s tilt up and pour 6 s, put the bottle
 /// upright, and refill it. A change of the fill level refills in simulate mode, so the level
@@ -33,6 +46,13 @@ fn hour_of_pours() -> Scene {
     Scene::parse(&text).expect("the benchmark scene is valid")
 }
 
+/// One hour of continuous pouring: follow mode holds the bottle full at 135°, so it glugs at
+/// 12 units a second for the whole hour.
+fn hour_of_follow_pouring() -> Scene {
+    Scene::parse("duration_s = 3600.0\ntilt_deg = 135.0\n[output]\ndrain = \"follow\"\n")
+        .expect("the benchmark scene is valid")
+}
+
 /// Renders into `out` (the sink a WAV writer would be), returning the sample count.
 fn render_into(scene: &Scene, out: &mut Vec<f32>) -> usize {
     out.clear();
@@ -40,7 +60,7 @@ fn render_into(scene: &Scene, out: &mut Vec<f32>) -> usize {
         scene,
         |block| {
             out.extend_from_slice(block);
-            Ok::<(), sake_glug::offline::RenderError>(())
+            Ok::<(), RenderError>(())
         },
         &mut |_| {},
     )
@@ -48,10 +68,22 @@ fn render_into(scene: &Scene, out: &mut Vec<f32>) -> usize {
     out.len()
 }
 
+/// Collects the units of a render, for the NumPy script.
+#[derive(Default)]
+struct Units(Vec<UnitOnset>);
+
+impl RenderObserver for Units {
+    fn unit_started(&mut self, onset: &UnitOnset) {
+        self.0.push(*onset);
+    }
+}
+
 fn bench(c: &mut Criterion) {
+    let mut report = String::new();
     for (name, scene) in [
         ("default scene", Scene::default()),
         ("one hour of pours", hour_of_pours()),
+        ("one hour of follow pouring", hour_of_follow_pouring()),
     ] {
         let mut out = Vec::new();
         let samples = render_into(&scene, &mut out);
@@ -72,17 +104,21 @@ fn bench(c: &mut Criterion) {
             },
         );
         group.finish();
-        report_realtime_factors(name, &scene, samples, &mut out);
+        let line = realtime_factors(name, &scene, samples, &mut out);
+        println!("{line}");
+        writeln!(report, "{line}").expect("a String takes any text");
     }
+    save_report(&report);
 }
 
-/// One line with the figures the project reports: × real time and the ratio to the memory limit,
-/// both measured here in the same run (best of five).
-fn report_realtime_factors(name: &str, scene: &Scene, samples: usize, out: &mut Vec<f32>) {
+/// The line the project quotes for one scene: × real time of the render, of filling the buffer
+/// and of the NumPy synthesis, all measured here in the same run (best of five for the two
+/// Rust figures, one run of the slower NumPy script).
+fn realtime_factors(name: &str, scene: &Scene, samples: usize, out: &mut Vec<f32>) -> String {
     let best = |f: &mut dyn FnMut()| {
         (0..5)
             .map(|_| {
-                let start = std::time::Instant::now();
+                let start = Instant::now();
                 f();
                 start.elapsed().as_secs_f64()
             })
@@ -96,12 +132,129 @@ fn report_realtime_factors(name: &str, scene: &Scene, samples: usize, out: &mut 
         out.resize(samples, 0.0);
     });
     let seconds = samples as f64 / scene.sample_rate as f64;
-    println!(
-        "{name}: render {:.0}× real time; filling the buffer {:.0}× real time; render costs {:.1}× the fill",
+    let numpy = match numpy_synthesis(scene, samples) {
+        Ok((numpy_s, error_db)) => format!(
+            "NumPy unit by unit {:.0}× (its samples {error_db:.0} dB from the render's)",
+            seconds / numpy_s
+        ),
+        Err(why) => format!("NumPy not measured: {why}"),
+    };
+    format!(
+        "{name} ({seconds:.1} s): render {:.0}× real time; filling the buffer {:.0}×; {numpy}",
         seconds / render_s,
         seconds / fill_s,
-        render_s / fill_s
+    )
+}
+
+/// Runs `benches/numpy_glug.py` on the units of one render of `scene`; returns the script's
+/// synthesis time (s) and its largest difference from the render, relative to the render's peak
+/// (dB): a check that it synthesised the same train.
+fn numpy_synthesis(scene: &Scene, samples: usize) -> Result<(f64, f64), String> {
+    let python = python_with_numpy().ok_or("no python3 with numpy found")?;
+    let mut units = Units::default();
+    let mut rendered = Vec::with_capacity(samples);
+    render_scene(
+        scene,
+        |block| {
+            rendered.extend_from_slice(block);
+            Ok::<(), RenderError>(())
+        },
+        &mut units,
+    )
+    .expect("renders");
+    let fs = scene.sample_rate as f64;
+    let mut table = Vec::with_capacity(units.0.len() * 8 * 8);
+    for unit in &units.0 {
+        let onset_s = (unit.sample as f64 + unit.fraction) / fs;
+        let [a1, a2] = unit.component_amplitudes();
+        let [f1, f2] = unit.shape.frequency_hz;
+        let [b1, b2] = unit.shape.decay_per_s;
+        let gain_db = scene.gain_db.value_at(onset_s);
+        for value in [onset_s, a1, a2, f1, f2, b1, b2, gain_db] {
+            table.extend_from_slice(&value.to_le_bytes());
+        }
+    }
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let units_path = dir.path().join("units.f64");
+    let out_path = dir.path().join("out.f32");
+    std::fs::write(&units_path, &table).map_err(|e| e.to_string())?;
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/numpy_glug.py");
+    let output = Command::new(&python)
+        .arg(&script)
+        .arg(&units_path)
+        .arg(samples.to_string())
+        .arg(fs.to_string())
+        .arg(&out_path)
+        .output()
+        .map_err(|e| e.to_string())?;
+    if !output.status.success() {
+        return Err(String::from_utf8_lossy(&output.stderr).into_owned());
+    }
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let seconds: f64 = stdout
+        .trim()
+        .strip_prefix("seconds=")
+        .and_then(|s| s.parse().ok())
+        .ok_or_else(|| format!("unexpected output from the script: {stdout}"))?;
+    let numpy: Vec<f32> = std::fs::read(&out_path)
+        .map_err(|e| e.to_string())?
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    let peak = rendered.iter().fold(0.0f32, |p, y| p.max(y.abs())) as f64;
+    let error = rendered
+        .iter()
+        .zip(&numpy)
+        .fold(0.0f64, |e, (a, b)| e.max((*a as f64 - *b as f64).abs()));
+    Ok((seconds, 20.0 * (error / peak).log10()))
+}
+
+/// The project's virtual environment (made by `cargo xtask test`), else `python3`, if NumPy
+/// imports in it.
+fn python_with_numpy() -> Option<PathBuf> {
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
+    [venv, PathBuf::from("python3")].into_iter().find(|python| {
+        Command::new(python)
+            .args(["-c", "import numpy"])
+            .output()
+            .is_ok_and(|out| out.status.success())
+    })
+}
+
+/// Writes the report with the commit it measured to `<target>/bench-render.md` (the target
+/// directory is found from this executable's path, `<target>/release/deps/render-…`).
+fn save_report(lines: &str) {
+    let Some(target) = std::env::current_exe()
+        .ok()
+        .and_then(|exe| Some(exe.parent()?.parent()?.parent()?.to_owned()))
+    else {
+        return;
+    };
+    let commit = Command::new("git")
+        .args(["describe", "--always", "--dirty"])
+        .output()
+        .ok()
+        .filter(|out| out.status.success())
+        .map_or("unknown".into(), |out| {
+            String::from_utf8_lossy(&out.stdout).trim().to_owned()
+        });
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|info| {
+            info.lines()
+                .find(|line| line.starts_with("model name"))
+                .and_then(|line| line.split(':').nth(1))
+                .map(|name| name.trim().to_owned())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let text = format!(
+        "`cargo bench --bench render` at commit {commit}, one core of {cpu}:\n\n```\n{lines}```\n"
     );
+    let path = target.join("bench-render.md");
+    match std::fs::write(&path, text) {
+        Ok(()) => println!("written to {}", path.display()),
+        Err(error) => println!("cannot write {}: {error}", path.display()),
+    }
 }
 
 criterion_group!(benches, bench);

@@ -41,6 +41,21 @@ impl Lane<'_> {
     pub fn is_constant(&self) -> bool {
         matches!(self, Lane::Constant(_))
     }
+
+    /// Whether the lane has the very same value (bit for bit) at every one of its first `len`
+    /// samples: a constant, or samples that do not change over them.
+    #[inline]
+    pub fn is_constant_over(&self, len: usize) -> bool {
+        match *self {
+            Lane::Constant(_) => true,
+            Lane::Samples(values) => match values.first() {
+                Some(first) => values[..len.min(values.len())]
+                    .iter()
+                    .all(|value| value.to_bits() == first.to_bits()),
+                None => true,
+            },
+        }
+    }
 }
 
 /// The automatable inputs of the model for one block (MODEL.md §1, §5).
@@ -93,6 +108,15 @@ impl<'a> Controls<'a> {
             && self.viscosity.is_constant()
             && self.fill_percent.is_constant()
             && self.pour_time_s.is_constant()
+    }
+
+    /// Whether the pour inputs hold the very same values over the first `len` samples, as
+    /// constants or as samples that do not change (the output gain aside).
+    pub fn pour_is_constant_over(&self, len: usize) -> bool {
+        self.tilt_deg.is_constant_over(len)
+            && self.viscosity.is_constant_over(len)
+            && self.fill_percent.is_constant_over(len)
+            && self.pour_time_s.is_constant_over(len)
     }
 
     /// A block of the same controls starting `offset` samples later.

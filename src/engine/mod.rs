@@ -198,37 +198,39 @@ impl<S: Synthesis> Engine<S> {
         if self.rests_under(controls) {
             return;
         }
-        let constant = controls.pour_is_constant().then(|| controls.values_at(0));
-        // Under constant controls they are read and sanitised once for the whole span.
-        let held = constant.map(ControlValues::sanitized);
         let Self {
             pour,
             voices,
             last_unit,
             ..
         } = self;
-        let mut last_step = None;
-        for index in 0..len {
-            let sample = self.sample + index as u64;
-            let start_unit = |onset: &UnitOnset| {
-                voices.start_unit(onset);
-                *last_unit = Some(*onset);
-                on_unit(onset);
-            };
-            let step = match held {
-                // Nothing can have changed since the span's first sample: refills only happen
-                // between calls, and the controls are the same.
-                Some(values) if index > 0 => pour.step_steady(sample, values.viscosity, start_unit),
-                Some(values) => pour.step_sanitized(sample, &values, start_unit),
-                None => {
-                    pour.step_sanitized(sample, &controls.values_at(index).sanitized(), start_unit)
-                }
-            };
-            if step.amount_ml > 0.0 {
-                self.active_until = sample + 1;
-            }
-            last_step = Some(step);
+        let mut start_unit = |onset: &UnitOnset| {
+            voices.start_unit(onset);
+            *last_unit = Some(*onset);
+            on_unit(onset);
+        };
+        // Constant over the span, as constants or as samples that do not change (a ramp's end
+        // inside the block).
+        let constant = controls
+            .pour_is_constant_over(len)
+            .then(|| controls.values_at(0));
+        let advanced = match constant {
+            // Under constant controls the pour takes the span at once (plain samples in closed
+            // form, the same numbers as one step per sample).
+            Some(values) => pour.advance(
+                self.sample,
+                len as u64,
+                &values.sanitized(),
+                &mut start_unit,
+            ),
+            // Otherwise the levels of the span are worked out at once, and the rest stepped
+            // sample by sample (the same numbers as `Pour::step`).
+            None => pour.advance_varying(self.sample, controls, len, &mut start_unit),
+        };
+        if let Some(until) = advanced.flowed_until {
+            self.active_until = until;
         }
+        let last_step = (len > 0).then_some(advanced.last);
         self.resting_under = match last_step {
             Some(step) if step.amount_ml == 0.0 && !step.refilled => constant,
             _ => None,

@@ -23,17 +23,7 @@ impl Automation {
     pub fn value_at(&self, time_s: f64) -> f64 {
         match self {
             Automation::Constant(value) => *value,
-            Automation::Points(points) => {
-                let segment = segment_at(points, time_s);
-                if segment == 0 {
-                    points[0].1
-                } else if segment == points.len() {
-                    points[points.len() - 1].1
-                } else {
-                    let ((t0, v0), (t1, v1)) = (points[segment - 1], points[segment]);
-                    v0 + (v1 - v0) * (time_s - t0) / (t1 - t0)
-                }
-            }
+            Automation::Points(points) => value_in(points, segment_at(points, time_s), time_s),
         }
     }
 
@@ -57,15 +47,42 @@ impl Automation {
     }
 
     /// The lane for the samples `first_sample .. first_sample + buffer.len()`: a constant when the
-    /// value cannot change over them (so the engine may skip work), else `buffer` filled.
+    /// value cannot change over them (so the engine may skip work), else `buffer` filled with
+    /// [`Automation::value_at`] of every sample's time. The points are looked up once per
+    /// segment, not once per sample: the samples of one segment are filled in one pass.
     pub fn lane<'a>(&self, first_sample: u64, sample_rate: f64, buffer: &'a mut [f64]) -> Lane<'a> {
         let time_of = |index: usize| (first_sample + index as u64) as f64 / sample_rate;
         if let Some(value) = self.constant_over(time_of(0), time_of(buffer.len().saturating_sub(1)))
         {
             return Lane::Constant(value);
         }
-        for (index, value) in buffer.iter_mut().enumerate() {
-            *value = self.value_at(time_of(index));
+        let Automation::Points(points) = self else {
+            unreachable!("a constant automation is constant over any samples")
+        };
+        let mut start = 0;
+        let mut segment = segment_at(points, time_of(0));
+        while start < buffer.len() {
+            // The samples before the next point's time stay in this segment; times grow with
+            // the sample index, so the first sample at or past it is found from a guess.
+            let end = match points.get(segment) {
+                Some(&(next_point_s, _)) => {
+                    let guess = (next_point_s * sample_rate).ceil() - first_sample as f64;
+                    let mut end = guess.clamp(start as f64, buffer.len() as f64) as usize;
+                    while end > start && time_of(end - 1) >= next_point_s {
+                        end -= 1;
+                    }
+                    while end < buffer.len() && time_of(end) < next_point_s {
+                        end += 1;
+                    }
+                    end
+                }
+                None => buffer.len(),
+            };
+            fill_segment(points, segment, &mut buffer[start..end], |index| {
+                time_of(start + index)
+            });
+            start = end;
+            segment += 1;
         }
         Lane::Samples(buffer)
     }
@@ -87,6 +104,39 @@ impl Automation {
 /// The index of the first point later than `time_s`: 0 before the first, `len` after the last.
 fn segment_at(points: &[(f64, f64)], time_s: f64) -> usize {
     points.partition_point(|point| point.0 <= time_s)
+}
+
+/// The value at `time_s`, which lies in `segment` (as [`segment_at`] gives it).
+#[inline]
+fn value_in(points: &[(f64, f64)], segment: usize, time_s: f64) -> f64 {
+    if segment == 0 {
+        points[0].1
+    } else if segment == points.len() {
+        points[points.len() - 1].1
+    } else {
+        let ((t0, v0), (t1, v1)) = (points[segment - 1], points[segment]);
+        v0 + (v1 - v0) * (time_s - t0) / (t1 - t0)
+    }
+}
+
+/// Fills `values` with the value at `time_of(index)`, every time lying in `segment`: a held
+/// value, or the same interpolation as [`value_in`] in a loop the compiler can vectorise.
+#[inline]
+fn fill_segment(
+    points: &[(f64, f64)],
+    segment: usize,
+    values: &mut [f64],
+    time_of: impl Fn(usize) -> f64,
+) {
+    if segment == 0 || segment == points.len() {
+        values.fill(value_in(points, segment, 0.0));
+        return;
+    }
+    let ((t0, v0), (t1, v1)) = (points[segment - 1], points[segment]);
+    let (rise, run) = (v1 - v0, t1 - t0);
+    for (index, value) in values.iter_mut().enumerate() {
+        *value = v0 + rise * (time_of(index) - t0) / run;
+    }
 }
 
 /// An automatable value as a scene file writes it: inline, or read from a CSV take that is
@@ -230,6 +280,38 @@ mod tests {
         assert_eq!(ramp.value_at(1.0), 0.0);
         assert_eq!(ramp.value_at(9.0), 0.0);
         assert_eq!(ramp.last_time_s(), 1.0);
+    }
+
+    #[test]
+    fn lanes_hold_the_value_of_every_sample_time() {
+        // Steps, ramps, holds and points between samples, at sample rates whose sample times
+        // are inexact, over blocks that start anywhere.
+        let automation = Automation::Points(vec![
+            (0.0, 90.0),
+            (0.013, 135.0),
+            (0.0131, 135.0),
+            (0.0131, 10.0),
+            (0.05, 170.0),
+            (0.05, 170.0),
+            (0.051, 0.0),
+            (0.07, 33.3),
+        ]);
+        for sample_rate in [1_000.0, 44_100.0, 48_000.0, 96_000.0] {
+            let mut buffer = vec![0.0; 700];
+            for first_sample in [0u64, 1, 333, 571, 2_205, 4_799] {
+                for len in [1, 2, 63, 700] {
+                    let lane = automation.lane(first_sample, sample_rate, &mut buffer[..len]);
+                    for index in 0..len {
+                        let time_s = (first_sample + index as u64) as f64 / sample_rate;
+                        assert_eq!(
+                            lane.at(index).to_bits(),
+                            automation.value_at(time_s).to_bits(),
+                            "{sample_rate} Hz, sample {first_sample} + {index}"
+                        );
+                    }
+                }
+            }
+        }
     }
 
     #[test]

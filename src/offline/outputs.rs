@@ -124,7 +124,8 @@ pub struct RenderReport {
     pub summary: RenderSummary,
     /// Audible glugs (those the clips mark).
     pub audible_glugs: usize,
-    /// Amplitude breakpoints of the felt envelope written to the clips.
+    /// Amplitude breakpoints of the felt envelope written to the clips (0 when the render wrote
+    /// no `.haptic`, `.ahap` or plot).
     pub envelope_breakpoints: usize,
     /// Each file written, with its size in bytes.
     pub files: Vec<(PathBuf, u64)>,
@@ -213,7 +214,19 @@ pub fn render_to_files(
         scene_name,
         seed: scene.config.seed,
     };
-    let breakpoints = clips::envelope_breakpoints(&source);
+    // The felt envelope is worked out only for the files that carry it (it costs about as much
+    // as the render of a pour itself).
+    let carries_envelope = formats.iter().any(|format| {
+        matches!(
+            format,
+            OutputFormat::Haptic | OutputFormat::Ahap | OutputFormat::Plot
+        )
+    });
+    let breakpoints = if carries_envelope {
+        clips::envelope_breakpoints(&source)
+    } else {
+        Vec::new()
+    };
     let mut finished: Vec<Finished> = Vec::new();
     for wav in wavs {
         finished.push(Finished::Wav(wav));

@@ -142,8 +142,11 @@ impl StabilityCase {
     pub fn time_reference(self) -> &'static str {
         match self {
             StabilityCase::DecaySweep => "the same pour with B = 0 (most work, no small values)",
-            StabilityCase::FrequencySweep | StabilityCase::TiltFlip => {
-                "continuous pouring (follow mode, 135°)"
+            StabilityCase::FrequencySweep => "continuous pouring (follow mode, 135°)",
+            StabilityCase::TiltFlip => {
+                "continuous pouring with the tilt moving at every sample (follow mode, a slow \
+                 sweep from 100° to 170°): under constant controls the pour takes a period at \
+                 once, under a moving tilt sample by sample, like the flip"
             }
             StabilityCase::SampleRateSweep => "continuous pouring at 48 kHz, per sample",
             StabilityCase::Flood => {
@@ -738,7 +741,17 @@ fn flood(scale: Scale) -> Vec<Outcome> {
 fn tilt_flip(scale: Scale) -> Vec<Outcome> {
     let fs = 48_000.0;
     let seconds = scale.sweep_s();
-    let normal = normal(fs, seconds, scale);
+    let sweep_samples = seconds * fs;
+    let sweep = move |sample: u64| {
+        (
+            ControlValues {
+                tilt_deg: 100.0 + 70.0 * (sample as f64 / sweep_samples),
+                ..ControlValues::default()
+            },
+            -6.0,
+        )
+    };
+    let normal = run(fs, follow(), seconds, &sweep, scale.repeats());
     let flip = |sample: u64| {
         (
             ControlValues {

@@ -3,15 +3,21 @@
 //! - `cargo xtask pour`: build the plugin bundles and render the built-in scene to `pour.wav`.
 //! - `cargo xtask test`: every test: formatting and lints, the Rust suites, then the bundles in a
 //!   real VST3 host.
-//! - `cargo xtask docs`: regenerates the generated blocks of docs/ from the current code.
+//! - `cargo xtask docs [--bench]`: regenerates the generated blocks of docs/ from the current
+//!   code, the cost figures of docs/scaling.md among them (callgrind, when valgrind is installed;
+//!   the render benchmark's last report, or a new one with `--bench`).
 //!
 //! Each product is built with only its features: the bundles with `editor` (which brings
 //! `plugin`), the command line with `cli`, so neither compiles the other's crates.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn main() -> nice_plug_xtask::Result<()> {
+    // Read before nice-plug's bundler runs: it clears cargo's variables for its own builds.
+    TARGET_DIR.get_or_init(|| {
+        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| PathBuf::from("target"), PathBuf::from)
+    });
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         Some("pour") => {
@@ -40,7 +46,8 @@ fn main() -> nice_plug_xtask::Result<()> {
         Some("docs") => {
             nice_plug_xtask::chdir_workspace_root()?;
             build_cli()?;
-            docs()
+            docs()?;
+            scaling_docs(args.iter().any(|arg| arg == "--bench"))
         }
         _ => nice_plug_xtask::main(),
     }
@@ -76,10 +83,25 @@ fn build_cli() -> nice_plug_xtask::Result<()> {
     ])
 }
 
+/// Where cargo builds: `$CARGO_TARGET_DIR` as the xtask started with it, else `target/`.
+static TARGET_DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+
+fn target_dir() -> PathBuf {
+    TARGET_DIR.get_or_init(|| PathBuf::from("target")).clone()
+}
+
+/// The release command line that `build_cli` built.
+fn cli() -> String {
+    target_dir()
+        .join("release/sake-glug")
+        .to_string_lossy()
+        .into_owned()
+}
+
 /// Regenerates what docs/ shows from the code: each generated block is the output of a command
 /// of the release CLI, written between its markers.
 fn docs() -> nice_plug_xtask::Result<()> {
-    let catalogue = output("target/release/sake-glug", &["stability", "--catalogue"])?;
+    let catalogue = output(&cli(), &["stability", "--catalogue"])?;
     replace_block("docs/stability.md", "stability-catalogue", &catalogue)?;
     // The presets as scene files, from the presets the plugin's menu offers.
     std::fs::create_dir_all("presets")?;
@@ -90,16 +112,163 @@ fn docs() -> nice_plug_xtask::Result<()> {
         println!("presets/{id}.toml written");
     }
     // The README's example of the pour plot: the default scene.
+    let clip = target_dir().join("pour-plot.haptic");
     run(
-        "target/release/sake-glug",
+        &cli(),
         &[
             "render",
             "-o",
-            "target/pour-plot.haptic",
+            &clip.to_string_lossy(),
             "--plot",
             "docs/pour-plot.png",
         ],
     )
+}
+
+/// Seconds of the two renders whose difference gives the cost of a minute of pouring: start-up,
+/// scene parsing and file creation cancel out.
+const CALLGRIND_RENDERS_S: [u32; 2] = [1, 61];
+
+/// docs/scaling.md's cost figures: instructions per output sample from callgrind (when valgrind
+/// is installed), and the render benchmark's report (run first with `bench`).
+fn scaling_docs(bench: bool) -> nice_plug_xtask::Result<()> {
+    if Command::new("valgrind").arg("--version").output().is_ok() {
+        let figure = instructions_per_sample()?;
+        replace_block("docs/scaling.md", "callgrind", &figure)?;
+    } else {
+        println!("valgrind is not installed: docs/scaling.md keeps its callgrind figure");
+    }
+    if bench {
+        cargo(&["bench", "--bench", "render"])?;
+    }
+    let report = target_dir().join("bench-render.md");
+    match std::fs::read_to_string(&report) {
+        Ok(text) => replace_block("docs/scaling.md", "bench-render", &text),
+        Err(_) => {
+            println!(
+                "no {} (`cargo bench --bench render` writes it): docs/scaling.md keeps its \
+                 bench figures",
+                report.display()
+            );
+            Ok(())
+        }
+    }
+}
+
+/// Instructions per output sample of `sake-glug render` on a minute of continuous pouring
+/// (follow mode, held full at 135°, writing an f32 WAV): callgrind's count for a 61 s render
+/// less that for a 1 s render, over 60 s of samples.
+fn instructions_per_sample() -> nice_plug_xtask::Result<String> {
+    let sample_rate = 48_000u64;
+    let dir = target_dir().join("callgrind");
+    std::fs::create_dir_all(&dir)?;
+    let mut counts = Vec::new();
+    for seconds in CALLGRIND_RENDERS_S {
+        let scene = dir.join(format!("pouring-{seconds}s.toml"));
+        std::fs::write(
+            &scene,
+            format!(
+                "sample_rate = {sample_rate}\nduration_s = {seconds}\ntilt_deg = 135.0\n\
+                 [output]\ndrain = \"follow\"\n"
+            ),
+        )?;
+        let profile = dir.join(format!("pouring-{seconds}s.callgrind"));
+        let wav = dir.join(format!("pouring-{seconds}s.wav"));
+        let status = Command::new("valgrind")
+            .arg("--tool=callgrind")
+            .arg(format!("--callgrind-out-file={}", profile.display()))
+            .arg(cli())
+            .arg("render")
+            .arg(&scene)
+            .arg("-o")
+            .arg(&wav)
+            .output()?
+            .status;
+        if !status.success() {
+            anyhow::bail!("callgrind of the {seconds} s render failed ({status})");
+        }
+        let text = std::fs::read_to_string(&profile)?;
+        let total: u64 = text
+            .lines()
+            .find_map(|line| line.strip_prefix("summary:"))
+            .and_then(|count| count.trim().parse().ok())
+            .ok_or_else(|| anyhow::anyhow!("{} has no summary line", profile.display()))?;
+        counts.push((seconds, total, profile));
+    }
+    let [(short_s, short, ref short_profile), (long_s, long, ref long_profile)] =
+        [counts[0].clone(), counts[1].clone()];
+    let samples = (long_s - short_s) as u64 * sample_rate;
+    let per_sample = long.saturating_sub(short) as f64 / samples as f64;
+    let mut text = format!(
+        "At commit {}: **{per_sample:.1} instructions per output sample** ({long} instructions \
+         for {long_s} s, {short} for {short_s} s, {samples} samples apart; \
+         `valgrind --tool=callgrind`, release CLI, f32 WAV at {sample_rate} Hz).\n\n\
+         Where they go (each function's own instructions, the same difference):\n\n\
+         | instructions per sample | function |\n|---:|---|\n",
+        commit()
+    );
+    let short_costs = function_costs(short_profile)?;
+    let mut rows: Vec<(f64, String)> = function_costs(long_profile)?
+        .into_iter()
+        .map(|(function, cost)| {
+            let before = short_costs.get(&function).copied().unwrap_or(0);
+            (
+                cost.saturating_sub(before) as f64 / samples as f64,
+                function,
+            )
+        })
+        .collect();
+    rows.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let shown = rows.iter().take_while(|(cost, _)| *cost >= 0.1).take(12);
+    let mut listed = 0.0;
+    for (cost, function) in shown {
+        text.push_str(&format!("| {cost:.1} | `{function}` |\n"));
+        listed += cost;
+    }
+    text.push_str(&format!(
+        "| {:.1} | everything else |\n",
+        per_sample - listed
+    ));
+    Ok(text)
+}
+
+/// Each function's own instruction count in a callgrind profile, as `callgrind_annotate` lists
+/// them (the binary's name dropped).
+fn function_costs(
+    profile: &Path,
+) -> nice_plug_xtask::Result<std::collections::HashMap<String, u64>> {
+    let listing = output(
+        "callgrind_annotate",
+        &["--threshold=100", &profile.to_string_lossy()],
+    )?;
+    let mut costs = std::collections::HashMap::new();
+    for line in listing.lines() {
+        let Some((count, rest)) = line.trim_start().split_once(' ') else {
+            continue;
+        };
+        let Ok(count) = count.replace(',', "").parse::<u64>() else {
+            continue;
+        };
+        let Some((_, location)) = rest.split_once(')') else {
+            continue;
+        };
+        let location = location.trim();
+        let function = location
+            .split_once(':')
+            .map_or(location, |(_, function)| function);
+        let function = function.split(" [").next().unwrap_or(function).trim();
+        if function.is_empty() || location.starts_with("PROGRAM TOTALS") {
+            continue;
+        }
+        *costs.entry(function.to_owned()).or_insert(0) += count;
+    }
+    Ok(costs)
+}
+
+/// The commit the docs are generated from, marked `-dirty` with uncommitted changes.
+fn commit() -> String {
+    output("git", &["describe", "--always", "--dirty"])
+        .map_or_else(|_| "unknown".into(), |text| text.trim().to_owned())
 }
 
 /// Replaces the text between `<!-- generated:NAME:begin -->` and `<!-- generated:NAME:end -->`.

@@ -1,6 +1,6 @@
 //! The bottle's residual volume and its tilt-dependent drain (MODEL.md §2, §3, §8).
 
-use super::curves::{FLOW, REST, SUBMERGED};
+use super::curves::{CurveSegment, FLOW, REST, SUBMERGED};
 use crate::engine::config::{ControlValues, DrainMode, ModelConfig};
 
 /// What one sample of pouring did.
@@ -18,11 +18,66 @@ pub struct Outflow {
 
 /// Levels that depend only on tilt, pour time and capacity, kept until one of those changes.
 #[derive(Debug, Clone, Copy)]
-struct Levels {
+pub struct Levels {
     key: [f64; 3],
-    rest_ml: f64,
-    submerged_ml: f64,
-    max_outflow_per_sample_ml: f64,
+    /// r(θ)·C: the liquid above it pours.
+    pub rest_ml: f64,
+    /// s(θ)·C: above it the mouth is submerged and the pour glugs.
+    pub submerged_ml: f64,
+    /// k(θ)/fs: the most that can leave in one sample.
+    pub max_outflow_per_sample_ml: f64,
+}
+
+impl Levels {
+    /// The outflow of a sample that starts at `volume_ml` (MODEL.md §3).
+    #[inline]
+    pub fn outflow_ml(&self, volume_ml: f64) -> f64 {
+        self.max_outflow_per_sample_ml
+            .min((volume_ml - self.rest_ml).max(0.0))
+    }
+}
+
+/// The levels of each sample of a span (see [`Bottle::levels_of_span`]).
+pub struct SpanLevels {
+    rest_ml: [f64; SPAN],
+    submerged_ml: [f64; SPAN],
+    max_outflow_ml: [f64; SPAN],
+}
+
+/// The most samples a [`SpanLevels`] holds: a grid period.
+pub const SPAN: usize = crate::engine::GRID;
+
+impl Default for SpanLevels {
+    fn default() -> Self {
+        Self {
+            rest_ml: [0.0; SPAN],
+            submerged_ml: [0.0; SPAN],
+            max_outflow_ml: [0.0; SPAN],
+        }
+    }
+}
+
+impl SpanLevels {
+    /// r·C, s·C and k/fs of sample `index`.
+    #[inline]
+    pub fn of(&self, index: usize) -> (f64, f64, f64) {
+        (
+            self.rest_ml[index],
+            self.submerged_ml[index],
+            self.max_outflow_ml[index],
+        )
+    }
+
+    /// The levels of sample `index`, whose controls give `key`.
+    #[inline]
+    pub fn at(&self, index: usize, key: [f64; 3]) -> Levels {
+        Levels {
+            key,
+            rest_ml: self.rest_ml[index],
+            submerged_ml: self.submerged_ml[index],
+            max_outflow_per_sample_ml: self.max_outflow_ml[index],
+        }
+    }
 }
 
 pub struct Bottle {
@@ -31,6 +86,9 @@ pub struct Bottle {
     refill_pending: bool,
     last_fill_percent: f64,
     levels: Levels,
+    /// The segments of r, s and h that the last tilt fell in: a tilt that moves a little from
+    /// sample to sample rarely leaves them.
+    segments: [CurveSegment; 3],
 }
 
 impl Bottle {
@@ -46,11 +104,49 @@ impl Bottle {
                 submerged_ml: 0.0,
                 max_outflow_per_sample_ml: 0.0,
             },
+            segments: [CurveSegment::default(); 3],
         }
     }
 
     pub fn volume_ml(&self) -> f64 {
         self.volume_ml
+    }
+
+    /// Sets V after steps taken elsewhere in closed form (see `super::span`).
+    pub fn set_volume_ml(&mut self, volume_ml: f64) {
+        self.volume_ml = volume_ml;
+    }
+
+    /// The levels of the last step.
+    pub fn current_levels(&self) -> &Levels {
+        &self.levels
+    }
+
+    /// Whether a [`Bottle::step`] under `controls` would be a [`Bottle::step_steady`]: no refill
+    /// pending, the same fill level, and the levels of the last step. (In follow mode V is the
+    /// fill level already, set by that step.)
+    #[inline]
+    pub fn is_steady_under(&self, controls: &ControlValues, capacity_ml: f64) -> bool {
+        !self.refill_pending
+            && controls.fill_percent == self.last_fill_percent
+            && [controls.tilt_deg, controls.pour_time_s, capacity_ml] == self.levels.key
+    }
+
+    /// Whether no sample of a span with these fill levels refills the bottle: no refill is
+    /// pending, and in simulate mode the fill level stays the last one.
+    pub fn refills_none_of(&self, fill_percents: &[f64], drain: DrainMode) -> bool {
+        !self.refill_pending
+            && (drain == DrainMode::Follow
+                || fill_percents
+                    .iter()
+                    .fold(true, |same, &fill| same & (fill == self.last_fill_percent)))
+    }
+
+    /// Takes the state after a span stepped elsewhere, sample by sample with the arithmetic of
+    /// [`Bottle::step_with`] (see `Pour::advance_varying`): V, and the last fill level seen.
+    pub fn end_span(&mut self, volume_ml: f64, last_fill_percent: f64) {
+        self.volume_ml = volume_ml;
+        self.last_fill_percent = last_fill_percent;
     }
 
     /// Fills the bottle to the fill level that the next sample carries.
@@ -61,20 +157,30 @@ impl Bottle {
     /// Advances one sample; `controls` must be sanitised.
     #[inline]
     pub fn step(&mut self, controls: &ControlValues, config: &ModelConfig) -> Outflow {
-        let fill_ml = controls.fill_percent / 100.0 * config.capacity_ml;
-        let fill_changed = controls.fill_percent != self.last_fill_percent;
-        self.last_fill_percent = controls.fill_percent;
+        let levels = self.levels(controls, config.capacity_ml);
+        self.step_with(controls.fill_percent, &levels, config)
+    }
+
+    /// [`Bottle::step`] with the levels of its controls worked out already (by
+    /// [`Bottle::levels_of_span`]).
+    #[inline]
+    pub fn step_with(
+        &mut self,
+        fill_percent: f64,
+        levels: &Levels,
+        config: &ModelConfig,
+    ) -> Outflow {
+        let fill_ml = fill_percent / 100.0 * config.capacity_ml;
+        let fill_changed = fill_percent != self.last_fill_percent;
+        self.last_fill_percent = fill_percent;
         let refilled = self.refill_pending || (config.drain == DrainMode::Simulate && fill_changed);
         self.refill_pending = false;
         if refilled || config.drain == DrainMode::Follow {
             self.volume_ml = fill_ml;
         }
 
-        let levels = self.levels(controls, config.capacity_ml);
         let volume_before_ml = self.volume_ml;
-        let amount_ml = levels
-            .max_outflow_per_sample_ml
-            .min((volume_before_ml - levels.rest_ml).max(0.0));
+        let amount_ml = levels.outflow_ml(volume_before_ml);
         if config.drain == DrainMode::Simulate {
             self.volume_ml = volume_before_ml - amount_ml;
         }
@@ -86,15 +192,55 @@ impl Bottle {
         }
     }
 
+    /// The levels of every sample of a span whose tilt (and perhaps pour time) changes from
+    /// sample to sample, into `levels`: the very values [`Bottle::step`] would work out one by
+    /// one, in loops that vectorise (a curve is interpolated over the whole span when every tilt
+    /// of it falls in one segment). The last sample's levels become the bottle's.
+    pub fn levels_of_span(
+        &mut self,
+        tilts: &[f64],
+        pour_times: &[f64],
+        capacity_ml: f64,
+        levels: &mut SpanLevels,
+    ) {
+        let len = tilts.len();
+        let [rest, submerged, flow] = &mut self.segments;
+        REST.fill(tilts, &mut levels.rest_ml[..len], rest);
+        SUBMERGED.fill(tilts, &mut levels.submerged_ml[..len], submerged);
+        FLOW.fill(tilts, &mut levels.max_outflow_ml[..len], flow);
+        let sample_rate = self.sample_rate;
+        for (rest, submerged) in levels.rest_ml[..len]
+            .iter_mut()
+            .zip(&mut levels.submerged_ml[..len])
+        {
+            *rest *= capacity_ml;
+            *submerged *= capacity_ml;
+        }
+        let flows = levels.max_outflow_ml[..len].iter_mut();
+        let first_pour_time = pour_times.first().copied().unwrap_or(f64::NAN);
+        if pour_times.iter().all(|&time| time == first_pour_time) {
+            // C/T once for the span: the same quotient at every sample.
+            let rate_scale = capacity_ml / first_pour_time;
+            for flow in flows {
+                *flow = rate_scale * *flow / sample_rate;
+            }
+        } else {
+            for (flow, pour_time) in flows.zip(pour_times) {
+                *flow = capacity_ml / pour_time * *flow / sample_rate;
+            }
+        }
+        if let Some(last) = len.checked_sub(1) {
+            self.levels = levels.at(last, [tilts[last], pour_times[last], capacity_ml]);
+        }
+    }
+
     /// [`Bottle::step`] again under the controls of the previous step: no refill can be pending
     /// and no level can have changed, so only the volume moves. Same arithmetic, same result.
     #[inline]
     pub fn step_steady(&mut self, drain: DrainMode) -> Outflow {
         let levels = &self.levels;
         let volume_before_ml = self.volume_ml;
-        let amount_ml = levels
-            .max_outflow_per_sample_ml
-            .min((volume_before_ml - levels.rest_ml).max(0.0));
+        let amount_ml = levels.outflow_ml(volume_before_ml);
         if drain == DrainMode::Simulate {
             self.volume_ml = volume_before_ml - amount_ml;
         }
@@ -111,11 +257,12 @@ impl Bottle {
         let key = [controls.tilt_deg, controls.pour_time_s, capacity_ml];
         if key != self.levels.key {
             let tilt = controls.tilt_deg;
-            let rate_ml_per_s = capacity_ml / controls.pour_time_s * FLOW.at(tilt);
+            let [rest, submerged, flow] = &mut self.segments;
+            let rate_ml_per_s = capacity_ml / controls.pour_time_s * FLOW.at_in(tilt, flow);
             self.levels = Levels {
                 key,
-                rest_ml: REST.at(tilt) * capacity_ml,
-                submerged_ml: SUBMERGED.at(tilt) * capacity_ml,
+                rest_ml: REST.at_in(tilt, rest) * capacity_ml,
+                submerged_ml: SUBMERGED.at_in(tilt, submerged) * capacity_ml,
                 max_outflow_per_sample_ml: rate_ml_per_s / self.sample_rate,
             };
         }

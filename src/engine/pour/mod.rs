@@ -3,19 +3,87 @@
 
 mod bottle;
 mod curves;
+mod exact;
 mod onsets;
 mod randomness;
+mod span;
 
 pub use bottle::Outflow;
-pub use curves::{TiltCurve, FLOW, REST, SUBMERGED};
+pub use curves::{CurveSegment, TiltCurve, FLOW, REST, SUBMERGED};
 pub use onsets::MAX_ONSETS_PER_SAMPLE;
 pub use randomness::UnitShape;
 
 use crate::engine::amplitude::unit_amplitude;
-use crate::engine::config::{ControlValues, ModelConfig};
-use bottle::Bottle;
+use crate::engine::config::{
+    ControlValues, DrainMode, ModelConfig, Range, FILL_PERCENT, POUR_TIME_S, TILT_DEG, VISCOSITY,
+};
+use crate::engine::controls::{Controls, Lane};
+use bottle::{Bottle, SpanLevels, SPAN};
+use exact::Direction;
 use onsets::OnsetDetector;
 use randomness::UnitDraws;
+use span::{PlainRun, PourState};
+
+/// The inputs of up to a grid period of samples, brought into range.
+struct SpanInputs {
+    tilt_deg: [f64; SPAN],
+    viscosity: [f64; SPAN],
+    fill_percent: [f64; SPAN],
+    pour_time_s: [f64; SPAN],
+}
+
+impl Default for SpanInputs {
+    fn default() -> Self {
+        Self {
+            tilt_deg: [0.0; SPAN],
+            viscosity: [0.0; SPAN],
+            fill_percent: [0.0; SPAN],
+            pour_time_s: [0.0; SPAN],
+        }
+    }
+}
+
+impl SpanInputs {
+    /// The first `len` ≤ [`SPAN`] samples of `controls`, each as
+    /// [`ControlValues::sanitized`] would give it.
+    fn read(&mut self, controls: &Controls, len: usize) {
+        read_lane(&controls.tilt_deg, &mut self.tilt_deg[..len], TILT_DEG);
+        read_lane(&controls.viscosity, &mut self.viscosity[..len], VISCOSITY);
+        read_lane(
+            &controls.fill_percent,
+            &mut self.fill_percent[..len],
+            FILL_PERCENT,
+        );
+        read_lane(
+            &controls.pour_time_s,
+            &mut self.pour_time_s[..len],
+            POUR_TIME_S,
+        );
+    }
+}
+
+/// The first `values.len()` samples of `lane`, brought into `range`.
+#[inline]
+fn read_lane(lane: &Lane, values: &mut [f64], range: Range) {
+    match *lane {
+        Lane::Constant(value) => values.fill(range.sanitize(value)),
+        Lane::Samples(samples) if samples.len() >= values.len() => {
+            for (value, &sample) in values.iter_mut().zip(samples) {
+                *value = range.sanitize(sample);
+            }
+        }
+        Lane::Samples(_) => {
+            for (index, value) in values.iter_mut().enumerate() {
+                *value = range.sanitize(lane.at(index));
+            }
+        }
+    }
+}
+
+/// After n plans in a row found no plain sample ahead, 2^n − 1 samples (at most 2^6 − 1) are
+/// stepped one by one before the next plan: a state that the closed form cannot take (a tie in
+/// the rounding) then costs a plan only now and then.
+const MAX_PLAN_BACKOFF_LOG2: u32 = 6;
 
 /// One wave unit as it starts (the inputs of §5).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -53,6 +121,15 @@ pub struct PourStats {
     pub units_skipped: u64,
 }
 
+/// What [`Pour::advance`] did over its samples.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Advanced {
+    /// The last sample's outflow.
+    pub last: Outflow,
+    /// The sample after the last one during which liquid flowed, if any did.
+    pub flowed_until: Option<u64>,
+}
+
 /// The pour: bottle, onset accumulator and random draws, turning the controls, sample by
 /// sample, into unit onsets.
 pub struct Pour {
@@ -61,6 +138,14 @@ pub struct Pour {
     onsets: OnsetDetector,
     draws: UnitDraws,
     stats: PourStats,
+    /// The plain samples ahead under the controls of the last step, once planned.
+    plain: Option<PlainRun>,
+    /// Per-sample steps to take before planning again, after a plan found none.
+    plan_backoff: u32,
+    /// Plans in a row that found no plain sample.
+    plans_failed: u32,
+    /// The next step must check for changes: the constants changed since the last one.
+    config_changed: bool,
 }
 
 impl Pour {
@@ -74,6 +159,10 @@ impl Pour {
             onsets: OnsetDetector::default(),
             draws: UnitDraws::new(config.seed),
             stats: PourStats::default(),
+            plain: None,
+            plan_backoff: 0,
+            plans_failed: 0,
+            config_changed: true,
         }
     }
 
@@ -85,6 +174,8 @@ impl Pour {
     /// New constants take effect from the next sample; a new seed at the next reset.
     pub fn set_config(&mut self, config: ModelConfig) {
         self.config = config.sanitized();
+        self.config_changed = true;
+        self.plain = None;
     }
 
     /// MODEL.md §8 reset: refill, re-seed, clear the counts.
@@ -93,11 +184,13 @@ impl Pour {
         self.onsets.clear();
         self.draws.reseed(self.config.seed);
         self.stats = PourStats::default();
+        self.plain = None;
     }
 
     /// MODEL.md §8 refill: the generator goes on.
     pub fn refill(&mut self) {
         self.bottle.refill();
+        self.plain = None;
     }
 
     /// Residual volume V after the last step (ml).
@@ -130,11 +223,254 @@ impl Pour {
         controls: &ControlValues,
         emit: impl FnMut(&UnitOnset),
     ) -> Outflow {
+        self.plain = None;
+        self.config_changed = false;
         let outflow = self.bottle.step(controls, &self.config);
         if outflow.refilled {
             self.onsets.clear();
         }
         self.count_onsets(sample, controls.viscosity, outflow, emit)
+    }
+
+    /// `count` samples from `first_sample` under the same `controls` (already brought into
+    /// range), with the same onsets, outflows and volumes as `count` calls of
+    /// [`Pour::step_sanitized`]: plain samples are taken in closed form (see [`span`]), the
+    /// others one by one.
+    pub fn advance(
+        &mut self,
+        first_sample: u64,
+        count: u64,
+        controls: &ControlValues,
+        mut emit: impl FnMut(&UnitOnset),
+    ) -> Advanced {
+        let mut advanced = Advanced {
+            last: Outflow {
+                volume_before_ml: self.bottle.volume_ml(),
+                amount_ml: 0.0,
+                submerged: false,
+                refilled: false,
+            },
+            flowed_until: None,
+        };
+        let mut done = 0;
+        if count > 0
+            && (self.config_changed
+                || !self
+                    .bottle
+                    .is_steady_under(controls, self.config.capacity_ml))
+        {
+            advanced.last = self.step_sanitized(first_sample, controls, &mut emit);
+            done = 1;
+            if advanced.last.amount_ml > 0.0 {
+                advanced.flowed_until = Some(first_sample + 1);
+            }
+        }
+        while done < count {
+            let sample = first_sample + done;
+            if self.plain.is_none() && self.plan_backoff == 0 {
+                self.plain = PlainRun::plan(&self.state());
+                if self.plain.is_some() {
+                    self.plans_failed = 0;
+                } else {
+                    // Mostly the very next sample alone is special (an onset, a binade edge);
+                    // a state that keeps failing is planned for ever more rarely.
+                    self.plan_backoff = (1 << self.plans_failed.min(MAX_PLAN_BACKOFF_LOG2)) - 1;
+                    self.plans_failed += 1;
+                }
+            }
+            match &mut self.plain {
+                Some(run) => {
+                    let taken = run.samples_left.min(count - done);
+                    run.samples_left -= taken;
+                    let run = *run;
+                    if run.samples_left == 0 {
+                        self.plain = None;
+                    }
+                    advanced.last = self.take_plain(&run, taken);
+                    if run.amount_ml > 0.0 {
+                        advanced.flowed_until = Some(sample + taken);
+                    }
+                    done += taken;
+                }
+                None => {
+                    self.plan_backoff = self.plan_backoff.saturating_sub(1);
+                    advanced.last = self.step_steady(sample, controls.viscosity, &mut emit);
+                    if advanced.last.amount_ml > 0.0 {
+                        advanced.flowed_until = Some(sample + 1);
+                    }
+                    done += 1;
+                }
+            }
+        }
+        advanced
+    }
+
+    /// `count` samples from `first_sample` whose controls may change from sample to sample: the
+    /// same onsets, outflows and volumes as `count` calls of [`Pour::step`] with
+    /// `controls.values_at(i)`. The inputs are brought into range and the levels of every sample
+    /// worked out first, a span at a time in loops that vectorise; only the refills, the volume,
+    /// the accumulator and the onsets are then stepped one sample at a time.
+    pub fn advance_varying(
+        &mut self,
+        first_sample: u64,
+        controls: &Controls,
+        count: usize,
+        mut emit: impl FnMut(&UnitOnset),
+    ) -> Advanced {
+        self.plain = None;
+        let mut advanced = Advanced {
+            last: Outflow {
+                volume_before_ml: self.bottle.volume_ml(),
+                amount_ml: 0.0,
+                submerged: false,
+                refilled: false,
+            },
+            flowed_until: None,
+        };
+        let capacity_ml = self.config.capacity_ml;
+        let mut inputs = SpanInputs::default();
+        let mut levels = SpanLevels::default();
+        let mut start = 0;
+        while start < count {
+            let len = (count - start).min(SPAN);
+            let controls = controls.offset(start);
+            inputs.read(&controls, len);
+            self.bottle.levels_of_span(
+                &inputs.tilt_deg[..len],
+                &inputs.pour_time_s[..len],
+                capacity_ml,
+                &mut levels,
+            );
+            self.config_changed = false;
+            let fills = &inputs.fill_percent[..len];
+            let first = first_sample + start as u64;
+            if self.bottle.refills_none_of(fills, self.config.drain) {
+                self.step_span_without_refill(
+                    first,
+                    &inputs,
+                    &levels,
+                    len,
+                    &mut advanced,
+                    &mut emit,
+                );
+            } else {
+                for (index, &fill) in fills.iter().enumerate() {
+                    let sample = first + index as u64;
+                    let key = [
+                        inputs.tilt_deg[index],
+                        inputs.pour_time_s[index],
+                        capacity_ml,
+                    ];
+                    let outflow = self
+                        .bottle
+                        .step_with(fill, &levels.at(index, key), &self.config);
+                    if outflow.refilled {
+                        self.onsets.clear();
+                    }
+                    let outflow =
+                        self.count_onsets(sample, inputs.viscosity[index], outflow, &mut emit);
+                    if outflow.amount_ml > 0.0 {
+                        advanced.flowed_until = Some(sample + 1);
+                    }
+                    advanced.last = outflow;
+                }
+            }
+            start += len;
+        }
+        advanced
+    }
+
+    /// The samples of a span that refills nothing, with the arithmetic of [`Bottle::step_with`]
+    /// and of the onset detector, but V and g kept in registers: a sample that starts a unit
+    /// goes through the detector itself, from the state before it.
+    fn step_span_without_refill(
+        &mut self,
+        first_sample: u64,
+        inputs: &SpanInputs,
+        levels: &SpanLevels,
+        len: usize,
+        advanced: &mut Advanced,
+        emit: &mut impl FnMut(&UnitOnset),
+    ) {
+        let simulate = self.config.drain == DrainMode::Simulate;
+        let capacity_ml = self.config.capacity_ml;
+        let mut volume = self.bottle.volume_ml();
+        let mut accumulated = self.onsets.accumulated_ml();
+        let mut pocket = self.draws.next_pocket_ml(&self.config);
+        for index in 0..len {
+            if !simulate {
+                volume = inputs.fill_percent[index] / 100.0 * capacity_ml;
+            }
+            let (rest_ml, submerged_ml, max_outflow_ml) = levels.of(index);
+            let volume_before_ml = volume;
+            let amount_ml = max_outflow_ml.min((volume - rest_ml).max(0.0));
+            let submerged = volume > submerged_ml;
+            if simulate {
+                volume = volume_before_ml - amount_ml;
+            }
+            let outflow = Outflow {
+                volume_before_ml,
+                amount_ml,
+                submerged,
+                refilled: false,
+            };
+            let sample = first_sample + index as u64;
+            if amount_ml > 0.0 {
+                advanced.flowed_until = Some(sample + 1);
+                if submerged {
+                    let sum = accumulated + amount_ml;
+                    if sum >= pocket {
+                        self.onsets.set_accumulated_ml(accumulated);
+                        self.count_onsets(sample, inputs.viscosity[index], outflow, &mut *emit);
+                        accumulated = self.onsets.accumulated_ml();
+                        pocket = self.draws.next_pocket_ml(&self.config);
+                    } else {
+                        accumulated = sum;
+                    }
+                }
+            }
+            advanced.last = outflow;
+        }
+        self.onsets.set_accumulated_ml(accumulated);
+        self.bottle.end_span(volume, inputs.fill_percent[len - 1]);
+    }
+
+    fn state(&self) -> PourState<'_> {
+        PourState {
+            volume_ml: self.bottle.volume_ml(),
+            accumulated_ml: self.onsets.accumulated_ml(),
+            levels: self.bottle.current_levels(),
+            drain: self.config.drain,
+            pocket_ml: self.draws.next_pocket_ml(&self.config),
+        }
+    }
+
+    /// `count` plain samples of `run`; returns the last one's outflow.
+    fn take_plain(&mut self, run: &PlainRun, count: u64) -> Outflow {
+        let volume = self.bottle.volume_ml();
+        let step = run.volume_step;
+        let volume_before_ml = if step > 0.0 {
+            self.bottle
+                .set_volume_ml(exact::after(volume, step, count, Direction::Down));
+            exact::after(volume, step, count - 1, Direction::Down)
+        } else {
+            volume
+        };
+        if run.accumulated_step > 0.0 {
+            let accumulated = self.onsets.accumulated_ml();
+            self.onsets.set_accumulated_ml(exact::after(
+                accumulated,
+                run.accumulated_step,
+                count,
+                Direction::Up,
+            ));
+        }
+        Outflow {
+            volume_before_ml,
+            amount_ml: run.amount_ml,
+            submerged: run.submerged,
+            refilled: false,
+        }
     }
 
     /// [`Pour::step_sanitized`] under the same controls as the previous step and with no refill
@@ -146,6 +482,7 @@ impl Pour {
         viscosity: f64,
         emit: impl FnMut(&UnitOnset),
     ) -> Outflow {
+        self.plain = None;
         let outflow = self.bottle.step_steady(self.config.drain);
         self.count_onsets(sample, viscosity, outflow, emit)
     }

@@ -28,6 +28,16 @@ impl OnsetDetector {
         self.accumulated_ml = 0.0;
     }
 
+    /// g: outflow counted towards the next pocket.
+    pub fn accumulated_ml(&self) -> f64 {
+        self.accumulated_ml
+    }
+
+    /// Sets g after steps taken elsewhere in closed form (see `super::span`).
+    pub fn set_accumulated_ml(&mut self, accumulated_ml: f64) {
+        self.accumulated_ml = accumulated_ml;
+    }
+
     /// Counts one sample's outflow; calls `emit` for every unit that starts in it and returns the
     /// number of units skipped by [`MAX_ONSETS_PER_SAMPLE`].
     #[inline]

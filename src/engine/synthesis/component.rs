@@ -50,6 +50,30 @@ impl Component {
         self.decay_per_sample * self.samples_since_onset(sample) > SILENT_DECAY_EXPONENT
     }
 
+    /// The first sample from which [`Component::is_silent_at`] holds (it then holds for good), or
+    /// `u64::MAX` if it never does: found once, so that a sounding component compares integers.
+    pub fn silent_from(&self) -> u64 {
+        if self.decay_per_sample.is_nan() || self.decay_per_sample <= 0.0 {
+            return u64::MAX;
+        }
+        let guess = self.onset_sample as f64
+            + self.onset_fraction
+            + SILENT_DECAY_EXPONENT / self.decay_per_sample;
+        // Beyond any render (and any u64).
+        if guess.is_nan() || guess >= 1e19 {
+            return u64::MAX;
+        }
+        // The guess is off by a sample at most; the test itself decides.
+        let mut sample = (guess as u64).max(self.onset_sample);
+        while sample > self.onset_sample && self.is_silent_at(sample - 1) {
+            sample -= 1;
+        }
+        while !self.is_silent_at(sample) {
+            sample += 1;
+        }
+        sample
+    }
+
     /// The exact complex state at `sample`; its imaginary part is the output.
     pub fn state_at(&self, sample: u64) -> [f64; 2] {
         let elapsed = self.samples_since_onset(sample);

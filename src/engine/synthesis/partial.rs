@@ -31,6 +31,8 @@ pub struct Partial {
     /// z^GRID in f64.
     period_step: [f64; 2],
     component: Component,
+    /// The sample from which the component is silent (see [`Component::silent_from`]).
+    silent_from: u64,
     periods_since_direct: u32,
     /// |anchor|², for choosing which component to give up when the bank is full (squared: only
     /// the order matters, and it saves a hypot per component per period).
@@ -52,6 +54,7 @@ impl Sounding for Partial {
                 component.radians_per_sample * grid,
             ),
             component,
+            silent_from: component.silent_from(),
             periods_since_direct: 0,
             level: 0.0,
         };
@@ -87,13 +90,29 @@ impl Partial {
         }
     }
 
+    /// Adds this component's samples for the whole period `out`, when its anchor is at the
+    /// period's first sample (it did not start within the period): the same sums as
+    /// [`Partial::synthesize`], with the length known to the compiler.
+    #[inline]
+    pub fn synthesize_period(&self, out: &mut [f32; GRID]) {
+        let [anchor_re, anchor_im] = self.anchor;
+        for ((y, &z_re), &z_im) in out.iter_mut().zip(&self.powers_re).zip(&self.powers_im) {
+            *y += anchor_re * z_im + anchor_im * z_re;
+        }
+    }
+
+    /// The first sample of the period being rendered, or of the component if it starts later.
+    pub fn anchor_sample(&self) -> u64 {
+        self.anchor_sample
+    }
+
     /// Moves to the period starting at `period_start`; returns false once the component is silent.
     pub fn advance(&mut self, period_start: u64) -> bool {
         if self.anchor_sample >= period_start {
             // Started on this very boundary: its anchor already belongs to the new period.
             return true;
         }
-        if self.component.is_silent_at(period_start) {
+        if period_start >= self.silent_from {
             return false;
         }
         self.set_anchor(self.next_anchor);
