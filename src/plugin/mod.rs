@@ -2,14 +2,17 @@
 //! the parameters, hands MIDI and the transport to [`RealtimeEngine`] and keeps no DSP of its own.
 
 mod feed;
+mod osc_input;
 mod params;
 mod realtime;
+pub mod standalone;
 mod transport;
 
 #[cfg(feature = "editor")]
 mod editor;
 
 pub use feed::{Feed, UnitView, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
+pub use osc_input::{OscInput, OscSettings, OscStatus, DEFAULT_AXIS};
 pub use params::{parse_number, GlugParams, Knob, ModelParams};
 pub use realtime::{MidiInput, RealtimeEngine, Settings};
 pub use transport::TransportWatch;
@@ -31,6 +34,8 @@ use nice_plug::prelude::*;
 pub struct SakeGlug {
     params: Arc<GlugParams>,
     feed: Arc<Feed>,
+    /// OSC from phones and sensors: the socket thread and the values it leaves for `process()`.
+    osc: Arc<OscInput>,
     /// Built in `initialize()`, where allocating is allowed.
     renderer: Option<RealtimeEngine>,
 }
@@ -40,6 +45,7 @@ impl Default for SakeGlug {
         Self {
             params: Arc::new(GlugParams::default()),
             feed: Arc::new(Feed::default()),
+            osc: Arc::new(OscInput::default()),
             renderer: None,
         }
     }
@@ -54,6 +60,11 @@ impl SakeGlug {
     /// What the audio thread reports to the editor.
     pub fn feed(&self) -> &Arc<Feed> {
         &self.feed
+    }
+
+    /// The OSC input (its status and counters).
+    pub fn osc(&self) -> &Arc<OscInput> {
+        &self.osc
     }
 
     /// The renderer, once the plugin has been initialised.
@@ -114,7 +125,10 @@ impl Plugin for SakeGlug {
 
     #[cfg(feature = "editor")]
     fn editor(&mut self, _async_executor: AsyncExecutor<Self>) -> Option<Self::Editor> {
-        editor::create(self.params.clone(), self.feed.clone())
+        if !standalone::editor_wanted() {
+            return None;
+        }
+        editor::create(self.params.clone(), self.feed.clone(), self.osc.clone())
     }
 
     fn activate(
@@ -123,6 +137,9 @@ impl Plugin for SakeGlug {
         buffer_config: &BufferConfig,
         _context: &mut impl ActivateContext<Self>,
     ) -> bool {
+        // Not the audio thread: the socket may be bound here.
+        let osc = &self.params.osc;
+        self.osc.listen(osc.port(), osc.axis());
         let sample_rate = buffer_config.sample_rate as f64;
         let reusable = self
             .renderer
@@ -155,6 +172,7 @@ impl Plugin for SakeGlug {
         let settings = Settings::from_params(&self.params);
         let transport = context.transport();
         renderer.observe_transport(transport.playing, transport.pos_samples(), settings.config);
+        renderer.apply_live(self.osc.live());
 
         let Some((first, others)) = channels.split_first_mut() else {
             return ProcessStatus::KeepAlive;

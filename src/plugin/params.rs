@@ -14,6 +14,7 @@ use nice_plug::prelude::*;
 use crate::device::midi::MidiMap;
 use crate::engine::config::{self, Range};
 use crate::engine::{ControlValues, DrainMode, ModelConfig};
+use crate::plugin::osc_input::OscSettings;
 
 /// How one float parameter is ranged, shown and handed to the engine.
 #[derive(Debug, Clone, Copy)]
@@ -244,6 +245,10 @@ pub struct GlugParams {
     /// CC number of the fill level; 128 or more means unmapped.
     #[persist = "midi_cc_fill"]
     pub midi_cc_fill: AtomicU8,
+
+    /// OSC settings (saved with the state, not automatable).
+    #[nested]
+    pub osc: OscSettings,
 }
 
 /// The Model group of parameters (MODEL.md §5, §7, §8).
@@ -302,6 +307,7 @@ impl Default for GlugParams {
             midi_cc_tilt_lsb: AtomicU8::new(midi[2]),
             midi_cc_viscosity: AtomicU8::new(midi[3]),
             midi_cc_fill: AtomicU8::new(midi[4]),
+            osc: OscSettings::default(),
         }
     }
 }

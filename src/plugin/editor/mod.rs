@@ -5,6 +5,7 @@ mod bottle;
 mod controls;
 mod envelopes;
 mod midi_settings;
+mod osc_settings;
 mod scope;
 
 use std::sync::Arc;
@@ -16,23 +17,30 @@ use nice_plug_egui::{
 };
 
 use crate::plugin::feed::Feed;
+use crate::plugin::osc_input::OscInput;
 use crate::plugin::params::GlugParams;
 
 pub const WIDTH: f64 = 760.0;
-pub const HEIGHT: f64 = 560.0;
+pub const HEIGHT: f64 = 640.0;
 
 pub struct GlugEditor {
     params: Arc<GlugParams>,
     feed: Arc<Feed>,
+    osc: Arc<OscInput>,
     gui: Option<GuiContext>,
     repaint: RepaintNotifier,
 }
 
-pub fn create(params: Arc<GlugParams>, feed: Arc<Feed>) -> Option<EguiEditor<GlugEditor>> {
+pub fn create(
+    params: Arc<GlugParams>,
+    feed: Arc<Feed>,
+    osc: Arc<OscInput>,
+) -> Option<EguiEditor<GlugEditor>> {
     let repaint = RepaintNotifier::new();
     let app = GlugEditor {
         params,
         feed,
+        osc,
         gui: None,
         repaint: repaint.clone(),
     };
@@ -52,12 +60,17 @@ impl NiceEguiApp for GlugEditor {
         _frame: &mut nice_plug_egui::Frame,
     ) -> Result<(), nice_plug_egui::baseview::HandlerError> {
         self.gui = Some(nice_gui_ctx);
+        crate::plugin::standalone::watch_quit_signals();
         Ok(())
     }
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut nice_plug_egui::Frame) {
         // The scope and the bottle move with the audio: draw every poll.
         self.repaint.request_repaint();
+        // The standalone app got SIGINT or SIGTERM: closing the window ends it cleanly.
+        if crate::plugin::standalone::quit_requested() {
+            ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+        }
         let Some(gui) = &self.gui else {
             return;
         };
@@ -69,6 +82,8 @@ impl NiceEguiApp for GlugEditor {
                 controls::show(ui, &self.params, &setter);
                 ui.separator();
                 midi_settings::show(ui, &self.params);
+                ui.separator();
+                osc_settings::show(ui, &self.params, &self.osc);
             });
             ui.vertical(|ui| {
                 bottle::show(ui, &self.feed, egui::vec2(420.0, 220.0));
@@ -99,6 +114,7 @@ mod tests {
             scope::show(ui, feed, egui::vec2(370.0, 200.0));
             envelopes::show(ui, feed, egui::vec2(370.0, 200.0));
             midi_settings::show(ui, params);
+            osc_settings::show(ui, params, &OscInput::default());
         });
         // Nothing uploads the font atlas here.
         output.textures_delta.clear();
