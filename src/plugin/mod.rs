@@ -173,6 +173,7 @@ impl Plugin for SakeGlug {
         let transport = context.transport();
         renderer.observe_transport(transport.playing, transport.pos_samples(), settings.config);
         renderer.apply_live(self.osc.live());
+        standalone::mark_processing();
 
         let Some((first, others)) = channels.split_first_mut() else {
             return ProcessStatus::KeepAlive;

@@ -60,7 +60,10 @@ impl OscSettings {
 
     /// Saves `port` (0 = off) and `axis`.
     pub fn set(&self, port: u16, axis: Axis) {
-        let index = Axis::ALL.iter().position(|&known| known == axis).unwrap_or(0);
+        let index = Axis::ALL
+            .iter()
+            .position(|&known| known == axis)
+            .unwrap_or(0);
         self.port.store(port, Ordering::Relaxed);
         self.axis.store(index as u8, Ordering::Relaxed);
     }
@@ -132,17 +135,22 @@ impl OscInput {
         let report: Report = Box::new(|count, error| {
             nice_log!("OSC: {count} malformed packet(s) ignored so far, the last: {error}")
         });
-        let (listener, error) =
-            match OscListener::spawn(address, axis, self.live.clone(), self.stats.clone(), report) {
-                Ok(listener) => {
-                    nice_log!("OSC: listening on UDP {address}, bottle axis {axis}");
-                    (Some(listener), None)
-                }
-                Err(error) => {
-                    nice_error!("OSC: cannot listen on UDP {address}: {error}");
-                    (None, Some(error.to_string()))
-                }
-            };
+        let (listener, error) = match OscListener::spawn(
+            address,
+            axis,
+            self.live.clone(),
+            self.stats.clone(),
+            report,
+        ) {
+            Ok(listener) => {
+                nice_log!("OSC: listening on UDP {address}, bottle axis {axis}");
+                (Some(listener), None)
+            }
+            Err(error) => {
+                nice_error!("OSC: cannot listen on UDP {address}: {error}");
+                (None, Some(error.to_string()))
+            }
+        };
         *running = Some(Running {
             port,
             axis,

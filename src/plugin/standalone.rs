@@ -19,6 +19,7 @@ pub struct StandaloneOptions {
 
 static OPTIONS: OnceLock<StandaloneOptions> = OnceLock::new();
 static QUIT: LazyLock<Arc<AtomicBool>> = LazyLock::new(Arc::default);
+static PROCESSING: AtomicBool = AtomicBool::new(false);
 
 /// Sets the options for this process; only the first call counts (returns whether it did).
 pub fn configure(options: StandaloneOptions) -> bool {
@@ -40,28 +41,52 @@ pub fn request_quit() {
     QUIT.store(true, Ordering::Relaxed);
 }
 
-/// Whether [`request_quit`] was called or a quit signal came (see [`watch_quit_signals`]).
+/// Whether [`request_quit`] was called or a quit signal came (see [`spawn_quit_watch`]).
 pub fn quit_requested() -> bool {
     QUIT.load(Ordering::Relaxed)
 }
 
-/// In the standalone app, makes SIGINT, SIGTERM and SIGHUP ask the editor to close. The
-/// wrapper's own handler (ctrlc) only ends a headless run, not one with a window; this one is
-/// chained to it, so both still run. Call it once the wrapper runs (the editor does, when it
-/// opens); does nothing outside the standalone app or a second time.
-pub fn watch_quit_signals() {
-    #[cfg(all(feature = "standalone", unix))]
-    {
-        static WATCHING: std::sync::Once = std::sync::Once::new();
-        if options().is_some() {
-            WATCHING.call_once(|| {
-                use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
-                for signal in [SIGINT, SIGTERM, SIGHUP] {
-                    if let Err(error) = signal_hook::flag::register(signal, QUIT.clone()) {
-                        nice_plug::nice_error!("cannot watch signal {signal}: {error}");
-                    }
+/// Marks that `process()` has run: the wrapper is running and has installed its own signal
+/// handler. Real-time safe (one relaxed atomic access).
+pub fn mark_processing() {
+    if !PROCESSING.load(Ordering::Relaxed) {
+        PROCESSING.store(true, Ordering::Relaxed);
+    }
+}
+
+/// In the standalone app: once the wrapper runs, makes SIGINT, SIGTERM and SIGHUP also ask the
+/// editor to close (the wrapper's own handler, ctrlc's, only ends a headless run), and ends the
+/// process `grace` after such a signal if the wrapper has not ended it by then. nice-plug's JACK
+/// backend can wait for ever for the server to confirm the client's deactivation; the audio has
+/// stopped by then, and the server drops the client when the process ends.
+///
+/// The handlers are added once `process()` has run (see [`mark_processing`]), so that they are
+/// chained after ctrlc's, which replaces whatever handler it finds: both run.
+#[cfg(all(feature = "standalone", unix))]
+pub fn spawn_quit_watch(grace: std::time::Duration) {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    use std::time::Duration;
+    let spawned = std::thread::Builder::new()
+        .name("quit watch".into())
+        .spawn(move || {
+            while !PROCESSING.load(Ordering::Relaxed) {
+                std::thread::sleep(Duration::from_millis(10));
+            }
+            for signal in [SIGINT, SIGTERM, SIGHUP] {
+                if let Err(error) = signal_hook::flag::register(signal, QUIT.clone()) {
+                    nice_plug::nice_error!("cannot watch signal {signal}: {error}");
                 }
-            });
-        }
+            }
+            while !QUIT.load(Ordering::Relaxed) {
+                std::thread::sleep(Duration::from_millis(10));
+            }
+            std::thread::sleep(grace);
+            nice_plug::nice_warn!(
+                "the audio backend did not stop within {grace:?} of the signal; exiting anyway"
+            );
+            std::process::exit(0);
+        });
+    if let Err(error) = spawned {
+        nice_plug::nice_error!("cannot watch for quit signals: {error}");
     }
 }

@@ -64,17 +64,17 @@ fn send(host: &TestHost, port: u16, packets: &[Vec<u8>]) {
 }
 
 fn volume_ml(host: &TestHost) -> f64 {
-    host.plugin.renderer().expect("activated").engine().volume_ml()
+    host.plugin
+        .renderer()
+        .expect("activated")
+        .engine()
+        .volume_ml()
 }
 
 #[test]
 fn osc_tilt_from_a_loopback_client_pours_the_bottle() {
     let (mut host, port) = listening_host(Axis::PlusY);
-    assert_eq!(
-        peak(&host.render_mono(9_600, 512)),
-        0.0,
-        "upright: silent"
-    );
+    assert_eq!(peak(&host.render_mono(9_600, 512)), 0.0, "upright: silent");
     send(
         &host,
         port,
@@ -211,7 +211,8 @@ fn fill_viscosity_and_refill_over_osc() {
 fn the_osc_setting_is_saved_and_a_taken_port_is_reported() {
     let (host, port) = listening_host(Axis::MinusX);
     let fields = {
-        let params = host.plugin.glug_params().clone() as std::sync::Arc<dyn nice_plug::prelude::Params>;
+        let params =
+            host.plugin.glug_params().clone() as std::sync::Arc<dyn nice_plug::prelude::Params>;
         params.serialize_fields()
     };
     assert_eq!(fields["osc_port"], port.to_string());
@@ -223,7 +224,10 @@ fn the_osc_setting_is_saved_and_a_taken_port_is_reported() {
     // A second instance on the same port cannot bind it, and says so.
     let second = TestHost::with_plugin(restored, RATE, 2);
     match second.plugin.osc().status() {
-        OscStatus::Failed { port: failed, error } => {
+        OscStatus::Failed {
+            port: failed,
+            error,
+        } => {
             assert_eq!(failed, port);
             assert!(!error.is_empty());
         }

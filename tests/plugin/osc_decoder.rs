@@ -139,8 +139,16 @@ fn gravity_vectors_from_every_app_become_tilt() {
 fn ios_apps_point_down_and_android_apps_up() {
     // A phone held upright along the bottle, its top edge to the mouth (axis +y): Core Motion
     // reports gravity along −y, Android's sensors the reaction along +y. Both read 0°.
-    let ios_upright = vec![OscType::Float(0.0), OscType::Float(-1.0), OscType::Float(0.0)];
-    let android_upright = vec![OscType::Float(0.0), OscType::Float(9.81), OscType::Float(0.0)];
+    let ios_upright = vec![
+        OscType::Float(0.0),
+        OscType::Float(-1.0),
+        OscType::Float(0.0),
+    ];
+    let android_upright = vec![
+        OscType::Float(0.0),
+        OscType::Float(9.81),
+        OscType::Float(0.0),
+    ];
     for address in ["/gyrosc/grav", "/accxyz"] {
         let packet = message(address, ios_upright.clone());
         assert_eq!(tilt(&controls_of(&packet, Axis::PlusY)), 0.0, "{address}");

@@ -105,7 +105,10 @@ fn process_does_not_allocate_while_osc_arrives() {
         // Refills are rare: the first glug of a full bottle needs 5 ml of outflow, ~80 ms.
         let message = match index % 4 {
             _ if index == 150 => ("/sakeglug/refill", vec![]),
-            0 => ("/sakeglug/tilt", vec![rosc::OscType::Float(100.0 + (index % 80) as f32)]),
+            0 => (
+                "/sakeglug/tilt",
+                vec![rosc::OscType::Float(100.0 + (index % 80) as f32)],
+            ),
             1 => ("/sakeglug/viscosity", vec![rosc::OscType::Float(0.5)]),
             2 => ("/gyrosc/grav", vec![rosc::OscType::Float(0.3); 3]),
             _ => ("/sakeglug/fill", vec![rosc::OscType::Int(90)]),
@@ -121,14 +124,26 @@ fn process_does_not_allocate_while_osc_arrives() {
         // Every other block waits for the socket thread, so that values do arrive mid-session.
         let stats = host.plugin.osc().stats();
         let deadline = std::time::Instant::now() + std::time::Duration::from_secs(5);
-        while index % 2 == 0 && stats.packets.load(std::sync::atomic::Ordering::Relaxed) <= index as u64 {
-            assert!(std::time::Instant::now() < deadline, "the listener reads the packets");
+        while index % 2 == 0
+            && stats.packets.load(std::sync::atomic::Ordering::Relaxed) <= index as u64
+        {
+            assert!(
+                std::time::Instant::now() < deadline,
+                "the listener reads the packets"
+            );
             std::thread::yield_now();
         }
         let out = host.process(240, Vec::new(), Playhead::default());
         heard = heard.max(peak(&out[0]));
     }
-    assert!(host.plugin.osc().stats().packets.load(std::sync::atomic::Ordering::Relaxed) > 0);
+    assert!(
+        host.plugin
+            .osc()
+            .stats()
+            .packets
+            .load(std::sync::atomic::Ordering::Relaxed)
+            > 0
+    );
     assert!(heard > 0.0, "OSC tilt made the bottle glug");
 }
 

@@ -23,7 +23,11 @@ pub struct AppArgs {
 }
 
 /// Our options and whether each takes a value.
-const OWN: [(&str, bool); 3] = [("--osc-port", true), ("--osc-axis", true), ("--no-editor", false)];
+const OWN: [(&str, bool); 3] = [
+    ("--osc-port", true),
+    ("--osc-axis", true),
+    ("--no-editor", false),
+];
 
 /// Splits the command line into our options (as `--name=value`, after the program name) and
 /// the wrapper's (with the program name first).

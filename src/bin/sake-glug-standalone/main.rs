@@ -12,10 +12,14 @@
 mod args;
 
 use std::process::ExitCode;
+use std::time::Duration;
 
 use nice_plug::prelude::nice_export_standalone_with_args;
 use sake_glug::plugin::standalone::{self, StandaloneOptions};
 use sake_glug::SakeGlug;
+
+/// How long the wrapper gets to stop after SIGINT or SIGTERM before the process ends anyway.
+const QUIT_GRACE: Duration = Duration::from_secs(3);
 
 fn main() -> ExitCode {
     let (own, wrapper_args) = args::split(std::env::args());
@@ -33,6 +37,7 @@ fn main() -> ExitCode {
         editor: !options.no_editor,
         osc: options.osc_port.map(|port| (port, options.osc_axis)),
     });
+    standalone::spawn_quit_watch(QUIT_GRACE);
     if nice_export_standalone_with_args::<SakeGlug, _>(wrapper_args) {
         ExitCode::SUCCESS
     } else {

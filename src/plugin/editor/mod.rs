@@ -60,7 +60,6 @@ impl NiceEguiApp for GlugEditor {
         _frame: &mut nice_plug_egui::Frame,
     ) -> Result<(), nice_plug_egui::baseview::HandlerError> {
         self.gui = Some(nice_gui_ctx);
-        crate::plugin::standalone::watch_quit_signals();
         Ok(())
     }
 
