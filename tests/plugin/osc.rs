@@ -188,7 +188,8 @@ fn fill_viscosity_and_refill_over_osc() {
     );
     host.render_mono(48_000, 512);
     assert!(volume_ml(&host) < 245.0);
-    // Values outside a control's range are clamped to it.
+    // Values outside a control's range are clamped to it; in simulate mode a new fill level
+    // refills the bottle (MODEL.md §8).
     send(
         &host,
         port,
@@ -196,7 +197,6 @@ fn fill_viscosity_and_refill_over_osc() {
             packet("/sakeglug/fill", vec![OscType::Int(50)]),
             packet("/sakeglug/viscosity", vec![OscType::Float(7.0)]),
             packet("/sakeglug/tilt", vec![OscType::Float(-40.0)]),
-            packet("/sakeglug/refill", vec![]),
         ],
     );
     host.render_mono(512, 512);
@@ -205,6 +205,18 @@ fn fill_viscosity_and_refill_over_osc() {
     let live = host.plugin.osc().live();
     assert_eq!(live.value(Target::Viscosity), Some(1.0));
     assert_eq!(live.value(Target::Tilt), Some(0.0));
+    // Poured, then refilled by /sakeglug/refill alone.
+    send(
+        &host,
+        port,
+        &[packet("/sakeglug/tilt", vec![OscType::Float(150.0)])],
+    );
+    host.render_mono(24_000, 512);
+    assert!(volume_ml(&host) < 140.0);
+    send(&host, port, &[packet("/sakeglug/refill", vec![])]);
+    host.render_mono(1, 1);
+    let refilled = volume_ml(&host);
+    assert!(refilled > 149.9, "refilled to 150 ml: {refilled}");
 }
 
 #[test]
