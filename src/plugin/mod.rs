@@ -2,14 +2,17 @@
 //! the parameters, hands MIDI and the transport to [`RealtimeEngine`] and keeps no DSP of its own.
 
 mod feed;
+mod osc_input;
 mod params;
 mod realtime;
+pub mod standalone;
 mod transport;
 
 #[cfg(feature = "editor")]
 mod editor;
 
 pub use feed::{Feed, UnitView, Visible, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
+pub use osc_input::{OscInput, OscSettings, OscStatus, DEFAULT_AXIS};
 pub use params::{migrate_state, parse_number, GlugParams, Knob, ModelParams, STATE_VERSION};
 pub use realtime::{RealtimeEngine, Settings, FADE_S};
 pub use transport::TransportWatch;
@@ -39,6 +42,8 @@ use crate::device::midi::{MidiInput, MidiMap};
 pub struct SakeGlugPlugin<const RAW_MIDI: bool> {
     params: Arc<GlugParams>,
     feed: Arc<Feed>,
+    /// OSC from phones and sensors: the socket thread and the values it leaves for `process()`.
+    osc: Arc<OscInput>,
     /// Built in `initialize()`, where allocating is allowed.
     renderer: Option<RealtimeEngine>,
 }
@@ -53,6 +58,7 @@ impl<const RAW_MIDI: bool> Default for SakeGlugPlugin<RAW_MIDI> {
         Self {
             params: Arc::new(GlugParams::default()),
             feed: Arc::new(Feed::default()),
+            osc: Arc::new(OscInput::default()),
             renderer: None,
         }
     }
@@ -67,6 +73,11 @@ impl<const RAW_MIDI: bool> SakeGlugPlugin<RAW_MIDI> {
     /// What the audio thread reports to the editor.
     pub fn feed(&self) -> &Arc<Feed> {
         &self.feed
+    }
+
+    /// The OSC input (its status and counters).
+    pub fn osc(&self) -> &Arc<OscInput> {
+        &self.osc
     }
 
     /// The renderer, once the plugin has been initialised.
@@ -141,7 +152,10 @@ impl<const RAW_MIDI: bool> Plugin for SakeGlugPlugin<RAW_MIDI> {
 
     #[cfg(feature = "editor")]
     fn editor(&mut self, _async_executor: AsyncExecutor<Self>) -> Option<Self::Editor> {
-        editor::create(self.params.clone(), self.feed.clone())
+        if !standalone::editor_wanted() {
+            return None;
+        }
+        editor::create(self.params.clone(), self.feed.clone(), self.osc.clone())
     }
 
     fn activate(
@@ -150,6 +164,9 @@ impl<const RAW_MIDI: bool> Plugin for SakeGlugPlugin<RAW_MIDI> {
         buffer_config: &BufferConfig,
         _context: &mut impl ActivateContext<Self>,
     ) -> bool {
+        // Not the audio thread: the socket may be bound here.
+        let osc = &self.params.osc;
+        self.osc.listen(osc.port(), osc.axis());
         let sample_rate = buffer_config.sample_rate as f64;
         let reusable = self
             .renderer
@@ -182,6 +199,8 @@ impl<const RAW_MIDI: bool> Plugin for SakeGlugPlugin<RAW_MIDI> {
         let settings = Settings::from_params(&self.params);
         let transport = context.transport();
         renderer.observe_transport(transport.playing, transport.pos_samples(), settings.config);
+        renderer.apply_live(self.osc.live());
+        standalone::mark_processing();
 
         let Some((first, others)) = channels.split_first_mut() else {
             return ProcessStatus::KeepAlive;

@@ -14,6 +14,7 @@ use nice_plug::prelude::*;
 use crate::device::midi::MidiMap;
 use crate::engine::config::{self, Range};
 use crate::engine::{ControlValues, DrainMode, ModelConfig};
+use crate::plugin::osc_input::OscSettings;
 
 /// How one float parameter is ranged, shown and handed to the engine.
 #[derive(Debug, Clone, Copy)]
@@ -262,10 +263,14 @@ pub struct GlugParams {
     /// by [`migrate_state`] before they load.
     #[persist = "state_version"]
     pub state_version: AtomicU8,
+
+    /// OSC settings (saved with the state, not automatable).
+    #[nested]
+    pub osc: OscSettings,
 }
 
 /// The saved state's layout. 0: before states carried a version (the parameters and MIDI
-/// fields of 0.1.0). 1: the same, with this version field.
+/// fields of 0.1.0). 1: the same with this version field, and the OSC settings (off unless set).
 pub const STATE_VERSION: u8 = 1;
 
 /// Brings a saved state up to [`STATE_VERSION`], one version at a time, before it loads; a
@@ -279,8 +284,8 @@ pub fn migrate_state(state: &mut PluginState) {
     if saved > STATE_VERSION {
         return;
     }
-    // 0 → 1: nothing was renamed or rescaled; the state only gains its version. A later change
-    // to a parameter's ID, range or unit adds its step here.
+    // 0 → 1: nothing was renamed or rescaled; the state gains its version, and the OSC settings
+    // keep their defaults (off). A later change to an ID, range or unit adds its step here.
     state
         .fields
         .insert("state_version".into(), STATE_VERSION.to_string());
@@ -343,6 +348,7 @@ impl Default for GlugParams {
             midi_cc_viscosity: AtomicU8::new(midi[3]),
             midi_cc_fill: AtomicU8::new(midi[4]),
             state_version: AtomicU8::new(STATE_VERSION),
+            osc: OscSettings::default(),
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The plugin's real-time side without plugin-framework types: parameter values, MIDI and
 //! transport in; engine output and the editor's feed out. Allocation-free after `new()`.
 
+use crate::device::live::{LiveControls, LiveReader};
 use crate::device::midi::{CcDecoder, DeviceAction, MidiInput, MidiMap, Overrides};
 use crate::engine::{ControlValues, Controls, Engine, ModelConfig};
 use crate::plugin::feed::{Feed, ScopeWriter, Visible};
@@ -55,6 +56,8 @@ pub struct RealtimeEngine {
     config: ModelConfig,
     decoder: CcDecoder,
     overrides: Overrides,
+    /// What has been taken from the live (OSC) input.
+    live: LiveReader,
     transport: TransportWatch,
     scope: ScopeWriter,
     units_seen: u64,
@@ -78,6 +81,7 @@ impl RealtimeEngine {
             config,
             decoder: CcDecoder::default(),
             overrides: Overrides::default(),
+            live: LiveReader::default(),
             transport: TransportWatch::default(),
             scope: ScopeWriter::new(sample_rate),
             units_seen: 0,
@@ -146,6 +150,18 @@ impl RealtimeEngine {
             Some(DeviceAction::Refill) => self.engine.refill(),
             Some(DeviceAction::Set(target, value)) => self.overrides.set(target, value),
             None => {}
+        }
+    }
+
+    /// Takes what a live input (OSC) set since the last call, as MIDI is taken: a new value
+    /// overrides its control, a refill refills. Atomic loads only: real-time safe.
+    pub fn apply_live(&mut self, live: &LiveControls) {
+        let changes = self.live.poll(live);
+        for (target, value) in changes.set_values() {
+            self.overrides.set(target, value);
+        }
+        if changes.refill {
+            self.engine.refill();
         }
     }
 

@@ -1,5 +1,5 @@
-//! The plugin through nice-plug's real traits: parameters, MIDI, state, transport resets, every
-//! sample rate, and real-time safety.
+//! The plugin through nice-plug's real traits: parameters, MIDI, OSC, state, transport resets,
+//! every sample rate, and real-time safety.
 
 mod host;
 
@@ -7,6 +7,9 @@ mod clap_state;
 
 mod midi;
 mod nyquist;
+mod osc;
+mod osc_decoder;
+mod osc_fuzz;
 mod params;
 mod realtime;
 mod reset;

@@ -86,6 +86,67 @@ fn process_does_not_allocate_under_a_busy_session() {
     }
 }
 
+/// OSC arriving from a socket thread while `process()` runs: the audio thread only reads atomics.
+#[test]
+fn process_does_not_allocate_while_osc_arrives() {
+    let plugin = sake_glug::SakeGlug::default();
+    let socket = std::net::UdpSocket::bind("127.0.0.1:0").expect("a free port");
+    let port = socket.local_addr().expect("its address").port();
+    drop(socket);
+    plugin
+        .glug_params()
+        .osc
+        .set(port, sake_glug::device::Axis::PlusY);
+    let mut host = TestHost::with_plugin(plugin, 48_000.0, 2);
+    host.guard = no_alloc;
+    let client = std::net::UdpSocket::bind("127.0.0.1:0").expect("client socket");
+    let mut heard = 0.0f32;
+    for index in 0..200u32 {
+        // Refills are rare: the first glug of a full bottle needs 5 ml of outflow, ~80 ms.
+        let message = match index % 4 {
+            _ if index == 150 => ("/sakeglug/refill", vec![]),
+            0 => (
+                "/sakeglug/tilt",
+                vec![rosc::OscType::Float(100.0 + (index % 80) as f32)],
+            ),
+            1 => ("/sakeglug/viscosity", vec![rosc::OscType::Float(0.5)]),
+            2 => ("/gyrosc/grav", vec![rosc::OscType::Float(0.3); 3]),
+            _ => ("/sakeglug/fill", vec![rosc::OscType::Int(90)]),
+        };
+        let bytes = rosc::encoder::encode(&rosc::OscPacket::Message(rosc::OscMessage {
+            addr: message.0.to_owned(),
+            args: message.1,
+        }))
+        .expect("encode");
+        client
+            .send_to(&bytes, ("127.0.0.1", port))
+            .expect("send over loopback");
+        // Every other block waits for the socket thread, so that values do arrive mid-session.
+        let stats = host.plugin.osc().stats();
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(5);
+        while index % 2 == 0
+            && stats.packets.load(std::sync::atomic::Ordering::Relaxed) <= index as u64
+        {
+            assert!(
+                std::time::Instant::now() < deadline,
+                "the listener reads the packets"
+            );
+            std::thread::yield_now();
+        }
+        let out = host.process(240, Vec::new(), Playhead::default());
+        heard = heard.max(peak(&out[0]));
+    }
+    assert!(
+        host.plugin
+            .osc()
+            .stats()
+            .packets
+            .load(std::sync::atomic::Ordering::Relaxed)
+            > 0
+    );
+    assert!(heard > 0.0, "OSC tilt made the bottle glug");
+}
+
 /// Proves the check above is armed: an allocation inside the same guard aborts the process.
 /// Runs itself as a child process, because the abort cannot be caught.
 #[cfg(all(debug_assertions, feature = "assert_process_allocs"))]

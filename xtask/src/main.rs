@@ -2,13 +2,14 @@
 //!
 //! - `cargo xtask pour`: build the plugin bundles and render the built-in scene to `pour.wav`.
 //! - `cargo xtask test`: every test: formatting and lints, the Rust suites, then the bundles in a
-//!   real VST3 host.
+//!   real VST3 host and the standalone app under a JACK server.
 //! - `cargo xtask docs [--bench]`: regenerates the generated blocks of docs/ from the current
 //!   code, the cost figures of docs/scaling.md among them (callgrind, when valgrind is installed;
 //!   the render benchmark's last report, or a new one with `--bench`).
 //!
 //! Each product is built with only its features: the bundles with `editor` (which brings
-//! `plugin`), the command line with `cli`, so neither compiles the other's crates.
+//! `plugin`), the command line with `cli`, the standalone app with `standalone`, so none compiles
+//! another's crates.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -53,7 +54,8 @@ fn main() -> nice_plug_xtask::Result<()> {
     }
 }
 
-/// The CLAP and VST3 bundles under target/bundled/, and the release CLI beside them.
+/// The CLAP and VST3 bundles under target/bundled/, and the release CLI and standalone app
+/// beside them.
 fn build_release() -> nice_plug_xtask::Result<()> {
     nice_plug_xtask::main_with_args(
         "cargo xtask",
@@ -67,7 +69,17 @@ fn build_release() -> nice_plug_xtask::Result<()> {
         ]
         .map(String::from),
     )?;
-    build_cli()
+    build_cli()?;
+    // The standalone app (JACK and ALSA: libjack and libasound at build time).
+    cargo(&[
+        "build",
+        "--release",
+        "--bin",
+        "sake-glug-standalone",
+        "--no-default-features",
+        "--features",
+        "standalone",
+    ])
 }
 
 /// The release command line alone, with only its features.
@@ -293,7 +305,8 @@ fn output(program: &str, args: &[&str]) -> nice_plug_xtask::Result<String> {
     Ok(String::from_utf8(out.stdout)?)
 }
 
-/// The bundles loaded in pedalboard, in a virtual environment made on first use.
+/// The bundles loaded in pedalboard and the standalone app under JACK, in a virtual environment
+/// made on first use.
 fn host_tests() -> nice_plug_xtask::Result<()> {
     let python = ".venv/bin/python";
     if !Path::new(python).exists() {

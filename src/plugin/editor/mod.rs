@@ -5,6 +5,7 @@ mod bottle;
 mod controls;
 mod envelopes;
 mod midi_settings;
+mod osc_settings;
 mod presets;
 mod scope;
 
@@ -17,14 +18,16 @@ use nice_plug_egui::{
 };
 
 use crate::plugin::feed::Feed;
+use crate::plugin::osc_input::OscInput;
 use crate::plugin::params::GlugParams;
 
 pub const WIDTH: f64 = 760.0;
-pub const HEIGHT: f64 = 560.0;
+pub const HEIGHT: f64 = 640.0;
 
 pub struct GlugEditor {
     params: Arc<GlugParams>,
     feed: Arc<Feed>,
+    osc: Arc<OscInput>,
     gui: Option<GuiContext>,
     /// The preset last picked in the menu (its label).
     preset: usize,
@@ -33,12 +36,17 @@ pub struct GlugEditor {
     midi_edited: bool,
 }
 
-pub fn create(params: Arc<GlugParams>, feed: Arc<Feed>) -> Option<EguiEditor<GlugEditor>> {
+pub fn create(
+    params: Arc<GlugParams>,
+    feed: Arc<Feed>,
+    osc: Arc<OscInput>,
+) -> Option<EguiEditor<GlugEditor>> {
     // The audio thread asks for redraws through the feed, when what it shows changes.
     let repaint = feed.repaint.clone();
     let app = GlugEditor {
         params,
         feed,
+        osc,
         gui: None,
         preset: 0,
         midi_edited: false,
@@ -63,6 +71,10 @@ impl NiceEguiApp for GlugEditor {
     }
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut nice_plug_egui::Frame) {
+        // The standalone app got SIGINT or SIGTERM: closing the window ends it cleanly.
+        if crate::plugin::standalone::quit_requested() {
+            ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+        }
         let Some(gui) = &self.gui else {
             return;
         };
@@ -75,6 +87,8 @@ impl NiceEguiApp for GlugEditor {
                 controls::show(ui, &self.params, &setter);
                 ui.separator();
                 self.midi_edited |= midi_settings::show(ui, &self.params);
+                ui.separator();
+                osc_settings::show(ui, &self.params, &self.osc);
             });
             ui.vertical(|ui| {
                 bottle::show(ui, &self.feed, egui::vec2(420.0, 220.0));
@@ -109,6 +123,7 @@ mod tests {
             scope::show(ui, feed, egui::vec2(370.0, 200.0));
             envelopes::show(ui, feed, egui::vec2(370.0, 200.0));
             midi_settings::show(ui, params);
+            osc_settings::show(ui, params, &OscInput::default());
         });
         // Nothing uploads the font atlas here.
         output.textures_delta.clear();

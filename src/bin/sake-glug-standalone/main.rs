@@ -1,0 +1,46 @@
+//! `sake-glug-standalone`: the plugin as an application, without a DAW: MIDI from the tilt
+//! device, OSC from a phone, the glug to the audio interface, the editor in a window.
+//!
+//! nice-plug's standalone wrapper parses its own options (`--backend jack|alsa`, ports, devices;
+//! see `--help`). Ours are taken out of the command line first and the rest is handed to the
+//! wrapper:
+//!
+//! - `--osc-port PORT`: listen for OSC on UDP PORT (every interface);
+//! - `--osc-axis AXIS`: the sensor axis from the bottle's base to its mouth (`+y` by default);
+//! - `--no-editor`: no window (no display needed); quit with Ctrl-C or SIGTERM.
+
+mod args;
+
+use std::process::ExitCode;
+use std::time::Duration;
+
+use nice_plug::prelude::nice_export_standalone_with_args;
+use sake_glug::plugin::standalone::{self, StandaloneOptions};
+use sake_glug::SakeGlug;
+
+/// How long the wrapper gets to stop after SIGINT or SIGTERM before the process ends anyway.
+const QUIT_GRACE: Duration = Duration::from_secs(3);
+
+fn main() -> ExitCode {
+    let (own, wrapper_args) = args::split(std::env::args());
+    let options = match args::parse(&own) {
+        Ok(options) => options,
+        Err(error) => error.exit(),
+    };
+    if wrapper_args
+        .iter()
+        .any(|arg| arg == "--help" || arg == "-h")
+    {
+        println!("{}\n", args::help());
+    }
+    standalone::configure(StandaloneOptions {
+        editor: !options.no_editor,
+        osc: options.osc_port.map(|port| (port, options.osc_axis)),
+    });
+    standalone::spawn_quit_watch(QUIT_GRACE);
+    if nice_export_standalone_with_args::<SakeGlug, _>(wrapper_args) {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}
