@@ -174,8 +174,11 @@ mod tests {
         // A second later the bucket is full again, no fuller.
         let next = (0..20).filter(|_| budget.admit(1.0)).count();
         assert_eq!(next, 8);
-        // One unit's worth of time admits one unit.
-        assert!(budget.admit(1.0 + 1.0 / STARTS_PER_SECOND));
-        assert!(!budget.admit(1.0 + 1.0 / STARTS_PER_SECOND));
+        // One unit's worth of time admits one unit (a binary fraction of a second, so the sum
+        // is exact), and not two.
+        let later = 1.0 + 1.0 / 4096.0;
+        assert!(STARTS_PER_SECOND / 4096.0 >= 1.0 && STARTS_PER_SECOND / 4096.0 < 2.0);
+        assert!(budget.admit(later));
+        assert!(!budget.admit(later));
     }
 }
