@@ -287,8 +287,8 @@ impl<S: Synthesis> Engine<S> {
         let ceiling = self.pour.config().ceiling as f32;
         let (mut events, mut non_finite) = (0u64, 0u64);
         let mut limit = |value: f32| {
-            // Branch-free counts: NaN fails both comparisons.
-            events += u64::from(!(value.abs() <= ceiling));
+            // Branch-free counts.
+            events += u64::from(value.is_nan() || value.abs() > ceiling);
             non_finite += u64::from(!value.is_finite());
             if value.is_nan() || value.abs() < f32::MIN_POSITIVE {
                 0.0

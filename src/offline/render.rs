@@ -177,7 +177,7 @@ fn refuse_endless_decays(scene: &Scene) -> Result<(), RenderError> {
         let can_sound = share_can_sound[index] && frequency_hz > 0.0 && lowest_draw_hz < nyquist_hz;
         let decay_per_s = config.decay_per_s[index];
         let decay_s = SILENT_DECAY_EXPONENT / decay_per_s;
-        if can_sound && !(decay_s <= MAX_DURATION_S) {
+        if can_sound && decay_s > MAX_DURATION_S {
             return Err(RenderError::DecaysTooSlowly {
                 key,
                 decay_per_s,

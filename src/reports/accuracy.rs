@@ -292,7 +292,7 @@ pub fn budget_failures(rows: &[Measurement]) -> Vec<String> {
             failures.push(format!(
                 "{label}: the error is NaN (nothing was compared: empty or silent windows)"
             ));
-        } else if row.path == SynthesisPath::Default && !(row.max_error_db < BUDGET_DB) {
+        } else if row.path == SynthesisPath::Default && row.max_error_db >= BUDGET_DB {
             failures.push(format!(
                 "{label}: max error {:.1} dB is not below the budget of {BUDGET_DB} dB",
                 row.max_error_db

@@ -144,16 +144,15 @@ fn a_unit_sounds_until_minus_120_db_and_stops_within_a_period() {
         let (from, to) = (silent_at as usize - 600, silent_at as usize);
         let frequency_hz = [80.0, 300.0][index];
         let mut loudest = 0.0f64;
-        for n in from..to {
+        for (n, &y) in out.iter().enumerate().take(to).skip(from) {
             let tau = (n as f64 - onset) / FS;
             let envelope = amplitude * (-decay_per_s * tau).exp();
             let exact = envelope * (std::f64::consts::TAU * frequency_hz * tau).sin();
             assert!(
-                (out[n] as f64 - exact).abs() < 0.05 * envelope,
-                "component {index} at sample {n}: {} against {exact:e}",
-                out[n]
+                (y as f64 - exact).abs() < 0.05 * envelope,
+                "component {index} at sample {n}: {y} against {exact:e}"
             );
-            loudest = loudest.max(out[n].abs() as f64);
+            loudest = loudest.max(y.abs() as f64);
         }
         assert!(
             loudest > 0.9e-6 * amplitude,

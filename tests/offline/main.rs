@@ -8,4 +8,5 @@ mod cli;
 mod clip_rules;
 mod clips_rendered;
 mod determinism;
+mod fuzz;
 mod scene_files;

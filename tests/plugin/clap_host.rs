@@ -176,6 +176,22 @@ impl ClapInstance {
         panic!("no parameter named {name}");
     }
 
+    /// Every parameter as (name, CLAP value, declared min, declared max).
+    pub fn parameter_values(&self) -> Vec<(std::ffi::CString, f64, f64, f64)> {
+        let params: &clap_plugin_params = self.extension(CLAP_EXT_PARAMS);
+        let count = unsafe { (params.count.unwrap())(self.plugin) };
+        (0..count)
+            .map(|index| {
+                let mut info: clap_param_info = unsafe { std::mem::zeroed() };
+                assert!(unsafe { (params.get_info.unwrap())(self.plugin, index, &mut info) });
+                let mut value = f64::NAN;
+                assert!(unsafe { (params.get_value.unwrap())(self.plugin, info.id, &mut value) });
+                let name = unsafe { CStr::from_ptr(info.name.as_ptr()) }.to_owned();
+                (name, value, info.min_value, info.max_value)
+            })
+            .collect()
+    }
+
     /// Activates at `sample_rate` and starts processing.
     pub fn activate(&mut self, sample_rate: f64) {
         unsafe {

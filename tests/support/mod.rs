@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod fuzz;
+
 use sake_glug::engine::synthesis::reference;
 use sake_glug::engine::{
     ControlSource, ControlValues, Engine, ModelConfig, Pour, UnitOnset, VoiceBank,
@@ -78,11 +80,12 @@ pub fn render_controls(
     controls: &impl ControlSource,
     len: u64,
 ) -> Vec<f32> {
+    let whole = 0..len;
     let spec = RenderSpec {
         sample_rate,
         config,
         len,
-        keep: &[0..len],
+        keep: std::slice::from_ref(&whole),
         energy_span: 0,
     };
     timing::timed_render::<VoiceBank>(&spec, controls).kept
