@@ -32,10 +32,23 @@ pub struct Engine<S: Synthesis = VoiceBank> {
     sample: u64,
     /// The pour's last step changed nothing and would change nothing again under these controls.
     resting_under: Option<ControlValues>,
+    /// The last output gain asked for (dB) and its linear value. Starts as a true pair (the
+    /// default's): any key could arrive, NaN included, and must never find a stale value.
     gain: (f64, f64),
     last_unit: Option<UnitOnset>,
     /// The sample after the last one during which liquid flowed or a component sounded.
     active_until: u64,
+    /// What the output stage saw before it limited the signal: see [`Engine::limiter_events`].
+    limiter: LimiterCounts,
+}
+
+/// Counts kept by the output stage, since the last reset.
+#[derive(Debug, Clone, Copy, Default)]
+struct LimiterCounts {
+    /// Samples the limiter changed: over the ceiling or not finite.
+    events: u64,
+    /// Samples that were NaN or infinite before the limiter.
+    non_finite: u64,
 }
 
 impl Engine {
@@ -55,9 +68,10 @@ impl<S: Synthesis> Engine<S> {
             voices: S::new(sample_rate),
             sample: 0,
             resting_under: None,
-            gain: (f64::NAN, 0.0),
+            gain: (config::GAIN_DB.default, db_to_gain(config::GAIN_DB.default)),
             last_unit: None,
             active_until: 0,
+            limiter: LimiterCounts::default(),
         };
         engine.reset();
         engine
@@ -87,6 +101,7 @@ impl<S: Synthesis> Engine<S> {
         self.resting_under = None;
         self.last_unit = None;
         self.active_until = 0;
+        self.limiter = LimiterCounts::default();
     }
 
     /// MODEL.md §8 refill: sounding units ring on, the generator goes on.
@@ -118,6 +133,33 @@ impl<S: Synthesis> Engine<S> {
     /// Components given up because more were sounding than the engine voices.
     pub fn components_given_up(&self) -> u64 {
         self.voices.given_up()
+    }
+
+    /// The most components that sounded at once since the last call (at any sample, not only at
+    /// the end of a block); the count then starts again from those sounding now.
+    pub fn take_peak_sounding(&mut self) -> usize {
+        self.voices.take_peak_len()
+    }
+
+    /// Samples since the last reset that the output stage's limiter changed: a signal over the
+    /// ceiling (clamped to it) or not finite (NaN to 0, ±∞ to ±ceiling). The output cannot show
+    /// what the limiter hid; this count can.
+    pub fn limiter_events(&self) -> u64 {
+        self.limiter.events
+    }
+
+    /// Samples since the last reset that were NaN or infinite before the limiter: the synthesis
+    /// itself failed there, even though the output stayed finite.
+    pub fn non_finite_before_limiter(&self) -> u64 {
+        self.limiter.non_finite
+    }
+
+    /// Gives the next component that starts a NaN state, as a broken synthesis would: how the
+    /// tests show that the stability checks see through the limiter. Only with the
+    /// `fault-injection` feature, which no product is built with.
+    #[cfg(feature = "fault-injection")]
+    pub fn inject_nan_into_next_component(&mut self) {
+        self.voices.poison_next_component();
     }
 
     /// Samples rendered since the last reset.
@@ -244,9 +286,14 @@ impl<S: Synthesis> Engine<S> {
     }
 
     /// Output gain, then the guarantees of MODEL.md §6: finite, within the ceiling, no denormal.
+    /// Counts what the limiter did, so that a check can look past it.
     fn apply_output_stage(&mut self, controls: &Controls, out: &mut [f32]) {
         let ceiling = self.pour.config().ceiling as f32;
-        let limit = |value: f32| {
+        let (mut events, mut non_finite) = (0u64, 0u64);
+        let mut limit = |value: f32| {
+            // Branch-free counts.
+            events += u64::from(value.is_nan() || value.abs() > ceiling);
+            non_finite += u64::from(!value.is_finite());
             if value.is_nan() || value.abs() < f32::MIN_POSITIVE {
                 0.0
             } else {
@@ -264,6 +311,8 @@ impl<S: Synthesis> Engine<S> {
                 *y = limit((*y as f64 * gain) as f32);
             }
         }
+        self.limiter.events += events;
+        self.limiter.non_finite += non_finite;
     }
 
     #[inline]

@@ -5,6 +5,7 @@ use std::time::{Duration, Instant};
 use super::scene::{LaneBuffers, Scene, MAX_DURATION_S};
 use crate::device::midi::{CcDecoder, DeviceAction, Target};
 use crate::device::midi_take::TimedInput;
+use crate::engine::synthesis::SILENT_DECAY_EXPONENT;
 use crate::engine::{Controls, DrainMode, Engine, Lane, UnitOnset};
 
 /// Samples per engine call offline; any size gives the same samples.
@@ -19,6 +20,23 @@ pub enum RenderError {
          point, or past {MAX_DURATION_S} s), so it has no natural end; give it a duration_s"
     )]
     NeverSettles,
+    /// The scene has no `duration_s` and a glug component decays too slowly to fall silent
+    /// within [`MAX_DURATION_S`]: refused before anything is rendered.
+    #[error(
+        "`{key}` = {decay_per_s} /s: a glug needs {decay_time} to decay to −120 dB, longer than \
+         the {MAX_DURATION_S} s a render may last, so the scene has no natural end; give it a \
+         duration_s, or a decay rate of at least {min_decay_per_s:.6} /s"
+    )]
+    DecaysTooSlowly {
+        /// The scene key of the decay rate.
+        key: &'static str,
+        /// Its value (1/s).
+        decay_per_s: f64,
+        /// How long e^(−Bτ) takes to reach 10⁻⁶ ("for ever" at B = 0).
+        decay_time: String,
+        /// The slowest decay that falls silent within the limit.
+        min_decay_per_s: f64,
+    },
 }
 
 /// What a finished render did.
@@ -80,6 +98,9 @@ pub fn render_scene<E: From<RenderError>>(
     observer: &mut impl RenderObserver,
 ) -> Result<RenderSummary, E> {
     let started = Instant::now();
+    if scene.duration_s.is_none() {
+        refuse_endless_decays(scene)?;
+    }
     let sample_rate = scene.sample_rate as f64;
     let mut engine = Engine::new(sample_rate, scene.config);
     let mut lanes = LaneBuffers::default();
@@ -200,14 +221,45 @@ impl<'a> TakePlayer<'a> {
     }
 }
 
+/// Refuses, before rendering, a scene without a duration whose glugs cannot fall silent within
+/// [`MAX_DURATION_S`]: a component that can sound (its share of c is not always 0, and some
+/// drawn frequency can lie between 0 and Nyquist) whose nominal decay takes longer than the limit
+/// to reach −120 dB (MODEL.md §10). Rendering it would only end at the limit, after gigabytes.
+fn refuse_endless_decays(scene: &Scene) -> Result<(), RenderError> {
+    let config = &scene.config;
+    let nyquist_hz = scene.sample_rate as f64 / 2.0;
+    let viscosities: Vec<f64> = scene.viscosity.values().collect();
+    let share_can_sound = [
+        viscosities.iter().any(|&c| c > 0.0),
+        viscosities.iter().any(|&c| c < 1.0),
+    ];
+    for (index, key) in ["glug.b1_per_s", "glug.b2_per_s"].into_iter().enumerate() {
+        let frequency_hz = config.frequency_hz[index];
+        let lowest_draw_hz = frequency_hz * (1.0 - config.freq_jitter);
+        let can_sound = share_can_sound[index] && frequency_hz > 0.0 && lowest_draw_hz < nyquist_hz;
+        let decay_per_s = config.decay_per_s[index];
+        let decay_s = SILENT_DECAY_EXPONENT / decay_per_s;
+        if can_sound && decay_s > MAX_DURATION_S {
+            return Err(RenderError::DecaysTooSlowly {
+                key,
+                decay_per_s,
+                decay_time: if decay_s.is_finite() {
+                    format!("{decay_s:.0} s")
+                } else {
+                    "for ever".into()
+                },
+                min_decay_per_s: SILENT_DECAY_EXPONENT / MAX_DURATION_S,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Whether, with the controls held still for good, the scene can be seen never to fall silent:
-/// follow mode holds the volume, so a bottle still pouring pours for ever, and a decay rate of 0
-/// rings for ever.
+/// follow mode holds the volume, so a bottle still pouring pours for ever. (A decay rate too slow
+/// to end, 0 included, is refused before rendering by [`refuse_endless_decays`].)
 fn endless(scene: &Scene, engine: &Engine) -> bool {
-    let pours_for_ever = scene.config.drain == DrainMode::Follow && !engine.is_resting();
-    let rings_for_ever =
-        scene.config.decay_per_s.contains(&0.0) && engine.sounding_components() > 0;
-    pours_for_ever || rings_for_ever
+    scene.config.drain == DrainMode::Follow && !engine.is_resting()
 }
 
 /// The largest |y| of a block. The engine's output is finite, and the bits of a finite float

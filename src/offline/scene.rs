@@ -72,6 +72,16 @@ pub enum SceneError {
         /// What was wrong.
         source: TakeError,
     },
+    /// A value that must be a whole number (the sample rate) has a fraction.
+    #[error("`{key}` = {value} is not a whole number: {what} must be whole")]
+    NotWhole {
+        /// The scene key (also for the command line's override of it).
+        key: &'static str,
+        /// The value given.
+        value: f64,
+        /// What the value is, in the message.
+        what: &'static str,
+    },
     /// An automation point whose time is not finite, is negative or comes before the previous
     /// point's.
     #[error("`{key}`: point {index} is at {time_s} s; point times must be finite, at least 0 and in order")]
@@ -174,9 +184,10 @@ impl Scene {
         file.validate(folder)
     }
 
-    /// The same scene at another sample rate (a take's messages move to their new samples).
+    /// The same scene at another sample rate, refused as a scene's `sample_rate` would be: out
+    /// of range or not a whole number of Hz. A take's messages move to their new samples.
     pub fn with_sample_rate(self, sample_rate: f64) -> Result<Self, SceneError> {
-        let sample_rate = check("sample_rate", sample_rate, config::SAMPLE_RATE_HZ)? as u32;
+        let sample_rate = check_sample_rate(sample_rate)?;
         let take = match self.take {
             Some(take) => Some(MidiTake::from_bytes(&take.path, take.bytes, sample_rate)?),
             None => None,
@@ -301,7 +312,9 @@ pub struct LaneBuffers([Vec<f64>; 5]);
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct SceneFile {
-    sample_rate: Option<u32>,
+    /// Read as a number of either type, so that a fraction is refused by [`check_sample_rate`]
+    /// with the same message as the command line's `--sample-rate`.
+    sample_rate: Option<f64>,
     duration_s: Option<f64>,
     seed: Option<u64>,
     deterministic: Option<bool>,
@@ -399,7 +412,7 @@ impl MidiSection {
 impl SceneFile {
     fn validate(self, folder: &Path) -> Result<Scene, SceneError> {
         let sample_rate = match self.sample_rate {
-            Some(rate) => check("sample_rate", rate as f64, config::SAMPLE_RATE_HZ)? as u32,
+            Some(rate) => check_sample_rate(rate)?,
             None => config::SAMPLE_RATE_HZ.default as u32,
         };
         let duration_s = self
@@ -522,6 +535,19 @@ fn check(key: &'static str, value: f64, range: Range) -> Result<f64, SceneError>
             max: range.max,
         })
     }
+}
+
+/// A sample rate in range and a whole number of Hz.
+fn check_sample_rate(sample_rate: f64) -> Result<u32, SceneError> {
+    let sample_rate = check("sample_rate", sample_rate, config::SAMPLE_RATE_HZ)?;
+    if sample_rate.fract() != 0.0 {
+        return Err(SceneError::NotWhole {
+            key: "sample_rate",
+            value: sample_rate,
+            what: "a sample rate is a number of samples per second",
+        });
+    }
+    Ok(sample_rate as u32)
 }
 
 fn constant(key: &'static str, value: Option<f64>, range: Range) -> Result<f64, SceneError> {

@@ -22,6 +22,9 @@ use crate::engine::{
 pub const WINDOW_S: f64 = 10.0;
 /// The render lengths of the table, in seconds: 1 s, 1 min, 1 h.
 pub const LENGTHS_S: [f64; 3] = [1.0, 60.0, 3600.0];
+/// The error budget of MODEL.md §9 for the default path: below this at every render length (the
+/// contract states it for an hour and forbids drift with length, so it holds at any length).
+pub const BUDGET_DB: f64 = -100.0;
 /// The output gain every case renders at (the model's default).
 const GAIN_DB: f64 = -6.0;
 
@@ -271,6 +274,32 @@ pub fn measure(
         }
     }
     rows
+}
+
+/// Why the rows fail MODEL.md §9, one line each; empty if they pass. A row whose error is NaN
+/// (empty or silent windows: a length or sample rate of 0) fails whatever its path, and the
+/// default path fails at any length where its max error is not below [`BUDGET_DB`].
+pub fn budget_failures(rows: &[Measurement]) -> Vec<String> {
+    let mut failures = Vec::new();
+    for row in rows {
+        let label = format!(
+            "{} / {} / {}",
+            row.case,
+            row.path.name(),
+            length_label(row.length_s)
+        );
+        if row.max_error_db.is_nan() || row.rms_error_db.is_nan() {
+            failures.push(format!(
+                "{label}: the error is NaN (nothing was compared: empty or silent windows)"
+            ));
+        } else if row.path == SynthesisPath::Default && row.max_error_db >= BUDGET_DB {
+            failures.push(format!(
+                "{label}: max error {:.1} dB is not below the budget of {BUDGET_DB} dB",
+                row.max_error_db
+            ));
+        }
+    }
+    failures
 }
 
 /// A length as the table shows it.

@@ -2,9 +2,10 @@
 //! by `sake-glug stability` (long renders) and `tests/stability.rs` (short ones).
 //!
 //! Every case renders through the engine's public API and checks some of:
-//! - **finite**: no NaN or infinity in any sample;
-//! - **ceiling**: |y| never exceeds the (sanitised) ceiling;
-//! - **energy**: once no unit starts any more, the energy of consecutive spans never grows;
+//! - **finite**: no NaN or infinity in any sample, before the output limiter as well as after;
+//! - **ceiling**: |y| never exceeds the (sanitised) ceiling, and how often the limiter acted;
+//! - **energy**: once no unit starts any more, the energy of consecutive spans never grows, judged
+//!   only where the limiter did not act (so the output is the signal before the limiter);
 //! - **time**: engine run time per sample within a factor of a normal case measured in the same
 //!   run (catches denormal slow-downs and runaway work); a ratio, never an absolute time;
 //! - case-specific properties (voices capped, nothing computed above Nyquist, no drift...).
@@ -59,6 +60,9 @@ pub const MAX_TIME_RATIO: f64 = 5.0;
 const ENERGY_TOLERANCE: f64 = 0.01;
 /// Span over which energy is summed: whole cycles of 80 Hz and 300 Hz.
 const ENERGY_SPAN_S: f64 = 0.1;
+/// The output gain of the decay sweep: twelve never-decaying units in phase at 300 Hz sum to
+/// 4 before the gain, and must stay under the ceiling so that their energy can be judged.
+const DECAY_SWEEP_GAIN_DB: f64 = -20.0;
 
 /// The stability catalogue: every group of cases, each describing what it renders and what its
 /// time check compares with. `sake-glug stability --catalogue` prints it as the case table of
@@ -111,7 +115,7 @@ impl StabilityCase {
         match self {
             StabilityCase::DecaySweep => {
                 "B1 = B2 ∈ {0, 10⁻⁶, 1, 45, 10³, 10⁵, 10⁷, 10⁹} s⁻¹; 1 s of steady pouring then \
-                 upright"
+                 upright, at −20 dB (twelve undecaying units in phase stay under the ceiling)"
             }
             StabilityCase::FrequencySweep => {
                 "f1 = f2 ∈ {0, 1, 80, 0.4999·fs, fs/2, fs, 400 kHz, 10⁹} Hz; the same pour"
@@ -235,15 +239,20 @@ impl Property {
     /// What the property asserts.
     pub fn description(self) -> String {
         match self {
-            Property::Finite => "no NaN or infinity in any sample".into(),
-            Property::Ceiling => {
-                "|y| never exceeds the sanitised ceiling (compared in f32, as the engine clamps)"
-                    .into()
-            }
+            Property::Finite => "no NaN or infinity in any sample: in the output, and before \
+                                 the output limiter (the engine counts the samples that were not \
+                                 finite before it turned them into 0 or the ceiling)"
+                .into(),
+            Property::Ceiling => "|y| never exceeds the sanitised ceiling (compared in f32, as \
+                                  the engine clamps); the measurement says on how many samples \
+                                  the limiter acted"
+                .into(),
             Property::Energy => format!(
                 "once no unit starts any more, the energy of consecutive {ENERGY_SPAN_S} s spans \
                  never grows by more than {} % (a never-decaying unit keeps its energy; a \
-                 decaying one loses it)",
+                 decaying one loses it); judged where the limiter did not act, where the output \
+                 is the signal before the limiter: a judged span in which the limiter acted \
+                 fails the check",
                 ENERGY_TOLERANCE * 100.0
             ),
             Property::Time => format!(
@@ -359,6 +368,11 @@ fn steady(_sample: u64) -> (ControlValues, f64) {
 
 /// Pours as [`steady`] for `pour_s`, then stands the bottle upright: nothing starts after.
 fn pour_then_stop(sample_rate: f64, pour_s: f64) -> Inputs {
+    pour_then_stop_at(sample_rate, pour_s, -6.0)
+}
+
+/// [`pour_then_stop`] at output gain `gain_db`.
+fn pour_then_stop_at(sample_rate: f64, pour_s: f64, gain_db: f64) -> Inputs {
     Box::new(move |sample| {
         let pouring = (sample as f64) < pour_s * sample_rate;
         (
@@ -366,7 +380,7 @@ fn pour_then_stop(sample_rate: f64, pour_s: f64) -> Inputs {
                 tilt_deg: if pouring { 135.0 } else { 0.0 },
                 ..ControlValues::default()
             },
-            -6.0,
+            gain_db,
         )
     })
 }
@@ -386,6 +400,33 @@ struct Run {
     units_started: u64,
     units_skipped: u64,
     given_up: u64,
+}
+
+#[cfg(feature = "fault-injection")]
+thread_local! {
+    /// Whether the engines this thread's cases build get a NaN in their first component.
+    static NAN_IN_A_COMPONENT: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `cases` with a NaN injected into the first component of every engine they build: the
+/// suite must then fail (the tests show it does). Only with the `fault-injection` feature.
+#[cfg(feature = "fault-injection")]
+pub fn with_nan_in_a_component<R>(cases: impl FnOnce() -> R) -> R {
+    NAN_IN_A_COMPONENT.with(|inject| inject.set(true));
+    let result = cases();
+    NAN_IN_A_COMPONENT.with(|inject| inject.set(false));
+    result
+}
+
+/// An engine on the default path, with the fault of [`with_nan_in_a_component`] when asked.
+fn new_engine(sample_rate: f64, config: ModelConfig) -> Engine<VoiceBank> {
+    #[allow(unused_mut)]
+    let mut engine = Engine::<VoiceBank>::with_synthesis(sample_rate, config);
+    #[cfg(feature = "fault-injection")]
+    if NAN_IN_A_COMPONENT.with(|inject| inject.get()) {
+        engine.inject_nan_into_next_component();
+    }
+    engine
 }
 
 impl Run {
@@ -420,7 +461,7 @@ fn run(
 ) -> Run {
     let mut best: Option<Run> = None;
     for _ in 0..repeats.max(1) {
-        let mut engine = Engine::<VoiceBank>::with_synthesis(sample_rate, config);
+        let mut engine = new_engine(sample_rate, config);
         let fs = engine.sample_rate();
         let len = (seconds * fs).round() as u64;
         let spec = RenderSpec {
@@ -451,10 +492,15 @@ fn check(what: Property, passed: bool, detail: String) -> Check {
 }
 
 fn finite(run: &Run) -> Check {
+    let hidden = run.render.non_finite_before_limiter;
     check(
         Property::Finite,
-        run.render.all_finite,
-        "every sample".into(),
+        run.render.all_finite && hidden == 0,
+        if hidden == 0 {
+            "every sample, before the limiter too".into()
+        } else {
+            format!("{hidden} samples NaN or infinite before the limiter")
+        },
     )
 }
 
@@ -463,14 +509,19 @@ fn ceiling(run: &Run) -> Check {
         Property::Ceiling,
         // In f32, as the engine clamps: 0.001 rounds up in f32.
         run.render.all_finite && run.render.peak <= run.ceiling as f32,
-        format!("peak {:.3} ≤ {}", run.render.peak, run.ceiling),
+        format!(
+            "peak {:.3} ≤ {}, limiter acted on {} samples",
+            run.render.peak, run.ceiling, run.render.limiter_events
+        ),
     )
 }
 
-/// Energy of consecutive spans after the last onset never grows beyond the tolerance.
+/// Energy of consecutive spans after the last onset never grows beyond the tolerance, and the
+/// limiter did not act in those spans (there the output is the signal before the limiter).
 fn energy_not_growing(run: &Run, span: u64) -> Check {
     let first = (run.render.last_onset_by / span + 1) as usize;
     let energies = run.render.energies.get(first..).unwrap_or(&[]);
+    let limited = limiter_events_in_spans(&run.render, first);
     let worst = energies
         .windows(2)
         .map(|pair| {
@@ -485,12 +536,24 @@ fn energy_not_growing(run: &Run, span: u64) -> Check {
         .fold(0.0, f64::max);
     check(
         Property::Energy,
-        worst <= 1.0 + ENERGY_TOLERANCE && energies.len() >= 2,
+        worst <= 1.0 + ENERGY_TOLERANCE && energies.len() >= 2 && limited == 0,
         format!(
-            "largest span-to-span ratio {worst:.4} over {} spans",
+            "largest span-to-span ratio {worst:.4} over {} spans, limiter acted on {limited} \
+             samples in them",
             energies.len()
         ),
     )
+}
+
+/// Samples the limiter changed in the energy spans from `first` on.
+fn limiter_events_in_spans(render: &TimedRender, first: usize) -> u64 {
+    let counts = &render.span_limiter_events;
+    match counts.last() {
+        Some(&last) if first < counts.len() => {
+            last - if first == 0 { 0 } else { counts[first - 1] }
+        }
+        _ => 0,
+    }
 }
 
 fn time_ratio(run: &Run, normal: &Run) -> Check {
@@ -514,12 +577,14 @@ fn outcome(
         name,
         checks,
         notes: format!(
-            "{:.0}× real time, {} units ({} skipped), {} components given up, at most {} sounding",
+            "{:.0}× real time, {} units ({} skipped), {} components given up, at most {} sounding, \
+             limiter acted on {} samples",
             run.times_real_time(sample_rate),
             run.units_started,
             run.units_skipped,
             run.given_up,
-            run.render.max_sounding
+            run.render.max_sounding,
+            run.render.limiter_events
         ),
     }
 }
@@ -541,7 +606,7 @@ fn decay_sweep(scale: Scale) -> Vec<Outcome> {
         decay_per_s: [decay; 2],
         ..follow().deterministic()
     };
-    let inputs = pour_then_stop(fs, 1.0);
+    let inputs = pour_then_stop_at(fs, 1.0, DECAY_SWEEP_GAIN_DB);
     let normal = run(fs, config(0.0), seconds, &inputs, scale.repeats());
     [0.0, 1e-6, 1.0, 45.0, 1e3, 1e5, 1e7, 1e9]
         .into_iter()
@@ -674,9 +739,10 @@ fn sample_rate_sweep(scale: Scale) -> Vec<Outcome> {
 }
 
 /// Pour time down to 10 ms and pockets down to 0.001 ml: hundreds of units due per sample.
-/// The pour voices at most 8 per sample and counts the rest as skipped, the bank starts at most
-/// 16 components per 64 samples and holds at most 256; the run time is compared with a busy but
-/// ordinary pour whose bank is also full (0.02 ml pockets).
+/// The pour voices at most 8 per sample and counts the rest as skipped, the start budget admits
+/// a burst of 8 units and then 6000 units per second, and the bank holds at most 256
+/// components (MODEL.md §11); the run time is compared with a busy but ordinary pour whose bank
+/// is also full (0.02 ml pockets).
 fn flood(scale: Scale) -> Vec<Outcome> {
     let fs = 48_000.0;
     let seconds = scale.sweep_s();
@@ -829,11 +895,16 @@ fn hostile_inputs(scale: Scale) -> Vec<Outcome> {
     ];
     let mut outcomes = Vec::new();
     let mut judge = |name: String, runs: Vec<Run>| {
-        let all_finite = runs.iter().all(|r| r.render.all_finite);
+        let hidden: u64 = runs
+            .iter()
+            .map(|r| r.render.non_finite_before_limiter)
+            .sum();
+        let all_finite = runs.iter().all(|r| r.render.all_finite) && hidden == 0;
         let within = runs
             .iter()
             .all(|r| r.render.all_finite && r.render.peak <= r.ceiling as f32);
         let peak = runs.iter().map(|r| r.render.peak).fold(0.0f32, f32::max);
+        let limited: u64 = runs.iter().map(|r| r.render.limiter_events).sum();
         outcomes.push(Outcome {
             group: StabilityCase::HostileInputs,
             name,
@@ -841,9 +912,16 @@ fn hostile_inputs(scale: Scale) -> Vec<Outcome> {
                 check(
                     Property::Finite,
                     all_finite,
-                    format!("{} renders", runs.len()),
+                    format!(
+                        "{} renders, {hidden} samples not finite before the limiter",
+                        runs.len()
+                    ),
                 ),
-                check(Property::Ceiling, within, format!("largest peak {peak:.3}")),
+                check(
+                    Property::Ceiling,
+                    within,
+                    format!("largest peak {peak:.3}, limiter acted on {limited} samples"),
+                ),
             ],
             notes: "values: NaN, +∞, −∞, −1e300, 1e300, −1, 0 (constants: at construction and \
                     again through set_config mid-pour)"
@@ -895,7 +973,7 @@ fn switch_config(
     seconds: f64,
     inputs: &impl ControlSource,
 ) -> Run {
-    let mut engine = Engine::<VoiceBank>::with_synthesis(sample_rate, follow());
+    let mut engine = new_engine(sample_rate, follow());
     let half = (seconds * sample_rate / 2.0).round() as u64;
     let spec = RenderSpec {
         sample_rate,
@@ -913,6 +991,9 @@ fn switch_config(
         after.peak = f32::INFINITY;
     }
     after.engine_time += before.engine_time;
+    after.limiter_events += before.limiter_events;
+    after.non_finite_before_limiter += before.non_finite_before_limiter;
+    after.max_sounding = after.max_sounding.max(before.max_sounding);
     Run {
         render: after,
         len: 2 * half,
@@ -935,10 +1016,14 @@ fn long_render(scale: Scale) -> Vec<Outcome> {
         // The first minute holds the onset transients of the ring scene; compare from the second.
         let (first, last) = (energies[1], energies[energies.len() - 1]);
         let ratio = last / first;
+        let limited = limiter_events_in_spans(&run.render, 1);
         check(
             what,
-            (1.0 - ENERGY_TOLERANCE..=1.0 + ENERGY_TOLERANCE).contains(&ratio),
-            format!("last minute's energy / second minute's = {ratio:.6}"),
+            (1.0 - ENERGY_TOLERANCE..=1.0 + ENERGY_TOLERANCE).contains(&ratio) && limited == 0,
+            format!(
+                "last minute's energy / second minute's = {ratio:.6}, limiter acted on \
+                 {limited} samples after the first minute"
+            ),
         )
     };
     let cost_flat = |run: &Run| {
@@ -1033,7 +1118,7 @@ fn long_run(
     inputs: &impl ControlSource,
     energy_span: u64,
 ) -> Run {
-    let mut engine = Engine::<VoiceBank>::with_synthesis(sample_rate, config);
+    let mut engine = new_engine(sample_rate, config);
     let len = (seconds * sample_rate).round() as u64;
     let spec = RenderSpec {
         sample_rate,

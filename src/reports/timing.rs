@@ -24,8 +24,15 @@ pub struct TimedRender {
     pub energies: Vec<f64>,
     /// Engine time spent up to the end of each energy span (the block that ends it).
     pub span_times: Vec<Duration>,
-    /// The most components that sounded at the end of any block.
+    /// The most components that sounded at once, at any sample.
     pub max_sounding: usize,
+    /// Samples the engine's output limiter changed (over the ceiling or not finite).
+    pub limiter_events: u64,
+    /// Samples that were NaN or infinite before the limiter.
+    pub non_finite_before_limiter: u64,
+    /// The limiter's events up to the end of each energy span (cumulative, exact: blocks are cut
+    /// at span ends), so a check can tell where the output is the unlimited signal.
+    pub span_limiter_events: Vec<u64>,
     /// The sample after the one in which the last unit started (0 if none did).
     pub last_onset_by: u64,
 }
@@ -71,12 +78,25 @@ pub fn timed_render_on<S: Synthesis>(
         energies: Vec::new(),
         span_times: Vec::new(),
         max_sounding: 0,
+        limiter_events: 0,
+        non_finite_before_limiter: 0,
+        span_limiter_events: Vec::new(),
         last_onset_by: 0,
     };
+    // Counts since the engine's reset; a caller's engine may have rendered before.
+    let (limiter_before, non_finite_before) =
+        (engine.limiter_events(), engine.non_finite_before_limiter());
+    engine.take_peak_sounding();
     let mut energy = 0.0;
     let mut start = 0u64;
     while start < spec.len {
-        let len = (spec.len - start).min(BLOCK as u64) as usize;
+        let mut len = (spec.len - start).min(BLOCK as u64) as usize;
+        if spec.energy_span > 0 {
+            // A block ends at the next span end, so the limiter's count is known per span. Any
+            // cut gives the same samples.
+            let to_span_end = spec.energy_span - start % spec.energy_span;
+            len = len.min(to_span_end as usize);
+        }
         for lane in &mut lanes {
             lane.clear();
         }
@@ -99,7 +119,9 @@ pub fn timed_render_on<S: Synthesis>(
         let began = Instant::now();
         engine.process(&block, out);
         result.engine_time += began.elapsed();
-        result.max_sounding = result.max_sounding.max(engine.sounding_components());
+        result.max_sounding = result.max_sounding.max(engine.take_peak_sounding());
+        result.limiter_events = engine.limiter_events() - limiter_before;
+        result.non_finite_before_limiter = engine.non_finite_before_limiter() - non_finite_before;
         result.last_onset_by = engine.last_unit().map_or(0, |unit| unit.sample + 1);
 
         for (offset, &y) in out.iter().enumerate() {
@@ -111,6 +133,7 @@ pub fn timed_render_on<S: Synthesis>(
                 if (sample + 1).is_multiple_of(spec.energy_span) {
                     result.energies.push(energy);
                     result.span_times.push(result.engine_time);
+                    result.span_limiter_events.push(result.limiter_events);
                     energy = 0.0;
                 }
             }

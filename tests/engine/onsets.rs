@@ -112,3 +112,27 @@ fn units_carry_the_viscosity_and_volume_at_their_onset() {
         assert!((onset.volume_ml - (300.0 - 60.0 * time)).abs() < 1e-6);
     }
 }
+
+#[test]
+fn a_flood_voices_exactly_eight_units_a_sample() {
+    // MODEL.md §11: 625 pockets are due in every sample here, 8 are voiced. The reference takes
+    // its onsets from the same schedule, so the cap is checked here, against the contract's 8.
+    let config = ModelConfig {
+        pocket_ml: 0.001,
+        ..ModelConfig::default().deterministic()
+    };
+    let controls = |_| ControlValues {
+        pour_time_s: 0.01,
+        ..tilt_only(135.0)
+    };
+    let (onsets, _) = pour_onsets(48_000.0, config, controls, 0.005);
+    let mut per_sample = std::collections::BTreeMap::new();
+    for onset in &onsets {
+        *per_sample.entry(onset.sample).or_insert(0) += 1;
+    }
+    assert_eq!(per_sample.len(), 240, "every sample of the flood glugs");
+    assert!(
+        per_sample.values().all(|&count| count == 8),
+        "{per_sample:?}"
+    );
+}

@@ -1,6 +1,14 @@
 //! The default real-time path against the f64 direct reference (MODEL.md §9): below −100 dB.
+//!
+//! The reference computes a(V), the c / (1 − c) split, the gain, the ceiling, the ranges inputs
+//! are brought into and the caps of MODEL.md §11 from its own copies of the contract, so these
+//! tests fail when the engine's copy of any of them is wrong; only the onset schedule is shared
+//! (it is checked on its own by `drain.rs` and `onsets.rs`).
 
-use crate::support::{error_db, reference_render, render_in_blocks};
+use crate::support::{
+    error_db, reference_controls, reference_render, render_controls, render_in_blocks,
+};
+use sake_glug::engine::{ControlValues, ModelConfig};
 use sake_glug::offline::Scene;
 
 fn assert_matches_reference(scene_text: &str, seconds: f64) {
@@ -65,4 +73,111 @@ fn slow_decays_and_high_frequencies_match_the_reference() {
         "#,
         4.0,
     );
+}
+
+#[test]
+fn other_capacities_and_viscosities_match_the_reference() {
+    // a(V) scales with C; c far from water's 0.33 weighs the split.
+    assert_matches_reference(
+        r#"
+        seed = 4
+        tilt_deg = [[0.0, 95.0], [1.0, 160.0]]
+        viscosity_c = [[0.0, 0.9], [2.0, 0.05]]
+        [bottle]
+        capacity_ml = 720.0
+        pocket_ml = 9.0
+        "#,
+        5.0,
+    );
+}
+
+#[test]
+fn a_short_flood_is_voiced_by_the_contracts_caps() {
+    // 625 pockets are due per sample for 10 ms: 8 a sample are voiced (§11), and of those the
+    // start budget admits a burst of 8 units and then 6000 per second, about 68 units, whose
+    // 136 components stay under the 256 the bank holds (which the reference does not model).
+    let scene = Scene::parse(
+        r#"
+        deterministic = true
+        tilt_deg = 135.0
+        pour_time_s = 0.01
+        [bottle]
+        pocket_ml = 0.001
+        "#,
+    )
+    .unwrap();
+    let len = 24_000;
+    let window = sake_glug::engine::synthesis::reference::evaluate(
+        48_000.0,
+        scene.config,
+        &scene,
+        0..len as u64,
+    );
+    assert!(
+        window.onsets.len() > 1000,
+        "the onset cap and the budget must both bite: {} onsets",
+        window.onsets.len()
+    );
+    let fast = render_in_blocks(&scene, len, &[4096]);
+    let error = error_db(&fast, &window.samples);
+    assert!(error < -100.0, "{error:.1} dB");
+}
+
+/// A steady pour at 135° whose inputs `vary` changes by time (s), asked for at `sample_rate`.
+fn assert_controls_match(
+    what: &str,
+    sample_rate: f64,
+    config: ModelConfig,
+    vary: impl Fn(f64, &mut ControlValues, &mut f64),
+) {
+    let fs = sake_glug::engine::Engine::new(sample_rate, config).sample_rate();
+    let controls = move |sample: u64| {
+        let mut values = ControlValues {
+            tilt_deg: 135.0,
+            ..ControlValues::default()
+        };
+        let mut gain_db = -6.0;
+        vary(sample as f64 / fs, &mut values, &mut gain_db);
+        (values, gain_db)
+    };
+    let len = (1.5 * fs) as u64;
+    let fast = render_controls(sample_rate, config, &controls, len);
+    let reference = reference_controls(sample_rate, config, &controls, len);
+    let error = error_db(&fast, &reference);
+    assert!(error < -100.0, "{what}: {error:.1} dB");
+}
+
+#[test]
+fn inputs_outside_their_ranges_are_brought_in_as_the_contract_says() {
+    let config = ModelConfig::default().deterministic();
+    // The sample rate is clamped to 1 kHz … 768 kHz, NaN is 48 kHz.
+    for requested in [500.0, 1e6, f64::NAN] {
+        assert_controls_match(&format!("fs {requested}"), requested, config, |_, _, _| {});
+    }
+    // c outside [0, 1] is clamped, NaN is water's 0.33.
+    assert_controls_match("viscosity", 48_000.0, config, |t, values, _| {
+        values.viscosity = match (t * 4.0) as u32 {
+            0 => 1.5,
+            1 => f64::NAN,
+            2 => -0.5,
+            _ => 0.8,
+        };
+    });
+    // The gain is clamped to −120 … +24 dB, NaN is −6 dB: −200 dB must sound at −120 dB.
+    for gain in [-200.0, f64::NAN, -119.0] {
+        assert_controls_match(&format!("gain {gain}"), 48_000.0, config, |_, _, g| {
+            *g = gain
+        });
+    }
+    // The ceiling, reached by a louder gain: 0.3 as asked; 7 and NaN become 1. (The error is
+    // relative to the clipped peak, so the overdrive is kept small.)
+    for (ceiling, gain) in [(0.3, 0.0), (7.0, 12.0), (f64::NAN, 12.0), (1.0, 30.0)] {
+        let clipped = ModelConfig { ceiling, ..config };
+        assert_controls_match(
+            &format!("ceiling {ceiling} at {gain} dB"),
+            48_000.0,
+            clipped,
+            move |_, _, g| *g = gain,
+        );
+    }
 }

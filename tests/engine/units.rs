@@ -172,3 +172,48 @@ fn amplitude_follows_the_papers_law_and_vanishes_below_84_ml() {
     assert!(units > 20);
     assert_eq!(silent, 0.0);
 }
+
+/// The voice caps of MODEL.md §11 in a 10 ms flood (625 pockets due per sample, 8 voiced): the
+/// start budget admits a burst of 8 units and then 6000 a second, whatever the sample rate, and
+/// admits or refuses whole units.
+#[test]
+fn the_start_budget_is_a_rate_in_time_and_admits_whole_units() {
+    let admitted_at = |fs: f64| {
+        // Follow mode keeps the bottle full, so every unit has both components.
+        let config = ModelConfig {
+            pocket_ml: 0.001,
+            drain: DrainMode::Follow,
+            ..ModelConfig::default().deterministic()
+        };
+        let mut engine = Engine::new(fs, config);
+        let controls = Controls {
+            tilt_deg: Lane::Constant(135.0),
+            pour_time_s: Lane::Constant(0.01),
+            ..Controls::default()
+        };
+        // 10 ms of flood; no component decays below −120 dB that soon.
+        let mut out = vec![0.0f32; (0.01 * fs) as usize];
+        engine.process(&controls, &mut out);
+        let stats = engine.stats();
+        let voiced = stats.units_started - stats.units_skipped;
+        let given_up = engine.components_given_up();
+        assert_eq!(given_up % 2, 0, "{fs} Hz: half a unit was given up");
+        let admitted = voiced - given_up / 2;
+        assert_eq!(
+            engine.sounding_components() as u64,
+            2 * admitted,
+            "{fs} Hz: every admitted unit sounds both components"
+        );
+        admitted
+    };
+    let at_48k = admitted_at(48_000.0);
+    // 8 at once, then 6000 /s over the 10 ms of the flood.
+    assert!((67..=69).contains(&at_48k), "{at_48k} units at 48 kHz");
+    for fs in [44_100.0, 96_000.0, 192_000.0] {
+        assert!(
+            admitted_at(fs).abs_diff(at_48k) <= 1,
+            "{} units at {fs} Hz, {at_48k} at 48 kHz",
+            admitted_at(fs)
+        );
+    }
+}

@@ -3,6 +3,8 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
+use sake_glug::offline::{render_scene, render_scene_to_vec, RenderError, Scene};
+
 fn sake_glug(directory: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sake-glug"))
         .current_dir(directory)
@@ -128,6 +130,55 @@ fn a_scene_that_never_falls_silent_is_refused_and_leaves_no_file() {
 }
 
 #[test]
+fn a_decay_too_slow_to_end_is_refused_before_anything_is_rendered() {
+    // 1e-6 /s takes 160 days to reach −120 dB: without a duration the render could only stop at
+    // the 24 h limit, after about 16 GB.
+    let scene = Scene::parse("tilt_deg = 135.0\n[glug]\nb2_per_s = 1e-6\n").unwrap();
+    let mut blocks = 0;
+    let result = render_scene(
+        &scene,
+        |_: &[f32]| {
+            blocks += 1;
+            Err(RenderError::NeverSettles)
+        },
+        &mut |_| {},
+    );
+    let message = result.unwrap_err().to_string();
+    assert_eq!(blocks, 0, "the render started: {message}");
+    assert!(
+        message.contains("`glug.b2_per_s` = 0.000001 /s")
+            && message.contains("give it a duration_s"),
+        "{message}"
+    );
+    // The same scene with a duration renders; and with c = 0 (no f1 component) a B1 of 0
+    // cannot ring, so it is not refused.
+    let timed = Scene::parse("duration_s = 0.5\ntilt_deg = 135.0\n[glug]\nb2_per_s = 1e-6\n");
+    assert!(render_scene_to_vec(&timed.unwrap()).is_ok());
+    let no_f1 = Scene::parse("tilt_deg = 135.0\nviscosity_c = 0.0\n[glug]\nb1_per_s = 0.0\n");
+    assert!(render_scene_to_vec(&no_f1.unwrap()).is_ok());
+    assert_refused(
+        "tilt_deg = 135.0\n[glug]\nb2_per_s = 1e-6\n",
+        "a glug needs 13815511 s to decay to −120 dB",
+    );
+}
+
+#[test]
+fn a_fractional_sample_rate_is_refused_on_the_command_line_as_in_a_scene() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = sake_glug(
+        directory.path(),
+        &["render", "--sample-rate", "44100.9", "-o", "out.wav"],
+    );
+    assert_eq!(output.status.code(), Some(1));
+    let message = String::from_utf8_lossy(&output.stderr);
+    let in_scene = Scene::parse("sample_rate = 44100.9")
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains(&in_scene), "{message}");
+    assert!(files_in(directory.path()).is_empty());
+}
+
+#[test]
 fn bad_arguments_are_errors_not_panics() {
     let directory = tempfile::tempdir().unwrap();
     let cases: [&[&str]; 3] = [
@@ -145,4 +196,17 @@ fn bad_arguments_are_errors_not_panics() {
         );
     }
     assert!(files_in(directory.path()).is_empty());
+}
+
+#[test]
+fn the_accuracy_command_fails_on_a_nan_row() {
+    // At a sample rate of 0 nothing is compared: the rows are NaN, which must not pass.
+    let directory = tempfile::tempdir().unwrap();
+    let output = sake_glug(
+        directory.path(),
+        &["accuracy", "--lengths", "1", "--sample-rate", "0"],
+    );
+    assert_eq!(output.status.code(), Some(1));
+    let message = String::from_utf8_lossy(&output.stderr);
+    assert!(message.contains("the error is NaN"), "{message}");
 }

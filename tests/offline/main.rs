@@ -8,6 +8,7 @@ mod cli;
 mod clip_rules;
 mod clips_rendered;
 mod determinism;
+mod fuzz;
 mod presets;
 mod scene_files;
 mod takes;

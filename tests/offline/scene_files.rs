@@ -57,36 +57,69 @@ fn every_invalid_fixture_is_refused_with_its_message() {
     }
 }
 
-#[test]
-fn the_full_fixture_reads_every_key() {
-    let text = std::fs::read_to_string(
+fn full_fixture() -> String {
+    std::fs::read_to_string(
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/scenes/valid/full.toml"),
     )
-    .unwrap();
-    let scene = Scene::parse(&text).unwrap();
-    assert_eq!(scene.sample_rate, 48_000);
-    assert_eq!(scene.duration_s, Some(8.0));
+    .unwrap()
+}
+
+#[test]
+fn the_full_fixture_reads_every_key_with_its_own_value() {
+    let scene = Scene::parse(&full_fixture()).unwrap();
+    let default = ModelConfig::default();
+    assert_eq!(scene.sample_rate, 44_100);
+    assert_eq!(scene.duration_s, Some(7.25));
+    let points = |pairs: &[(f64, f64)]| Automation::Points(pairs.to_vec());
+    assert_eq!(scene.tilt_deg, points(&[(0.0, 91.0), (0.75, 133.0)]));
+    assert_eq!(scene.viscosity, points(&[(0.0, 0.61), (2.0, 0.47)]));
+    assert_eq!(scene.fill_percent, Automation::Constant(88.5));
+    assert_eq!(scene.pour_time_s, points(&[(0.0, 6.5), (1.0, 4.25)]));
+    assert_eq!(scene.gain_db, points(&[(0.0, -9.5), (3.0, -3.0)]));
     assert_eq!(
-        scene.tilt_deg,
-        Automation::Points(vec![(0.0, 90.0), (0.5, 135.0)])
+        scene.config,
+        ModelConfig {
+            capacity_ml: 720.0,
+            pocket_ml: 4.5,
+            frequency_hz: [95.0, 280.0],
+            decay_per_s: [52.0, 33.0],
+            // deterministic = true sets every spread to zero...
+            timing_jitter: 0.0,
+            freq_jitter: 0.0,
+            decay_sigma: 0.0,
+            seed: 42,
+            drain: DrainMode::Follow,
+            ceiling: default.ceiling,
+        }
     );
-    assert_eq!(scene.config, ModelConfig::default());
-    let changed = Scene::parse(
-        "seed = 9\ndeterministic = true\n[bottle]\ncapacity_ml = 720.0\n[glug]\nf2_hz = 250.0\n[output]\ndrain = \"follow\"",
-    )
-    .unwrap();
-    assert_eq!(changed.config.seed, 9);
-    assert_eq!(changed.config.capacity_ml, 720.0);
-    assert_eq!(changed.config.frequency_hz, [80.0, 250.0]);
-    assert_eq!(changed.config.drain, DrainMode::Follow);
+    // ...so the spreads are read from the same file without that line.
+    let random = full_fixture().replace("deterministic = true\n", "");
+    let scene = Scene::parse(&random).unwrap();
     assert_eq!(
         (
-            changed.config.timing_jitter,
-            changed.config.freq_jitter,
-            changed.config.decay_sigma
+            scene.config.timing_jitter,
+            scene.config.freq_jitter,
+            scene.config.decay_sigma
         ),
-        (0.0, 0.0, 0.0)
+        (0.21, 0.07, 0.5)
     );
+    // Every value differs from its default, so a key that is not read shows.
+    assert_ne!(scene.config.timing_jitter, default.timing_jitter);
+    assert_ne!(scene.config.freq_jitter, default.freq_jitter);
+    assert_ne!(scene.config.decay_sigma, default.decay_sigma);
+}
+
+#[test]
+fn a_fractional_sample_rate_is_refused_in_a_scene_and_as_an_override_alike() {
+    let in_scene = Scene::parse("sample_rate = 48000.5")
+        .unwrap_err()
+        .to_string();
+    let override_ = Scene::default()
+        .with_sample_rate(48_000.5)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(in_scene, override_);
+    assert!(in_scene.contains("`sample_rate` = 48000.5 is not a whole number"));
 }
 
 #[test]

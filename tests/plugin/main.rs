@@ -1,6 +1,11 @@
 //! The plugin through nice-plug's real traits: parameters, MIDI, OSC, state, transport resets,
 //! every sample rate, and real-time safety.
 
+#[path = "../support/mod.rs"]
+mod support;
+
+mod clap_host;
+mod fuzz;
 mod host;
 
 mod clap_state;

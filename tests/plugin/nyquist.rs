@@ -1,9 +1,14 @@
 //! At every sample rate from 1 kHz to 768 kHz: a component at or above Nyquist is omitted, and
 //! whatever the parameters, the output is finite, within the ceiling and free of denormals.
+//!
+//! Where the f2 knob (10 Hz – 24 kHz) reaches Nyquist the plugin is driven through its
+//! parameters; at 88.2 kHz and above it cannot, so the same settings with f2 past the knob go
+//! through the plugin's real-time side, the code `process()` runs after reading the parameters.
 
 use nice_plug::prelude::Plugin;
 
 use crate::host::{peak, TestHost};
+use sake_glug::plugin::{Feed, RealtimeEngine, Settings};
 
 const RATES: [f32; 10] = [
     1_000.0, 8_000.0, 22_050.0, 44_100.0, 48_000.0, 88_200.0, 96_000.0, 192_000.0, 384_000.0,
@@ -26,27 +31,55 @@ fn quarter_second(host: &mut TestHost) -> Vec<f32> {
     host.render_mono(total, 512)
 }
 
+/// The f2 knob stops at 24 kHz: at 88.2 kHz and above it cannot reach Nyquist.
+const F2_KNOB_MAX_HZ: f64 = 24_000.0;
+
+/// A quarter second of the same pour through the plugin's real-time side ([`RealtimeEngine`],
+/// what `process()` runs once nice-plug has read the parameters) with f2 at `f2_hz`, which may
+/// lie beyond the knob's reach; and the components sounding at its end.
+fn quarter_second_beyond_the_knob(rate: f32, f2_hz: f64) -> (Vec<f32>, usize) {
+    let host = f2_only(rate, 1_000.0);
+    let mut settings = Settings::from_params(host.plugin.glug_params());
+    settings.config.frequency_hz[1] = f2_hz;
+    let mut engine = RealtimeEngine::new(rate as f64, settings.config);
+    let feed = Feed::default();
+    let mut out = vec![0.0f32; (rate / 4.0) as usize];
+    for block in out.chunks_mut(512) {
+        engine.process(&settings, block, &feed);
+    }
+    (out, engine.engine().sounding_components())
+}
+
 #[test]
 fn a_component_at_or_above_nyquist_is_omitted() {
     for rate in RATES {
         let nyquist = rate as f64 / 2.0;
-        // Below Nyquist the component sounds (where the knob reaches; it stops at 24 kHz).
-        let below = (nyquist * 0.9).min(24_000.0);
-        let mut host = f2_only(rate, below);
-        assert!(
-            peak(&quarter_second(&mut host)) > 1e-3,
-            "{below} Hz at {rate} Hz must sound"
-        );
-        // At and above Nyquist, where the knob reaches, it is omitted: silence.
-        for f2 in [nyquist, nyquist * 1.5, 24_000.0] {
-            if f2 > 24_000.0 || f2 < nyquist {
-                continue;
-            }
-            let mut host = f2_only(rate, f2);
-            let out = quarter_second(&mut host);
+        // Below Nyquist the component sounds, through the knob where it reaches and beyond it.
+        let below = nyquist * 0.9;
+        if below <= F2_KNOB_MAX_HZ {
+            let mut host = f2_only(rate, below);
             assert!(
-                out.iter().all(|&s| s == 0.0),
-                "{f2} Hz at {rate} Hz must be omitted, peak {}",
+                peak(&quarter_second(&mut host)) > 1e-3,
+                "{below} Hz at {rate} Hz must sound"
+            );
+        }
+        let (out, _) = quarter_second_beyond_the_knob(rate, below);
+        assert!(peak(&out) > 1e-3, "{below} Hz at {rate} Hz must sound");
+        // At and above Nyquist it is omitted at every rate: silence, and nothing computed.
+        for f2 in [nyquist, nyquist * 1.5, nyquist * 4.0] {
+            if f2 <= F2_KNOB_MAX_HZ {
+                let mut host = f2_only(rate, f2);
+                let out = quarter_second(&mut host);
+                assert!(
+                    out.iter().all(|&s| s == 0.0),
+                    "{f2} Hz at {rate} Hz must be omitted, peak {}",
+                    peak(&out)
+                );
+            }
+            let (out, sounding) = quarter_second_beyond_the_knob(rate, f2);
+            assert!(
+                out.iter().all(|&s| s == 0.0) && sounding == 0,
+                "{f2} Hz at {rate} Hz must be omitted: peak {}, {sounding} sounding",
                 peak(&out)
             );
         }

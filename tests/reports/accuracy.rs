@@ -96,3 +96,28 @@ fn every_engine_path_matches_the_reference_on_a_one_second_pour() {
         assert!(error < budget, "{}: {error:.1} dB", path.name());
     }
 }
+
+#[test]
+fn the_budget_is_gated_at_every_length_and_a_nan_row_fails() {
+    let pours = [scene("pours")];
+    let rows = accuracy::measure(&pours, &[1.0], FS, |_| {});
+    assert_eq!(accuracy::budget_failures(&rows), Vec::<String>::new());
+    // Over budget at 1 s: a short render answers to the budget too.
+    let mut over = rows.clone();
+    let default = over
+        .iter_mut()
+        .find(|row| row.path == SynthesisPath::Default)
+        .unwrap();
+    default.max_error_db = -99.0;
+    let failures = accuracy::budget_failures(&over);
+    assert_eq!(failures.len(), 1, "{failures:?}");
+    assert!(
+        failures[0].contains("default (f32 anchored) / 1 s"),
+        "{failures:?}"
+    );
+    // A sample rate of 0 leaves nothing to compare: every engine path's row is NaN and fails.
+    let empty = accuracy::measure(&pours, &[1.0], 0.0, |_| {});
+    let failures = accuracy::budget_failures(&empty);
+    assert_eq!(failures.len(), 3, "{failures:?}");
+    assert!(failures.iter().all(|failure| failure.contains("NaN")));
+}

@@ -47,3 +47,71 @@ fn hostile_values_for_every_input() {
 fn ten_minutes_stay_stationary_and_do_not_drift() {
     assert_all_pass(StabilityCase::LongRender.run(Scale::Test));
 }
+
+/// A NaN in one component is hidden from the output by the limiter (it becomes 0), so only a
+/// check before the limiter can see it: every case that voices a component must fail.
+#[cfg(feature = "fault-injection")]
+#[test]
+fn a_nan_injected_into_a_component_fails_the_suite() {
+    use sake_glug::reports::stability::{with_nan_in_a_component, Property};
+    let outcomes = with_nan_in_a_component(|| {
+        let mut outcomes = StabilityCase::DecaySweep.run(Scale::Test);
+        outcomes.extend(StabilityCase::TiltFlip.run(Scale::Test));
+        outcomes
+    });
+    for outcome in &outcomes {
+        // A case whose components are all below −120 dB at their first sample (B = 10⁹ /s)
+        // voices nothing, so there is nothing to inject into.
+        let nothing_voiced = outcome.notes.contains("at most 0 sounding");
+        let finite = outcome
+            .checks
+            .iter()
+            .find(|check| check.what == Property::Finite)
+            .unwrap();
+        assert_eq!(
+            finite.passed,
+            nothing_voiced,
+            "{} / {}: {}",
+            outcome.group,
+            outcome.name,
+            outcome.summary()
+        );
+    }
+    assert!(outcomes.iter().filter(|o| !o.passed()).count() >= 8);
+}
+
+/// The report's "at most N sounding" is the true peak, not the count at the end of a block: at
+/// 1 kHz a 4096-sample block outlasts every unit, so a count taken at block ends reads 0.
+#[test]
+fn the_peak_voice_count_is_counted_where_it_happens() {
+    use sake_glug::engine::{ControlValues, Controls, Engine, ModelConfig, VoiceBank};
+    use sake_glug::reports::timing::{self, RenderSpec};
+    let fs = 1_000.0;
+    let controls = |sample: u64| {
+        let tilt_deg = if sample < 1_000 { 135.0 } else { 0.0 };
+        let values = ControlValues {
+            tilt_deg,
+            ..ControlValues::default()
+        };
+        (values, -6.0)
+    };
+    let len = 3_000;
+    let spec = RenderSpec {
+        sample_rate: fs,
+        config: ModelConfig::default(),
+        len,
+        keep: &[],
+        energy_span: 0,
+    };
+    let reported = timing::timed_render::<VoiceBank>(&spec, &controls).max_sounding;
+    // The truth, sample by sample.
+    let mut engine = Engine::new(fs, ModelConfig::default());
+    let mut truth = 0;
+    for sample in 0..len {
+        let (values, gain_db) = controls(sample);
+        engine.process(&Controls::constant(values, gain_db), &mut [0.0]);
+        truth = truth.max(engine.sounding_components());
+    }
+    assert!(truth > 0);
+    assert_eq!(reported, truth);
+}

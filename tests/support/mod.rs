@@ -1,10 +1,15 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod fuzz;
+
 use sake_glug::engine::synthesis::reference;
-use sake_glug::engine::{ControlValues, Engine, ModelConfig, Pour, UnitOnset};
+use sake_glug::engine::{
+    ControlSource, ControlValues, Engine, ModelConfig, Pour, UnitOnset, VoiceBank,
+};
 use sake_glug::offline::{LaneBuffers, Scene};
 use sake_glug::reports::accuracy;
+use sake_glug::reports::timing::{self, RenderSpec};
 
 /// Renders `len` samples of `scene` on the default path, cutting time into blocks of the sizes
 /// `block_sizes` yields (cycled).
@@ -65,4 +70,33 @@ pub fn tilt_only(tilt_deg: f64) -> ControlValues {
         tilt_deg,
         ..ControlValues::default()
     }
+}
+
+/// Renders `len` samples of `controls` on the default path, asking for `sample_rate` as given
+/// (the engine brings it into range), in the blocks of the reports.
+pub fn render_controls(
+    sample_rate: f64,
+    config: ModelConfig,
+    controls: &impl ControlSource,
+    len: u64,
+) -> Vec<f32> {
+    let whole = 0..len;
+    let spec = RenderSpec {
+        sample_rate,
+        config,
+        len,
+        keep: std::slice::from_ref(&whole),
+        energy_span: 0,
+    };
+    timing::timed_render::<VoiceBank>(&spec, controls).kept
+}
+
+/// The f64 reference of the same controls, asked for at the same `sample_rate`.
+pub fn reference_controls(
+    sample_rate: f64,
+    config: ModelConfig,
+    controls: &impl ControlSource,
+    len: u64,
+) -> Vec<f64> {
+    reference::evaluate(sample_rate, config, controls, 0..len).samples
 }

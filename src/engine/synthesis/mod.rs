@@ -12,7 +12,7 @@ mod recursive;
 pub mod reference;
 mod voices;
 
-pub use bank::{MAX_PARTIALS, MAX_STARTS_PER_PERIOD};
+pub use bank::{MAX_PARTIALS, STARTS_PER_SECOND, START_BURST_UNITS};
 pub use component::SILENT_DECAY_EXPONENT;
 pub use partial::GRID;
 pub use recursive::{RecursiveF32, RecursiveF64, REANCHOR_SAMPLES};
@@ -34,8 +34,14 @@ pub trait Synthesis {
     fn is_empty(&self) -> bool;
     /// Components sounding.
     fn len(&self) -> usize;
-    /// Components given up because the bank was full.
+    /// Components given up because the bank was full or the start budget was spent.
     fn given_up(&self) -> u64;
+    /// The most components that sounded at once since the last call; the count then starts
+    /// again from those sounding now.
+    fn take_peak_len(&mut self) -> usize;
+    /// The next component to start gets a NaN state (a test's deliberate fault).
+    #[cfg(feature = "fault-injection")]
+    fn poison_next_component(&mut self);
     /// Voices a unit that starts during sample `onset.sample`.
     fn start_unit(&mut self, onset: &UnitOnset);
     /// Adds every component into `out`, which starts at absolute sample `span_start` and lies

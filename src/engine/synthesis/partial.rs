@@ -68,6 +68,13 @@ impl Sounding for Partial {
     fn level(&self) -> f64 {
         self.level as f64
     }
+
+    #[cfg(feature = "fault-injection")]
+    fn poison(&mut self) {
+        // Both anchors: the NaN lasts until the next re-anchoring from the closed form.
+        self.set_anchor([f64::NAN; 2]);
+        self.next_anchor = [f64::NAN; 2];
+    }
 }
 
 impl Partial {

@@ -61,6 +61,11 @@ impl<T: Float> Sounding for Oscillator<T> {
     fn level(&self) -> f64 {
         self.state.norm().to_f64().unwrap_or(0.0)
     }
+
+    #[cfg(feature = "fault-injection")]
+    fn poison(&mut self) {
+        self.state = Complex::new(T::nan(), T::nan());
+    }
 }
 
 impl<T: Float> Oscillator<T> {
@@ -136,6 +141,15 @@ impl<T: Float> Synthesis for RecursiveBank<T> {
 
     fn given_up(&self) -> u64 {
         self.bank.given_up()
+    }
+
+    fn take_peak_len(&mut self) -> usize {
+        self.bank.take_peak_len()
+    }
+
+    #[cfg(feature = "fault-injection")]
+    fn poison_next_component(&mut self) {
+        self.bank.poison_next();
     }
 
     fn start_unit(&mut self, onset: &UnitOnset) {

@@ -37,6 +37,15 @@ impl Synthesis for VoiceBank {
         self.bank.given_up()
     }
 
+    fn take_peak_len(&mut self) -> usize {
+        self.bank.take_peak_len()
+    }
+
+    #[cfg(feature = "fault-injection")]
+    fn poison_next_component(&mut self) {
+        self.bank.poison_next();
+    }
+
     fn start_unit(&mut self, onset: &UnitOnset) {
         self.bank.start_unit(onset, self.sample_rate);
     }
