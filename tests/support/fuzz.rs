@@ -60,7 +60,8 @@ where
         Ok(()) => "passed".to_string(),
         Err(error) => format!("FAILED: {error}"),
     };
-    println!("fuzz-summary | {target} | {cases} | {seconds:.1} | {verdict}");
+    // On a line of its own, after libtest's "test NAME ... ".
+    println!("\nfuzz-summary | {target} | {cases} | {seconds:.1} | {verdict}");
     if let Err(error) = result {
         panic!("fuzz target {target}: {error}");
     }

@@ -374,7 +374,8 @@ fn fuzz() -> nice_plug_xtask::Result<()> {
     print!("{stdout}");
     let rows: Vec<String> = stdout
         .lines()
-        .filter_map(|line| line.strip_prefix("fuzz-summary "))
+        // libtest may print "test NAME ... " before the harness's line.
+        .filter_map(|line| line.split_once("fuzz-summary ").map(|(_, row)| row))
         .map(|row| format!("{row} |"))
         .collect();
     let mut table = String::from("| target | cases | time (s) | result |\n|---|---:|---:|---|\n");
