@@ -163,3 +163,43 @@ proptest! {
         }
     }
 }
+
+// The target of `cargo xtask fuzz` (a million cases there, proptest's default here).
+
+#[test]
+fn fuzz_osc_packets() {
+    let valid = valid_osc();
+    let keep_limit = valid.len() + 8;
+    let known = (
+        prop::sample::select(vec![
+            "/sakeglug/tilt",
+            "/sakeglug/viscosity",
+            "/sakeglug/fill",
+            "/sakeglug/refill",
+            "/gyrosc/grav",
+            "/accxyz",
+            "/gravity",
+            "/acceleration",
+        ]),
+        prop::collection::vec(osc_argument(), 0..5),
+    )
+        .prop_map(|(address, args)| {
+            let packet = OscPacket::Message(OscMessage {
+                addr: address.into(),
+                args,
+            });
+            rosc::encoder::encode(&packet).unwrap()
+        });
+    let packets = prop_oneof![
+        prop::collection::vec(any::<u8>(), 0..256),
+        (edits(), any::<usize>()).prop_map(move |(edits, keep)| mutate(
+            valid.clone(),
+            &edits,
+            keep % keep_limit
+        )),
+        known,
+    ];
+    crate::support::fuzz::run("OSC packets (decode_osc)", packets, |packet| {
+        check_osc(&packet)
+    });
+}

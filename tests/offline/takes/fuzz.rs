@@ -213,3 +213,39 @@ proptest! {
         }
     }
 }
+
+// The targets of `cargo xtask fuzz` (a million cases each there, proptest's default here): the
+// properties above, over every kind of input at once.
+
+#[test]
+fn fuzz_midi_take_files() {
+    let valid = valid_midi();
+    let keep_limit = valid.len() + 8;
+    let bytes = prop_oneof![
+        prop::collection::vec(any::<u8>(), 0..256),
+        (edits(), any::<usize>()).prop_map(move |(edits, keep)| mutate(
+            valid.clone(),
+            &edits,
+            keep % keep_limit
+        )),
+    ];
+    crate::support::fuzz::run("MIDI take files (read_midi_take)", bytes, |bytes| {
+        check_midi(&bytes, 48_000)
+    });
+}
+
+#[test]
+fn fuzz_csv_lanes() {
+    let text = prop_oneof![
+        "(?s).{0,200}".prop_map(|text| format!("time_s,ax,ay,az,fill\n{text}")),
+        (edits(), any::<usize>()).prop_map(|(edits, keep)| {
+            let mutated = mutate(
+                VALID_CSV.as_bytes().to_vec(),
+                &edits,
+                keep % (VALID_CSV.len() + 8),
+            );
+            String::from_utf8_lossy(&mutated).into_owned()
+        }),
+    ];
+    crate::support::fuzz::run("CSV lanes (read_csv_lane)", text, |text| check_csv(&text));
+}
