@@ -1,26 +1,7 @@
 //! The `sake-glug render` command as a user runs it.
 
-use std::path::Path;
-use std::process::{Command, Output};
-
+use crate::command::{files_in, sake_glug};
 use sake_glug::offline::{render_scene, render_scene_to_vec, RenderError, Scene};
-
-fn sake_glug(directory: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sake-glug"))
-        .current_dir(directory)
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn files_in(directory: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(directory)
-        .unwrap()
-        .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
 
 #[test]
 fn with_no_scene_it_renders_the_default_pour_to_pour_wav() {

@@ -3,7 +3,6 @@
 //! the WAV; batches survive a bad scene; no file is partial, none is too long for its format.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use sake_glug::engine::UnitOnset;
 use sake_glug::offline::{
@@ -12,6 +11,7 @@ use sake_glug::offline::{
 };
 
 use crate::clip_rules::{ahap, haptic};
+use crate::command::{files_in, sake_glug};
 
 /// A pour with the viscosity and gain automated, so that every mapping is exercised.
 const SCENE: &str = r#"
@@ -156,23 +156,6 @@ fn a_render_too_long_for_a_wav_is_refused_before_a_byte_is_written() {
     assert_eq!(std::fs::read_dir(directory.path()).unwrap().count(), 0);
 }
 
-fn sake_glug(directory: &Path, args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_sake-glug"))
-        .current_dir(directory)
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn names(directory: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(directory)
-        .unwrap()
-        .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
-
 #[test]
 fn a_batch_renders_every_good_scene_and_reports_the_bad_one() {
     let directory = tempfile::tempdir().unwrap();
@@ -212,7 +195,7 @@ fn a_batch_renders_every_good_scene_and_reports_the_bad_one() {
         "{stderr}"
     );
     assert_eq!(
-        names(&dir.join("clips")),
+        files_in(&dir.join("clips")),
         [
             "short.ahap",
             "short.haptic",
@@ -239,7 +222,7 @@ fn an_unknown_extension_is_refused_before_anything_is_rendered() {
         "{stderr}"
     );
     assert!(
-        names(directory.path()).is_empty(),
+        files_in(directory.path()).is_empty(),
         "not even the WAV is written"
     );
 }
@@ -256,7 +239,7 @@ fn the_plot_comes_from_the_same_render() {
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
-    assert_eq!(names(directory.path()), ["pour.haptic", "pour.png"]);
+    assert_eq!(files_in(directory.path()), ["pour.haptic", "pour.png"]);
     let png = std::fs::read(directory.path().join("pour.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
 }

@@ -7,6 +7,7 @@ mod support;
 mod cli;
 mod clip_rules;
 mod clips_rendered;
+mod command;
 mod determinism;
 mod fuzz;
 mod presets;

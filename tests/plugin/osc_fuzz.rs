@@ -6,6 +6,8 @@
 //! otherwise (e.g. `PROPTEST_CASES=100000 cargo test --release --test plugin osc_fuzz`).
 
 use proptest::prelude::*;
+
+use crate::support::fuzz::{edits, mutate};
 use rosc::{OscBundle, OscMessage, OscPacket, OscTime, OscType};
 
 use sake_glug::device::axis::Axis;
@@ -43,41 +45,6 @@ fn valid_osc() -> Vec<u8> {
         ],
     }))
     .unwrap()
-}
-
-/// Byte edits: overwrite, insert or delete at positions taken modulo the length.
-#[derive(Debug, Clone)]
-enum Edit {
-    Set(usize, u8),
-    Insert(usize, u8),
-    Remove(usize),
-}
-
-fn edits() -> impl Strategy<Value = Vec<Edit>> {
-    let edit = prop_oneof![
-        (any::<usize>(), any::<u8>()).prop_map(|(at, byte)| Edit::Set(at, byte)),
-        (any::<usize>(), any::<u8>()).prop_map(|(at, byte)| Edit::Insert(at, byte)),
-        any::<usize>().prop_map(Edit::Remove),
-    ];
-    prop::collection::vec(edit, 1..8)
-}
-
-fn mutate(mut bytes: Vec<u8>, edits: &[Edit], keep: usize) -> Vec<u8> {
-    for edit in edits {
-        match *edit {
-            Edit::Set(at, byte) if !bytes.is_empty() => {
-                let at = at % bytes.len();
-                bytes[at] = byte;
-            }
-            Edit::Insert(at, byte) => bytes.insert(at % (bytes.len() + 1), byte),
-            Edit::Remove(at) if !bytes.is_empty() => {
-                bytes.remove(at % bytes.len());
-            }
-            _ => {}
-        }
-    }
-    bytes.truncate(keep);
-    bytes
 }
 
 fn check_osc(packet: &[u8]) -> Result<(), TestCaseError> {

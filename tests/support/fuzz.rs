@@ -109,3 +109,45 @@ pub fn toml_number(value: f64) -> String {
         }
     }
 }
+
+/// Byte edits for inputs that are nearly right: overwrite, insert or delete at positions taken
+/// modulo the length (shared by every fuzz target that mutates a valid file or packet).
+#[derive(Debug, Clone)]
+pub enum Edit {
+    /// Overwrite the byte at a position.
+    Set(usize, u8),
+    /// Insert a byte at a position.
+    Insert(usize, u8),
+    /// Remove the byte at a position.
+    Remove(usize),
+}
+
+/// One to seven edits.
+pub fn edits() -> impl Strategy<Value = Vec<Edit>> {
+    use proptest::prelude::*;
+    let edit = prop_oneof![
+        (any::<usize>(), any::<u8>()).prop_map(|(at, byte)| Edit::Set(at, byte)),
+        (any::<usize>(), any::<u8>()).prop_map(|(at, byte)| Edit::Insert(at, byte)),
+        any::<usize>().prop_map(Edit::Remove),
+    ];
+    prop::collection::vec(edit, 1..8)
+}
+
+/// `bytes` with `edits` applied, then cut to at most `keep` bytes.
+pub fn mutate(mut bytes: Vec<u8>, edits: &[Edit], keep: usize) -> Vec<u8> {
+    for edit in edits {
+        match *edit {
+            Edit::Set(at, byte) if !bytes.is_empty() => {
+                let at = at % bytes.len();
+                bytes[at] = byte;
+            }
+            Edit::Insert(at, byte) => bytes.insert(at % (bytes.len() + 1), byte),
+            Edit::Remove(at) if !bytes.is_empty() => {
+                bytes.remove(at % bytes.len());
+            }
+            _ => {}
+        }
+    }
+    bytes.truncate(keep);
+    bytes
+}

@@ -10,6 +10,8 @@ use midly::num::{u15, u24, u28, u4, u7};
 use midly::{Format, Header, MetaMessage, MidiMessage, Smf, Timing, TrackEvent, TrackEventKind};
 use proptest::prelude::*;
 
+use crate::support::fuzz::{edits, mutate};
+
 use sake_glug::device::axis::Axis;
 use sake_glug::device::csv_lane::{read_csv_lane, CsvLaneSpec};
 use sake_glug::device::midi_take::read_midi_take;
@@ -73,41 +75,6 @@ fn csv_specs() -> [CsvLaneSpec; 3] {
             axis: Axis::MinusZ,
         },
     ]
-}
-
-/// Byte edits: overwrite, insert or delete at positions taken modulo the length.
-#[derive(Debug, Clone)]
-enum Edit {
-    Set(usize, u8),
-    Insert(usize, u8),
-    Remove(usize),
-}
-
-fn edits() -> impl Strategy<Value = Vec<Edit>> {
-    let edit = prop_oneof![
-        (any::<usize>(), any::<u8>()).prop_map(|(at, byte)| Edit::Set(at, byte)),
-        (any::<usize>(), any::<u8>()).prop_map(|(at, byte)| Edit::Insert(at, byte)),
-        any::<usize>().prop_map(Edit::Remove),
-    ];
-    prop::collection::vec(edit, 1..8)
-}
-
-fn mutate(mut bytes: Vec<u8>, edits: &[Edit], keep: usize) -> Vec<u8> {
-    for edit in edits {
-        match *edit {
-            Edit::Set(at, byte) if !bytes.is_empty() => {
-                let at = at % bytes.len();
-                bytes[at] = byte;
-            }
-            Edit::Insert(at, byte) => bytes.insert(at % (bytes.len() + 1), byte),
-            Edit::Remove(at) if !bytes.is_empty() => {
-                bytes.remove(at % bytes.len());
-            }
-            _ => {}
-        }
-    }
-    bytes.truncate(keep);
-    bytes
 }
 
 fn check_midi(bytes: &[u8], sample_rate: u32) -> Result<(), TestCaseError> {

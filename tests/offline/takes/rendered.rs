@@ -2,9 +2,7 @@
 //! gravity vector and a MIDI take give the same samples as the inline automation they stand
 //! for; a malformed take is refused with its file, line and column, and nothing is written.
 
-use std::path::Path;
-use std::process::Command;
-
+use crate::command::sake_glug;
 use sake_glug::offline::{render_scene_to_vec, Scene, SceneError};
 
 fn render(scene: &Scene) -> Vec<f32> {
@@ -104,14 +102,6 @@ fn a_malformed_csv_take_is_refused_with_file_line_and_column() {
     for part in ["tilt_deg", "take.csv", "line 3", "\"ninety\""] {
         assert!(message.contains(part), "{message} lacks {part}");
     }
-}
-
-fn sake_glug(directory: &Path, args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_sake-glug"))
-        .current_dir(directory)
-        .args(args)
-        .output()
-        .unwrap()
 }
 
 #[test]
