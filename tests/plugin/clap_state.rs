@@ -2,110 +2,11 @@
 //! plugin factory and the `clap.state` extension, exactly as a host calls them. A state saved
 //! by an older version (a fixture) loads with the same parameter values and is migrated.
 
-use std::ffi::{c_char, c_void};
 use std::path::Path;
-use std::ptr::null;
 
-use clap_sys::entry::clap_plugin_entry;
-use clap_sys::ext::state::{clap_plugin_state, CLAP_EXT_STATE};
-use clap_sys::factory::plugin_factory::{clap_plugin_factory, CLAP_PLUGIN_FACTORY_ID};
-use clap_sys::host::clap_host;
-use clap_sys::plugin::clap_plugin;
-use clap_sys::stream::{clap_istream, clap_ostream};
-use clap_sys::version::CLAP_VERSION;
 use serde_json::Value;
 
-unsafe extern "C" fn no_extension(_: *const clap_host, _: *const c_char) -> *const c_void {
-    null()
-}
-unsafe extern "C" fn no_request(_: *const clap_host) {}
-
-/// A host that offers no extensions: enough for the plugin to save and load its state.
-static HOST: clap_host = clap_host {
-    clap_version: CLAP_VERSION,
-    host_data: std::ptr::null_mut(),
-    name: c"sake-glug state test".as_ptr(),
-    vendor: c"".as_ptr(),
-    url: c"".as_ptr(),
-    version: c"1".as_ptr(),
-    get_extension: Some(no_extension),
-    request_restart: Some(no_request),
-    request_process: Some(no_request),
-    request_callback: Some(no_request),
-};
-
-/// One plugin instance created through the CLAP factory.
-struct ClapInstance {
-    plugin: *const clap_plugin,
-    state: *const clap_plugin_state,
-}
-
-impl ClapInstance {
-    fn new() -> Self {
-        let entry: &clap_plugin_entry = &sake_glug::plugin::clap_entry;
-        unsafe {
-            assert!((entry.init.unwrap())(c"".as_ptr()));
-            let factory = (entry.get_factory.unwrap())(CLAP_PLUGIN_FACTORY_ID.as_ptr())
-                as *const clap_plugin_factory;
-            let descriptor = ((*factory).get_plugin_descriptor.unwrap())(factory, 0);
-            let plugin = ((*factory).create_plugin.unwrap())(factory, &HOST, (*descriptor).id);
-            assert!(!plugin.is_null());
-            assert!(((*plugin).init.unwrap())(plugin));
-            let state = ((*plugin).get_extension.unwrap())(plugin, CLAP_EXT_STATE.as_ptr())
-                as *const clap_plugin_state;
-            assert!(!state.is_null(), "the plugin offers clap.state");
-            Self { plugin, state }
-        }
-    }
-
-    /// The bytes a host would store in its project.
-    fn save(&self) -> Vec<u8> {
-        unsafe extern "C" fn write(
-            s: *const clap_ostream,
-            buffer: *const c_void,
-            size: u64,
-        ) -> i64 {
-            let bytes = unsafe { &mut *((*s).ctx as *mut Vec<u8>) };
-            bytes.extend_from_slice(unsafe {
-                std::slice::from_raw_parts(buffer as *const u8, size as usize)
-            });
-            size as i64
-        }
-        let mut bytes = Vec::new();
-        let stream = clap_ostream {
-            ctx: &mut bytes as *mut Vec<u8> as *mut c_void,
-            write: Some(write),
-        };
-        assert!(unsafe { ((*self.state).save.unwrap())(self.plugin, &stream) });
-        bytes
-    }
-
-    /// Loads bytes as a host restores a project; false if the plugin refuses them.
-    fn load(&self, bytes: &[u8]) -> bool {
-        struct Reader<'a>(&'a [u8]);
-        unsafe extern "C" fn read(s: *const clap_istream, buffer: *mut c_void, size: u64) -> i64 {
-            let reader = unsafe { &mut *((*s).ctx as *mut Reader) };
-            let count = reader.0.len().min(size as usize);
-            unsafe {
-                std::ptr::copy_nonoverlapping(reader.0.as_ptr(), buffer as *mut u8, count);
-            }
-            reader.0 = &reader.0[count..];
-            count as i64
-        }
-        let mut reader = Reader(bytes);
-        let stream = clap_istream {
-            ctx: &mut reader as *mut Reader as *mut c_void,
-            read: Some(read),
-        };
-        unsafe { ((*self.state).load.unwrap())(self.plugin, &stream) }
-    }
-}
-
-impl Drop for ClapInstance {
-    fn drop(&mut self) {
-        unsafe { ((*self.plugin).destroy.unwrap())(self.plugin) };
-    }
-}
+use crate::clap_host::ClapInstance;
 
 /// The JSON inside saved bytes (the CLAP wrapper prefixes its length).
 fn json(bytes: &[u8]) -> Value {
