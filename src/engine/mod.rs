@@ -289,30 +289,37 @@ impl<S: Synthesis> Engine<S> {
     /// Counts what the limiter did, so that a check can look past it.
     fn apply_output_stage(&mut self, controls: &Controls, out: &mut [f32]) {
         let ceiling = self.pour.config().ceiling as f32;
-        let (mut events, mut non_finite) = (0u64, 0u64);
-        let mut limit = |value: f32| {
-            // Branch-free counts.
-            events += u64::from(value.is_nan() || value.abs() > ceiling);
-            non_finite += u64::from(!value.is_finite());
-            if value.is_nan() || value.abs() < f32::MIN_POSITIVE {
-                0.0
-            } else {
-                value.clamp(-ceiling, ceiling)
-            }
-        };
         if let Lane::Constant(gain_db) = controls.gain_db {
             let gain = self.gain_at(gain_db);
             for y in out.iter_mut() {
-                *y = limit((*y as f64 * gain) as f32);
+                *y = (*y as f64 * gain) as f32;
             }
         } else {
             for (index, y) in out.iter_mut().enumerate() {
                 let gain = self.gain_at(controls.gain_db.at(index));
-                *y = limit((*y as f64 * gain) as f32);
+                *y = (*y as f64 * gain) as f32;
             }
         }
-        self.limiter.events += events;
-        self.limiter.non_finite += non_finite;
+        // Whether the limiter has anything to do: NaN, ±∞ or a sample past the ceiling. A
+        // reduction the compiler vectorises; the counting pass below runs only when it does.
+        let outside = out.iter().fold(false, |outside, y| {
+            outside | y.is_nan() | (y.abs() > ceiling)
+        });
+        if outside {
+            for y in out.iter() {
+                self.limiter.events += u64::from(y.is_nan() | (y.abs() > ceiling));
+                self.limiter.non_finite += u64::from(!y.is_finite());
+            }
+        }
+        for y in out.iter_mut() {
+            let value = *y;
+            let clamped = value.clamp(-ceiling, ceiling);
+            *y = if value.is_nan() | (value.abs() < f32::MIN_POSITIVE) {
+                0.0
+            } else {
+                clamped
+            };
+        }
     }
 
     #[inline]
