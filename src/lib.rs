@@ -3,14 +3,15 @@
 //! One engine, three products:
 //!
 //! - [`engine`]: the model of `docs/MODEL.md` (controls → pour → synthesis), shared by all;
-//! - [`plugin`]: the CLAP/VST3 plugin (feature `plugin`, its egui editor with `editor`);
+//! - [`plugin`]: the CLAP/VST3 plugin (feature `plugin`, its egui editor with `editor`), also
+//!   run as the standalone app `sake-glug-standalone` (feature `standalone`);
 //! - [`offline`]: scene files, automation lanes, the offline renderer and its file writers, used
 //!   by the `sake-glug` command line (feature `cli`);
 //! - [`reports`]: the accuracy and stability reports the command line prints.
 //!
-//! [`device`] holds what a tilt device sends (the MIDI mapping), shared by the plugin and the
-//! offline renderer. Data flows one way: scene, take or host → controls → pour → synthesis →
-//! sinks (WAV, audio out).
+//! [`device`] holds what a tilt device sends (the MIDI mapping and decoder, recorded MIDI and
+//! CSV takes, OSC from phones), shared by the plugin and the offline renderer. Data flows one
+//! way: scene, take or host → controls → pour → synthesis → sinks (WAV, clips, plot, audio out).
 #![warn(missing_docs)]
 
 pub mod device;
