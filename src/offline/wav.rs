@@ -148,17 +148,7 @@ impl WavFile {
             .tempfile_in(directory)
             .map_err(io_error)?;
         let file = temp.reopen().map_err(io_error)?;
-        let (bits_per_sample, sample_format) = match format {
-            SampleFormat::F32 => (32, HoundFormat::Float),
-            SampleFormat::S24 => (24, HoundFormat::Int),
-            SampleFormat::S16 => (16, HoundFormat::Int),
-        };
-        let spec = WavSpec {
-            channels: 1,
-            sample_rate,
-            bits_per_sample,
-            sample_format,
-        };
+        let spec = wav_spec(sample_rate, format);
         let encode_error = |source| WavError::Encode {
             path: path.to_owned(),
             source,
@@ -254,6 +244,21 @@ impl SampleFormat {
     }
 }
 
+/// The header of a mono file of `format` at `sample_rate` (Hz).
+fn wav_spec(sample_rate: u32, format: SampleFormat) -> WavSpec {
+    let (bits_per_sample, sample_format) = match format {
+        SampleFormat::F32 => (32, HoundFormat::Float),
+        SampleFormat::S24 => (24, HoundFormat::Int),
+        SampleFormat::S16 => (16, HoundFormat::Int),
+    };
+    WavSpec {
+        channels: 1,
+        sample_rate,
+        bits_per_sample,
+        sample_format,
+    }
+}
+
 /// Temporary files are private by default; the finished WAV should get the permissions any new
 /// file gets (0o666 less the umask), as if it had been written in place.
 pub(crate) fn temp_file_builder() -> tempfile::Builder<'static, 'static> {
@@ -335,17 +340,7 @@ mod tests {
     }
 
     fn write_with_hound(path: &Path, samples: &[f32], format: SampleFormat) {
-        let (bits_per_sample, sample_format) = match format {
-            SampleFormat::F32 => (32, HoundFormat::Float),
-            SampleFormat::S24 => (24, HoundFormat::Int),
-            SampleFormat::S16 => (16, HoundFormat::Int),
-        };
-        let spec = WavSpec {
-            channels: 1,
-            sample_rate: 44_100,
-            bits_per_sample,
-            sample_format,
-        };
+        let spec = wav_spec(44_100, format);
         let mut writer = WavWriter::create(path, spec).unwrap();
         for &y in samples {
             match format {

@@ -130,6 +130,21 @@ pub struct Advanced {
     pub flowed_until: Option<u64>,
 }
 
+impl Advanced {
+    /// Before the first sample of a span: nothing flowed yet from `volume_ml`.
+    fn nothing_yet(volume_ml: f64) -> Self {
+        Self {
+            last: Outflow {
+                volume_before_ml: volume_ml,
+                amount_ml: 0.0,
+                submerged: false,
+                refilled: false,
+            },
+            flowed_until: None,
+        }
+    }
+}
+
 /// The pour: bottle, onset accumulator and random draws, turning the controls, sample by
 /// sample, into unit onsets.
 pub struct Pour {
@@ -243,15 +258,7 @@ impl Pour {
         controls: &ControlValues,
         mut emit: impl FnMut(&UnitOnset),
     ) -> Advanced {
-        let mut advanced = Advanced {
-            last: Outflow {
-                volume_before_ml: self.bottle.volume_ml(),
-                amount_ml: 0.0,
-                submerged: false,
-                refilled: false,
-            },
-            flowed_until: None,
-        };
+        let mut advanced = Advanced::nothing_yet(self.bottle.volume_ml());
         let mut done = 0;
         if count > 0
             && (self.config_changed
@@ -318,15 +325,7 @@ impl Pour {
         mut emit: impl FnMut(&UnitOnset),
     ) -> Advanced {
         self.plain = None;
-        let mut advanced = Advanced {
-            last: Outflow {
-                volume_before_ml: self.bottle.volume_ml(),
-                amount_ml: 0.0,
-                submerged: false,
-                refilled: false,
-            },
-            flowed_until: None,
-        };
+        let mut advanced = Advanced::nothing_yet(self.bottle.volume_ml());
         let capacity_ml = self.config.capacity_ml;
         let mut inputs = SpanInputs::default();
         let mut levels = SpanLevels::default();
