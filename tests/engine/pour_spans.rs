@@ -12,17 +12,8 @@ const SCENES: &[&str] = &[
     // The default pour, and a seeded one.
     "tilt_deg = [[0.0, 90.0], [0.5, 135.0]]\nduration_s = 6.0",
     "seed = 5\ntilt_deg = [[0.0, 90.0], [0.5, 135.0]]\nduration_s = 6.0",
-    // determinism.rs's busy scene.
-    r#"
-    seed = 11
-    duration_s = 3.0
-    tilt_deg = [[0.0, 70.0], [0.3, 150.0], [1.2, 150.0], [1.2001, 0.0], [1.5, 0.0], [1.6, 140.0]]
-    viscosity_c = [[0.0, 0.1], [3.0, 0.9]]
-    fill_percent = [[0.0, 100.0], [1.4, 100.0], [1.4, 90.0]]
-    pour_time_s = [[0.0, 3.0], [2.0, 4.0]]
-    [output]
-    gain_db = [[0.0, -12.0], [2.5, 0.0]]
-    "#,
+    // The busy scene of the determinism test.
+    crate::support::BUSY_SCENE,
     // Held tilts that stop at the rest level, then pour on past the submerged level.
     r#"
     seed = 3

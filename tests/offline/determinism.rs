@@ -1,20 +1,9 @@
 //! A scene and a seed give the same samples on every run and at every block size.
 
 use crate::support::render_in_blocks;
+use crate::support::BUSY_SCENE;
 use sake_glug::offline::render_scene_to_vec;
 use sake_glug::offline::Scene;
-
-/// A pour with everything automated, randomness on, so any block-dependence would show.
-const BUSY_SCENE: &str = r#"
-seed = 11
-duration_s = 3.0
-tilt_deg = [[0.0, 70.0], [0.3, 150.0], [1.2, 150.0], [1.2001, 0.0], [1.5, 0.0], [1.6, 140.0]]
-viscosity_c = [[0.0, 0.1], [3.0, 0.9]]
-fill_percent = [[0.0, 100.0], [1.4, 100.0], [1.4, 90.0]]
-pour_time_s = [[0.0, 3.0], [2.0, 4.0]]
-[output]
-gain_db = [[0.0, -12.0], [2.5, 0.0]]
-"#;
 
 #[test]
 fn block_size_never_changes_a_sample() {
