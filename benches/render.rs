@@ -73,7 +73,7 @@ fn render_into(scene: &Scene, out: &mut Vec<f32>) -> usize {
 struct Units(Vec<UnitOnset>);
 
 impl RenderObserver for Units {
-    fn unit_started(&mut self, onset: &UnitOnset) {
+    fn unit_started(&mut self, onset: &UnitOnset, _output_gain: f64) {
         self.0.push(*onset);
     }
 }

@@ -65,6 +65,10 @@ pub const FREQ_JITTER: Range = Range::new(0.0, 1.0, 0.05);
 pub const DECAY_SIGMA: Range = Range::new(0.0, 3.0, 0.35);
 /// Hard output ceiling (linear amplitude): every output sample stays within ±ceiling.
 pub const CEILING: Range = Range::new(0.001, 1.0, 1.0);
+/// How long the output gain and the ceiling take to reach a new value (s), MODEL.md §6: long
+/// enough that a jump does not click (the 80 Hz component turns by a quarter of its period in it),
+/// short enough to follow a fader.
+pub const OUTPUT_RAMP_S: f64 = 0.010;
 
 /// How the residual volume evolves (MODEL.md §8). Scenes name it in lower case (`"simulate"`,
 /// `"follow"`); the plugin's Drain mode parameter is this same type.

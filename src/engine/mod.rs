@@ -8,14 +8,15 @@
 mod amplitude;
 pub mod config;
 mod controls;
+mod output;
 pub mod pour;
 mod presets;
 pub mod synthesis;
 
-pub(crate) use amplitude::db_to_gain;
 pub use amplitude::unit_amplitude;
 pub use config::{ControlValues, DrainMode, ModelConfig, Range};
 pub use controls::{ControlSource, Controls, Lane};
+use output::OutputStage;
 pub use pour::{Pour, PourStats, UnitOnset};
 pub use presets::{Preset, PRESETS};
 pub use synthesis::{RecursiveF32, RecursiveF64, Synthesis, VoiceBank, GRID};
@@ -32,23 +33,11 @@ pub struct Engine<S: Synthesis = VoiceBank> {
     sample: u64,
     /// The pour's last step changed nothing and would change nothing again under these controls.
     resting_under: Option<ControlValues>,
-    /// The last output gain asked for (dB) and its linear value. Starts as a true pair (the
-    /// default's): any key could arrive, NaN included, and must never find a stale value.
-    gain: (f64, f64),
+    /// Gain, ceiling and limiter (MODEL.md §6).
+    output: OutputStage,
     last_unit: Option<UnitOnset>,
     /// The sample after the last one during which liquid flowed or a component sounded.
     active_until: u64,
-    /// What the output stage saw before it limited the signal: see [`Engine::limiter_events`].
-    limiter: LimiterCounts,
-}
-
-/// Counts kept by the output stage, since the last reset.
-#[derive(Debug, Clone, Copy, Default)]
-struct LimiterCounts {
-    /// Samples the limiter changed: over the ceiling or not finite.
-    events: u64,
-    /// Samples that were NaN or infinite before the limiter.
-    non_finite: u64,
 }
 
 impl Engine {
@@ -68,10 +57,9 @@ impl<S: Synthesis> Engine<S> {
             voices: S::new(sample_rate),
             sample: 0,
             resting_under: None,
-            gain: (config::GAIN_DB.default, db_to_gain(config::GAIN_DB.default)),
+            output: OutputStage::new(sample_rate),
             last_unit: None,
             active_until: 0,
-            limiter: LimiterCounts::default(),
         };
         engine.reset();
         engine
@@ -101,7 +89,7 @@ impl<S: Synthesis> Engine<S> {
         self.resting_under = None;
         self.last_unit = None;
         self.active_until = 0;
-        self.limiter = LimiterCounts::default();
+        self.output.reset();
     }
 
     /// MODEL.md §8 refill: sounding units ring on, the generator goes on.
@@ -145,13 +133,13 @@ impl<S: Synthesis> Engine<S> {
     /// ceiling (clamped to it) or not finite (NaN to 0, ±∞ to ±ceiling). The output cannot show
     /// what the limiter hid; this count can.
     pub fn limiter_events(&self) -> u64 {
-        self.limiter.events
+        self.output.limiter.events
     }
 
     /// Samples since the last reset that were NaN or infinite before the limiter: the synthesis
     /// itself failed there, even though the output stayed finite.
     pub fn non_finite_before_limiter(&self) -> u64 {
-        self.limiter.non_finite
+        self.output.limiter.non_finite
     }
 
     /// Gives the next component that starts a NaN state, as a broken synthesis would: how the
@@ -160,6 +148,18 @@ impl<S: Synthesis> Engine<S> {
     #[cfg(feature = "fault-injection")]
     pub fn inject_nan_into_next_component(&mut self) {
         self.voices.poison_next_component();
+    }
+
+    /// The output ceiling at the last sample rendered (linear): the scene's or the parameter's,
+    /// or on its ramp to a new one (MODEL.md §6).
+    pub fn ceiling_now(&self) -> f64 {
+        self.output.ceiling_now()
+    }
+
+    /// The output gain at the last sample rendered (linear), on its ramp as
+    /// [`Engine::ceiling_now`].
+    pub fn gain_now(&self) -> f64 {
+        self.output.gain_now()
     }
 
     /// Samples rendered since the last reset.
@@ -185,21 +185,24 @@ impl<S: Synthesis> Engine<S> {
 
     /// Renders `out.len()` samples; `controls` give the inputs from the block's first sample.
     pub fn process(&mut self, controls: &Controls, out: &mut [f32]) {
-        self.process_observed(controls, out, &mut |_| {});
+        self.process_observed(controls, out, &mut |_, _| {});
     }
 
-    /// [`Engine::process`], telling `on_unit` of every unit that starts, in order: what the clip
-    /// writers need to know of the glugs. Watching changes no sample.
+    /// [`Engine::process`], telling `on_unit` of every unit that starts, in order, with the output
+    /// gain (linear) at its first sample: what the clip writers need to know of the glugs.
+    /// Watching changes no sample.
     pub fn process_observed(
         &mut self,
         controls: &Controls,
         out: &mut [f32],
-        on_unit: &mut impl FnMut(&UnitOnset),
+        on_unit: &mut impl FnMut(&UnitOnset, f64),
     ) {
         if self.voices.is_empty() && self.rests_under(controls) {
             // Settled under the same controls: the block is silence, so it costs a fill and not
             // a walk over its grid periods. An empty bank only needs the last period start.
             out.fill(0.0);
+            self.output
+                .pass_silence(&controls.gain_db, self.pour.config().ceiling, out.len());
             let end = self.sample + out.len() as u64;
             let last_period = end / GRID as u64 * GRID as u64;
             if last_period > self.sample {
@@ -222,21 +225,29 @@ impl<S: Synthesis> Engine<S> {
         &mut self,
         controls: &Controls,
         out: &mut [f32],
-        on_unit: &mut impl FnMut(&UnitOnset),
+        on_unit: &mut impl FnMut(&UnitOnset, f64),
     ) {
         out.fill(0.0);
         self.step_pour(controls, out.len(), on_unit);
+        let ceiling = self.pour.config().ceiling;
         if self.voices.is_empty() {
+            self.output
+                .pass_silence(&controls.gain_db, ceiling, out.len());
             self.advance_position(out.len());
             return;
         }
         self.voices.synthesize(self.sample, out);
         self.active_until = self.sample + out.len() as u64;
-        self.apply_output_stage(controls, out);
+        self.output.apply(&controls.gain_db, ceiling, out);
         self.advance_position(out.len());
     }
 
-    fn step_pour(&mut self, controls: &Controls, len: usize, on_unit: &mut impl FnMut(&UnitOnset)) {
+    fn step_pour(
+        &mut self,
+        controls: &Controls,
+        len: usize,
+        on_unit: &mut impl FnMut(&UnitOnset, f64),
+    ) {
         if self.rests_under(controls) {
             return;
         }
@@ -244,12 +255,17 @@ impl<S: Synthesis> Engine<S> {
             pour,
             voices,
             last_unit,
+            output,
+            sample: span_start,
             ..
         } = self;
+        let span_start = *span_start;
         let mut start_unit = |onset: &UnitOnset| {
             voices.start_unit(onset);
             *last_unit = Some(*onset);
-            on_unit(onset);
+            // Heard from the sample after the one it starts in (MODEL.md §6: t_i ≤ t_n).
+            let first_heard = (onset.sample + 1 - span_start) as usize;
+            on_unit(onset, output.gain_ahead(&controls.gain_db, first_heard));
         };
         // Constant over the span, as constants or as samples that do not change (a ramp's end
         // inside the block).
@@ -283,51 +299,6 @@ impl<S: Synthesis> Engine<S> {
     /// stepping it would change nothing.
     fn rests_under(&self, controls: &Controls) -> bool {
         controls.pour_is_constant() && self.resting_under == Some(controls.values_at(0))
-    }
-
-    /// Output gain, then the guarantees of MODEL.md §6: finite, within the ceiling, no denormal.
-    /// Counts what the limiter did, so that a check can look past it.
-    fn apply_output_stage(&mut self, controls: &Controls, out: &mut [f32]) {
-        let ceiling = self.pour.config().ceiling as f32;
-        if let Lane::Constant(gain_db) = controls.gain_db {
-            let gain = self.gain_at(gain_db);
-            for y in out.iter_mut() {
-                *y = (*y as f64 * gain) as f32;
-            }
-        } else {
-            for (index, y) in out.iter_mut().enumerate() {
-                let gain = self.gain_at(controls.gain_db.at(index));
-                *y = (*y as f64 * gain) as f32;
-            }
-        }
-        // Whether the limiter has anything to do: NaN, ±∞ or a sample past the ceiling. A
-        // reduction the compiler vectorises; the counting pass below runs only when it does.
-        let outside = out.iter().fold(false, |outside, y| {
-            outside | y.is_nan() | (y.abs() > ceiling)
-        });
-        if outside {
-            for y in out.iter() {
-                self.limiter.events += u64::from(y.is_nan() | (y.abs() > ceiling));
-                self.limiter.non_finite += u64::from(!y.is_finite());
-            }
-        }
-        for y in out.iter_mut() {
-            let value = *y;
-            let clamped = value.clamp(-ceiling, ceiling);
-            *y = if value.is_nan() | (value.abs() < f32::MIN_POSITIVE) {
-                0.0
-            } else {
-                clamped
-            };
-        }
-    }
-
-    #[inline]
-    fn gain_at(&mut self, gain_db: f64) -> f64 {
-        if gain_db.to_bits() != self.gain.0.to_bits() {
-            self.gain = (gain_db, db_to_gain(config::GAIN_DB.sanitize(gain_db)));
-        }
-        self.gain.1
     }
 
     fn advance_position(&mut self, len: usize) {

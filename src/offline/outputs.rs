@@ -13,8 +13,7 @@ use super::clips::{self, ClipSource, Glug, HapticBand};
 use super::render::{render_scene, RenderError, RenderObserver, RenderSummary};
 use super::scene::Scene;
 use super::wav::{temp_file_builder, SampleFormat, WavError, WavFile};
-use crate::engine::config::GAIN_DB;
-use crate::engine::{db_to_gain, UnitOnset};
+use crate::engine::UnitOnset;
 
 /// A kind of file a render writes, chosen by the file's extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -205,7 +204,7 @@ pub fn render_to_files(
     let glugs: Vec<Glug> = observer
         .units
         .iter()
-        .map(|unit| glug(scene, unit))
+        .map(|(unit, gain)| glug(scene, unit, *gain))
         .collect();
     let source = ClipSource {
         duration_s: summary.duration_s(),
@@ -294,11 +293,10 @@ pub fn render_to_files(
     })
 }
 
-/// A unit as the clips see it: its onset in seconds and its components at the output gain of
-/// its onset.
-fn glug(scene: &Scene, unit: &UnitOnset) -> Glug {
+/// A unit as the clips see it: its onset in seconds and its components at the output gain it
+/// starts to be heard at.
+fn glug(scene: &Scene, unit: &UnitOnset, gain: f64) -> Glug {
     let onset_s = (unit.sample as f64 + unit.fraction) / scene.sample_rate as f64;
-    let gain = db_to_gain(GAIN_DB.sanitize(scene.gain_db.value_at(onset_s)));
     let [a1, a2] = unit.component_amplitudes();
     Glug {
         onset_s,
@@ -312,7 +310,8 @@ fn glug(scene: &Scene, unit: &UnitOnset) -> Glug {
 /// Collects what the clips and the plot need while the render runs.
 struct Observer<P> {
     progress: P,
-    units: Vec<UnitOnset>,
+    /// Each unit with the output gain it is heard at.
+    units: Vec<(UnitOnset, f64)>,
     /// `(position, V)` after every block, when the plot is drawn.
     bottle: Vec<(u64, f64)>,
     bottle_every: Option<usize>,
@@ -331,8 +330,8 @@ impl<P: FnMut(u64)> RenderObserver for Observer<P> {
         (self.progress)(rendered)
     }
 
-    fn unit_started(&mut self, onset: &UnitOnset) {
-        self.units.push(*onset);
+    fn unit_started(&mut self, onset: &UnitOnset, output_gain: f64) {
+        self.units.push((*onset, output_gain));
     }
 
     fn bottle_every(&self) -> Option<usize> {

@@ -71,8 +71,9 @@ impl RenderSummary {
 pub trait RenderObserver {
     /// `rendered` samples are done.
     fn progress(&mut self, _rendered: u64) {}
-    /// A unit started (its onset is `(onset.sample + onset.fraction) / fs`).
-    fn unit_started(&mut self, _onset: &UnitOnset) {}
+    /// A unit started (its onset is `(onset.sample + onset.fraction) / fs`), heard at the output
+    /// gain `output_gain` (linear, on its ramp: MODEL.md §6).
+    fn unit_started(&mut self, _onset: &UnitOnset, _output_gain: f64) {}
     /// Samples between two [`RenderObserver::bottle`] reports, or `None` for none: the render
     /// then cuts time at least this finely, which changes no sample.
     fn bottle_every(&self) -> Option<usize> {
@@ -129,7 +130,9 @@ pub fn render_scene<E: From<RenderError>>(
         let mut controls = scene.controls(position, &mut lanes, len);
         take.override_lanes(&mut controls);
         let block = &mut block[..len];
-        engine.process_observed(&controls, block, &mut |onset| observer.unit_started(onset));
+        engine.process_observed(&controls, block, &mut |onset, gain| {
+            observer.unit_started(onset, gain)
+        });
         observer.progress(engine.position());
         if observer.bottle_every().is_some() {
             observer.bottle(engine.position(), engine.volume_ml());

@@ -176,7 +176,8 @@ impl RealtimeEngine {
     fn add_fading_tail(&mut self, controls: &Controls, span: &mut [f32]) {
         let tail = &mut self.tail_span[..span.len()];
         self.tail.process(controls, tail);
-        let ceiling = self.config.ceiling as f32;
+        // The ceiling of the pour that plays, where its ramp has got to (MODEL.md §6).
+        let ceiling = self.engine.ceiling_now() as f32;
         for (y, ringing) in span.iter_mut().zip(tail.iter()) {
             let gain = self.fade_left as f32 / self.fade_len as f32;
             *y = (*y + ringing * gain).clamp(-ceiling, ceiling);

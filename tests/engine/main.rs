@@ -6,6 +6,7 @@ mod support;
 
 mod drain;
 mod onsets;
+mod output_ramps;
 mod pour_spans;
 mod reference_match;
 mod units;

@@ -71,7 +71,7 @@ fn engine_onsets(scene: &Scene, len: u64, sizes: &[usize]) -> Vec<UnitOnset> {
         }
         let size = size.min((len - done) as usize);
         let controls = scene.controls(done, &mut lanes, size);
-        engine.process_observed(&controls, &mut out[..size], &mut |onset| {
+        engine.process_observed(&controls, &mut out[..size], &mut |onset, _| {
             onsets.push(*onset)
         });
         done += size as u64;

@@ -26,7 +26,7 @@ gain_db = [[0.0, -3.0], [2.5, -9.0]]
 fn engine_units(scene: &Scene) -> Vec<UnitOnset> {
     struct Units(Vec<UnitOnset>);
     impl RenderObserver for Units {
-        fn unit_started(&mut self, onset: &UnitOnset) {
+        fn unit_started(&mut self, onset: &UnitOnset, _output_gain: f64) {
             self.0.push(*onset);
         }
     }

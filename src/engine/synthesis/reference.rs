@@ -64,6 +64,49 @@ const CEILING: Allowed = Allowed {
     default: 1.0,
 };
 
+/// MODEL.md §6: gain and ceiling reach a new value in a straight line over 10 ms.
+const OUTPUT_RAMP_S: f64 = 0.010;
+
+/// MODEL.md §6 as the contract words it: the value at sample n, where the target asked for
+/// last changed at sample `since` (from the value the sample before had, `from`), is
+/// from + (to − from)·min(1, (n − since + 1)/R).
+struct Ramped {
+    samples: f64,
+    from: f64,
+    to: f64,
+    since: u64,
+    now: f64,
+}
+
+impl Ramped {
+    fn new(sample_rate: f64) -> Self {
+        Self {
+            samples: (sample_rate * OUTPUT_RAMP_S).round().max(1.0),
+            from: f64::NAN,
+            to: f64::NAN,
+            since: 0,
+            now: f64::NAN,
+        }
+    }
+
+    /// The value at `sample` whose target is `to`; called for every sample from 0 on.
+    fn at(&mut self, sample: u64, to: f64) -> f64 {
+        if sample == 0 {
+            // A reset: the first sample takes its target as it is.
+            (self.from, self.to, self.since) = (to, to, 0);
+        } else if to.to_bits() != self.to.to_bits() {
+            (self.from, self.to, self.since) = (self.now, to, sample);
+        }
+        let done = (sample - self.since + 1) as f64 / self.samples;
+        self.now = if done >= 1.0 {
+            self.to
+        } else {
+            self.from + (self.to - self.from) * done
+        };
+        self.now
+    }
+}
+
 /// MODEL.md §11: units voiced per sample at most.
 const ONSETS_PER_SAMPLE: usize = 8;
 /// MODEL.md §11: the start budget holds at most 8 units and refills at 6000 units per second.
@@ -87,7 +130,7 @@ struct Unit {
     /// t_i in samples: n + x.
     onset: f64,
     first_sample: u64,
-    /// A1 = c·a(V_i), A2 = (1 − c)·a(V_i); the gain G is applied per sample.
+    /// A1 = c·a(V_i), A2 = (1 − c)·a(V_i); the gain G is applied per sample, on its ramp.
     amplitudes: [f64; 2],
     frequency_hz: [f64; 2],
     decay_per_s: [f64; 2],
@@ -109,6 +152,7 @@ pub fn evaluate(
     let mut units = Vec::new();
     let mut budget = (BUDGET_UNITS, 0.0f64);
     let mut gains = Vec::with_capacity((window.end - window.start) as usize);
+    let mut gain = Ramped::new(sample_rate);
     for sample in 0..window.end {
         let (values, gain_db) = controls.at(sample);
         // §5: c is taken at the onset's sample, brought into [0, 1].
@@ -138,8 +182,9 @@ pub fn evaluate(
                 decay_per_s: onset.shape.decay_per_s,
             });
         });
+        let gain = gain.at(sample, 10f64.powf(GAIN_DB.bring_in(gain_db) / 20.0));
         if sample >= window.start {
-            gains.push(10f64.powf(GAIN_DB.bring_in(gain_db) / 20.0));
+            gains.push(gain);
         }
     }
 

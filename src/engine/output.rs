@@ -1,0 +1,277 @@
+//! The output stage of MODEL.md §6: the output gain, then the limiter that keeps every sample
+//! finite, within the ceiling and free of denormals. Gain and ceiling reach a new value along a
+//! straight ramp of [`OUTPUT_RAMP_S`], sample by sample, so that moving them does not click and
+//! the same automation gives the same samples however time is cut into blocks.
+
+use super::amplitude::db_to_gain;
+use super::config::{GAIN_DB, OUTPUT_RAMP_S};
+use super::controls::Lane;
+
+/// A value that goes to each new target in a straight line of `len` samples.
+///
+/// The value at a sample is worked out from how far the ramp has gone, never summed step by
+/// step, so skipping samples (silence) lands on the same value as stepping through them.
+#[derive(Debug, Clone, Copy)]
+struct Ramp {
+    /// Where the ramp under way started: the value at the sample before its target changed.
+    start: f64,
+    target: f64,
+    /// Samples of the ramp taken; `len` once the value is the target.
+    taken: u32,
+    len: u32,
+    value: f64,
+}
+
+impl Ramp {
+    fn settled_at(target: f64, len: u32) -> Self {
+        Self {
+            start: target,
+            target,
+            taken: len,
+            len,
+            value: target,
+        }
+    }
+
+    /// A new target asked for from this sample on starts a new ramp from the value now.
+    #[inline]
+    fn retarget(&mut self, target: f64) {
+        if target.to_bits() != self.target.to_bits() {
+            self.start = self.value;
+            self.target = target;
+            self.taken = 0;
+        }
+    }
+
+    /// The value at the next sample.
+    #[inline]
+    fn next(&mut self) -> f64 {
+        if self.taken < self.len {
+            self.skip(1);
+        }
+        self.value
+    }
+
+    /// Goes `samples` samples along the ramp.
+    fn skip(&mut self, samples: u64) {
+        if self.taken == self.len {
+            return;
+        }
+        self.taken = (u64::from(self.taken) + samples).min(u64::from(self.len)) as u32;
+        self.value = if self.taken == self.len {
+            self.target
+        } else {
+            self.start + (self.target - self.start) * (f64::from(self.taken) / f64::from(self.len))
+        };
+    }
+
+    fn is_settled(&self) -> bool {
+        self.taken == self.len
+    }
+}
+
+/// Counts kept by the output stage, since the last reset.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct LimiterCounts {
+    /// Samples the limiter changed: over the ceiling or not finite.
+    pub events: u64,
+    /// Samples that were NaN or infinite before the limiter.
+    pub non_finite: u64,
+}
+
+/// Gain, ceiling and limiter, with what they need to remember between blocks.
+#[derive(Debug, Clone)]
+pub(super) struct OutputStage {
+    ramp_len: u32,
+    /// The last output gain asked for (dB) and its linear value. Starts as a true pair (the
+    /// default's): any key could arrive, NaN included, and must never find a stale value.
+    gain_db: (f64, f64),
+    gain: Ramp,
+    ceiling: Ramp,
+    /// No sample rendered since the reset: the first sample takes its gain and ceiling as they
+    /// are, with no ramp from whatever came before (a bounce starts from silence).
+    fresh: bool,
+    pub limiter: LimiterCounts,
+}
+
+impl OutputStage {
+    pub fn new(sample_rate: f64) -> Self {
+        let ramp_len = ((sample_rate * OUTPUT_RAMP_S).round() as u32).max(1);
+        let gain_db = (GAIN_DB.default, db_to_gain(GAIN_DB.default));
+        Self {
+            ramp_len,
+            gain_db,
+            gain: Ramp::settled_at(gain_db.1, ramp_len),
+            ceiling: Ramp::settled_at(1.0, ramp_len),
+            fresh: true,
+            limiter: LimiterCounts::default(),
+        }
+    }
+
+    pub fn reset(&mut self) {
+        self.fresh = true;
+        self.limiter = LimiterCounts::default();
+    }
+
+    /// The ceiling at the last sample rendered (linear).
+    pub fn ceiling_now(&self) -> f64 {
+        self.ceiling.value
+    }
+
+    /// The gain at the last sample rendered (linear).
+    pub fn gain_now(&self) -> f64 {
+        self.gain.value
+    }
+
+    /// The gain (linear) the output will have at sample `index` of a block about to be applied
+    /// with `gain_db`: what a unit starting there is heard at. Changes nothing.
+    pub fn gain_ahead(&self, gain_db: &Lane, index: usize) -> f64 {
+        let target = |index: usize| db_to_gain(GAIN_DB.sanitize(gain_db.at(index)));
+        let mut gain = if self.fresh {
+            Ramp::settled_at(target(0), self.ramp_len)
+        } else {
+            self.gain
+        };
+        if gain_db.is_constant() {
+            gain.retarget(target(0));
+            gain.skip(index as u64 + 1);
+        } else {
+            for at in 0..=index {
+                gain.retarget(target(at));
+                gain.next();
+            }
+        }
+        gain.value
+    }
+
+    /// The targets of a block's first sample: straight in after a reset, ramped to otherwise.
+    fn begin(&mut self, gain_db: f64, ceiling: f64) {
+        let gain = self.linear_gain(gain_db);
+        if std::mem::take(&mut self.fresh) {
+            self.gain = Ramp::settled_at(gain, self.ramp_len);
+            self.ceiling = Ramp::settled_at(ceiling, self.ramp_len);
+        } else {
+            self.gain.retarget(gain);
+            self.ceiling.retarget(ceiling);
+        }
+    }
+
+    #[inline]
+    fn linear_gain(&mut self, gain_db: f64) -> f64 {
+        if gain_db.to_bits() != self.gain_db.0.to_bits() {
+            self.gain_db = (gain_db, db_to_gain(GAIN_DB.sanitize(gain_db)));
+        }
+        self.gain_db.1
+    }
+
+    /// Moves gain and ceiling through `len` samples that are silent (nothing sounds), as
+    /// [`OutputStage::apply`] would have.
+    pub fn pass_silence(&mut self, gain_db: &Lane, ceiling: f64, len: usize) {
+        if len == 0 {
+            return;
+        }
+        self.begin(gain_db.at(0), ceiling);
+        self.ceiling.skip(len as u64);
+        match gain_db {
+            Lane::Constant(_) => self.gain.skip(len as u64),
+            Lane::Samples(_) => {
+                for index in 0..len {
+                    let target = self.linear_gain(gain_db.at(index));
+                    self.gain.retarget(target);
+                    self.gain.next();
+                }
+            }
+        }
+    }
+
+    /// Output gain, then the guarantees of MODEL.md §6: finite, within the ceiling, no denormal.
+    /// Counts what the limiter did, so that a check can look past it.
+    pub fn apply(&mut self, gain_db: &Lane, ceiling: f64, out: &mut [f32]) {
+        if out.is_empty() {
+            return;
+        }
+        self.begin(gain_db.at(0), ceiling);
+        if gain_db.is_constant() && self.gain.is_settled() {
+            let gain = self.gain.value;
+            for y in out.iter_mut() {
+                *y = (*y as f64 * gain) as f32;
+            }
+        } else {
+            for (index, y) in out.iter_mut().enumerate() {
+                let target = self.linear_gain(gain_db.at(index));
+                self.gain.retarget(target);
+                *y = (*y as f64 * self.gain.next()) as f32;
+            }
+        }
+        if self.ceiling.is_settled() {
+            self.limit(out, self.ceiling.value as f32);
+        } else {
+            for y in out.iter_mut() {
+                let ceiling = self.ceiling.next() as f32;
+                self.limit(std::slice::from_mut(y), ceiling);
+            }
+        }
+    }
+
+    /// The limiter at one ceiling.
+    #[inline]
+    fn limit(&mut self, out: &mut [f32], ceiling: f32) {
+        // Whether the limiter has anything to do: NaN, ±∞ or a sample past the ceiling. A
+        // reduction the compiler vectorises; the counting pass below runs only when it does.
+        let outside = out.iter().fold(false, |outside, y| {
+            outside | y.is_nan() | (y.abs() > ceiling)
+        });
+        if outside {
+            for y in out.iter() {
+                self.limiter.events += u64::from(y.is_nan() | (y.abs() > ceiling));
+                self.limiter.non_finite += u64::from(!y.is_finite());
+            }
+        }
+        for y in out.iter_mut() {
+            let value = *y;
+            let clamped = value.clamp(-ceiling, ceiling);
+            *y = if value.is_nan() | (value.abs() < f32::MIN_POSITIVE) {
+                0.0
+            } else {
+                clamped
+            };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_ramp_reaches_its_target_in_len_samples_in_a_straight_line() {
+        let mut ramp = Ramp::settled_at(1.0, 4);
+        ramp.retarget(3.0);
+        let values: Vec<f64> = (0..6).map(|_| ramp.next()).collect();
+        assert_eq!(values, [1.5, 2.0, 2.5, 3.0, 3.0, 3.0]);
+    }
+
+    #[test]
+    fn skipping_lands_where_stepping_does() {
+        let mut stepped = Ramp::settled_at(0.2, 480);
+        let mut skipped = stepped;
+        stepped.retarget(0.9);
+        skipped.retarget(0.9);
+        for _ in 0..123 {
+            stepped.next();
+        }
+        skipped.skip(123);
+        assert_eq!(stepped.value.to_bits(), skipped.value.to_bits());
+    }
+
+    #[test]
+    fn a_new_target_mid_ramp_starts_from_the_value_reached() {
+        let mut ramp = Ramp::settled_at(0.0, 10);
+        ramp.retarget(1.0);
+        for _ in 0..5 {
+            ramp.next();
+        }
+        ramp.retarget(0.0);
+        assert_eq!(ramp.next(), 0.5 - 0.05);
+    }
+}
