@@ -26,6 +26,16 @@ fn pouring() -> ControlValues {
 /// The pour under `gain_db` (one value per sample) in blocks of `block`, with the ceiling
 /// `ceilings.0` until `ceilings.1` takes over at `MOVE_AT`.
 fn render(gain_db: &[f64], ceilings: (f64, f64), block: usize) -> Vec<f32> {
+    render_moving_at(MOVE_AT, gain_db, ceilings, block)
+}
+
+/// [`render`] with the ceiling moving at `move_at`.
+fn render_moving_at(
+    move_at: usize,
+    gain_db: &[f64],
+    ceilings: (f64, f64),
+    block: usize,
+) -> Vec<f32> {
     let config = |ceiling| ModelConfig {
         ceiling,
         ..ModelConfig::default()
@@ -35,9 +45,9 @@ fn render(gain_db: &[f64], ceilings: (f64, f64), block: usize) -> Vec<f32> {
     let mut done = 0;
     while done < out.len() {
         let mut len = block.min(out.len() - done);
-        if done < MOVE_AT {
-            len = len.min(MOVE_AT - done);
-        } else if done == MOVE_AT {
+        if done < move_at {
+            len = len.min(move_at - done);
+        } else if done == move_at {
             engine.set_config(config(ceilings.1));
         }
         let controls = Controls {
@@ -88,23 +98,27 @@ fn a_gain_jump_while_glugs_ring_ramps_without_a_click() {
 fn a_ceiling_lowered_while_glugs_ring_ramps_down_to_it() {
     let ramp = ramp_len();
     let low = 0.01;
-    let lowered = render(&gain_step(0.0, 0.0), (1.0, low), 512);
-    let unlimited = render(&gain_step(0.0, 0.0), (1.0, 1.0), 512);
-    let above = unlimited[MOVE_AT..MOVE_AT + 100]
-        .iter()
-        .fold(0.0f32, |peak, y| peak.max(y.abs()));
+    let gain = gain_step(0.0, 0.0);
+    let unlimited = render(&gain, (1.0, 1.0), 512);
+    // The ceiling comes down at the loudest sample of a ringing glug: cut there, it would click.
+    let move_at = (MOVE_AT..MOVE_AT + 1_000)
+        .max_by(|a, b| unlimited[*a].abs().total_cmp(&unlimited[*b].abs()))
+        .unwrap();
     assert!(
-        above > 3.0 * low as f32,
-        "the ceiling would not bite ({above})"
+        unlimited[move_at].abs() > 5.0 * low as f32,
+        "the ceiling would not bite"
     );
-    assert_eq!(lowered[..MOVE_AT], unlimited[..MOVE_AT]);
+    let lowered = render_moving_at(move_at, &gain, (1.0, low), 512);
+    assert_eq!(lowered[..move_at], unlimited[..move_at]);
     // Once the ramp is over, the new ceiling holds...
-    assert!(lowered[MOVE_AT + ramp - 1..]
+    assert!(lowered[move_at + ramp - 1..]
         .iter()
         .all(|y| y.abs() <= low as f32));
-    // ...and it came down without a click: no step larger than the open signal's usual one.
-    let across = largest_step(&lowered[MOVE_AT - 1..MOVE_AT + ramp + 1]);
-    let usual = largest_step(&unlimited);
+    // ...and it came down without a click: no step larger than the signal's usual ones, those of
+    // the glug before (open) and of the pour after (limited).
+    let across = largest_step(&lowered[move_at - 1..move_at + ramp + 1]);
+    let usual = largest_step(&lowered[move_at - 4_800..move_at])
+        .max(largest_step(&lowered[move_at + ramp..]));
     assert!(across <= usual, "a step of {across} against {usual}");
 }
 
@@ -133,17 +147,33 @@ fn the_ramps_give_the_same_samples_at_every_block_size() {
 }
 
 #[test]
-fn a_render_whose_gain_and_ceiling_never_move_is_the_one_without_ramps() {
-    // A constant gain is a constant from the first sample on: no ramp from a default.
-    let config = ModelConfig {
-        ceiling: 0.5,
+fn a_reset_starts_at_the_gain_and_ceiling_asked_for() {
+    // A bottle that glugs within the ramp's first milliseconds: a ramp left over from before
+    // the reset would show in them.
+    let early = |ceiling| ModelConfig {
+        ceiling,
+        pocket_ml: 0.01,
         ..ModelConfig::default()
     };
-    let mut engine = Engine::new(RATE, config);
-    let mut out = vec![0.0f32; 9_600];
-    engine.process(&Controls::constant(pouring(), 3.0), &mut out);
-    assert_eq!(engine.gain_now(), 10f64.powf(3.0 / 20.0));
-    assert_eq!(engine.ceiling_now(), 0.5);
+    let fast_pour = ControlValues {
+        pour_time_s: 0.05,
+        ..pouring()
+    };
+    let mut fresh = Engine::new(RATE, early(0.05));
+    let mut expected = vec![0.0f32; 4 * ramp_len()];
+    fresh.process(&Controls::constant(fast_pour, -3.0), &mut expected);
+    assert!(expected[..ramp_len()].iter().any(|y| *y != 0.0));
+    assert_eq!(fresh.gain_now(), 10f64.powf(-3.0 / 20.0));
+    assert_eq!(fresh.ceiling_now(), 0.05);
+
+    let mut reused = Engine::new(RATE, early(1.0));
+    let mut before = vec![0.0f32; 48_000];
+    reused.process(&Controls::constant(fast_pour, 12.0), &mut before);
+    reused.set_config(early(0.05));
+    reused.reset();
+    let mut after = vec![0.0f32; expected.len()];
+    reused.process(&Controls::constant(fast_pour, -3.0), &mut after);
+    assert_eq!(after, expected);
 }
 
 #[test]
