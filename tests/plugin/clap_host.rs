@@ -135,32 +135,31 @@ impl ClapInstance {
     /// Sets the parameter named `name` (as a host lists it) from `text`, as a host's automation
     /// does: the text is turned into the parameter's CLAP value and sent in a flush.
     pub fn set_text(&self, name: &str, text: &str) {
+        let change = self.change(0, name, text);
+        let event = change.event(0);
+        let events = EventList(vec![&event.header]);
         let params: &clap_plugin_params = self.extension(CLAP_EXT_PARAMS);
-        let id = self.param_id(params, name);
+        unsafe { (params.flush.unwrap())(self.plugin, &events.input(), &no_output()) };
+    }
+
+    /// A change of the parameter named `name` to `text` at sample `at` of a render, as a host's
+    /// automation lane sends it.
+    pub fn change(&self, at: u64, name: &str, text: &str) -> ParamChange {
+        let params: &clap_plugin_params = self.extension(CLAP_EXT_PARAMS);
+        let param_id = self.param_id(params, name);
         let text = std::ffi::CString::new(text).unwrap();
         let mut value = 0.0;
         assert!(
-            unsafe { (params.text_to_value.unwrap())(self.plugin, id, text.as_ptr(), &mut value) },
+            unsafe {
+                (params.text_to_value.unwrap())(self.plugin, param_id, text.as_ptr(), &mut value)
+            },
             "{name} does not parse {text:?}"
         );
-        let event = clap_event_param_value {
-            header: clap_event_header {
-                size: std::mem::size_of::<clap_event_param_value>() as u32,
-                time: 0,
-                space_id: CLAP_CORE_EVENT_SPACE_ID,
-                type_: CLAP_EVENT_PARAM_VALUE,
-                flags: 0,
-            },
-            param_id: id,
-            cookie: ptr::null_mut(),
-            note_id: -1,
-            port_index: -1,
-            channel: -1,
-            key: -1,
+        ParamChange {
+            at,
+            param_id,
             value,
-        };
-        let events = EventList(vec![&event.header]);
-        unsafe { (params.flush.unwrap())(self.plugin, &events.input(), &no_output()) };
+        }
     }
 
     fn param_id(&self, params: &clap_plugin_params, name: &str) -> u32 {
@@ -209,6 +208,17 @@ impl ClapInstance {
     /// Renders `total` samples of the stereo output in blocks of `block`, with no events and no
     /// transport; returns the left channel.
     pub fn render(&mut self, total: usize, block: usize) -> Vec<f32> {
+        self.render_automated(total, block, &[])
+    }
+
+    /// [`ClapInstance::render`] with parameter `changes` (in order of time) sent as events in the
+    /// blocks they fall in, at their offsets there.
+    pub fn render_automated(
+        &mut self,
+        total: usize,
+        block: usize,
+        changes: &[ParamChange],
+    ) -> Vec<f32> {
         assert!(self.activated);
         let mut out = Vec::with_capacity(total);
         let mut left = vec![0.0f32; block];
@@ -224,7 +234,13 @@ impl ClapInstance {
                 latency: 0,
                 constant_mask: 0,
             };
-            let events = EventList(Vec::new());
+            let block_start = steady_time as u64;
+            let in_block: Vec<clap_event_param_value> = changes
+                .iter()
+                .filter(|change| (block_start..block_start + len as u64).contains(&change.at))
+                .map(|change| change.event((change.at - block_start) as u32))
+                .collect();
+            let events = EventList(in_block.iter().map(|event| &event.header).collect());
             let input = events.input();
             let output_events = no_output();
             let process = clap_process {
@@ -259,6 +275,36 @@ impl Drop for ClapInstance {
                 ((*self.plugin).deactivate.unwrap())(self.plugin);
             }
             ((*self.plugin).destroy.unwrap())(self.plugin);
+        }
+    }
+}
+
+/// A parameter's new CLAP value from a sample of a render on.
+#[derive(Debug, Clone, Copy)]
+pub struct ParamChange {
+    /// The sample it takes effect at, counted from the render's start.
+    pub at: u64,
+    param_id: u32,
+    value: f64,
+}
+
+impl ParamChange {
+    fn event(&self, time: u32) -> clap_event_param_value {
+        clap_event_param_value {
+            header: clap_event_header {
+                size: std::mem::size_of::<clap_event_param_value>() as u32,
+                time,
+                space_id: CLAP_CORE_EVENT_SPACE_ID,
+                type_: CLAP_EVENT_PARAM_VALUE,
+                flags: 0,
+            },
+            param_id: self.param_id,
+            cookie: ptr::null_mut(),
+            note_id: -1,
+            port_index: -1,
+            channel: -1,
+            key: -1,
+            value: self.value,
         }
     }
 }

@@ -8,6 +8,7 @@ mod clap_host;
 mod fuzz;
 mod host;
 
+mod automation;
 mod clap_state;
 
 mod midi;
