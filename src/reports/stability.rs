@@ -3,7 +3,8 @@
 //!
 //! Every case renders through the engine's public API and checks some of:
 //! - **finite**: no NaN or infinity in any sample, before the output limiter as well as after;
-//! - **ceiling**: |y| never exceeds the (sanitised) ceiling, and how often the limiter acted;
+//! - **ceiling**: |y| never exceeds the (sanitised) ceiling, or the higher of the old and the new
+//!   one while it ramps to a new one (MODEL.md §6), and how often the limiter acted;
 //! - **energy**: once no unit starts any more, the energy of consecutive spans never grows, judged
 //!   only where the limiter did not act (so the output is the signal before the limiter);
 //! - **time**: engine run time per sample within a factor of a normal case measured in the same
@@ -12,7 +13,7 @@
 
 use super::accuracy;
 use super::timing::{self, RenderSpec, TimedRender};
-use crate::engine::config::{self, ControlValues};
+use crate::engine::config::{self, ControlValues, OUTPUT_RAMP_S};
 use crate::engine::synthesis::reference;
 use crate::engine::synthesis::MAX_PARTIALS;
 use crate::engine::ControlSource;
@@ -244,8 +245,9 @@ impl Property {
                                  finite before it turned them into 0 or the ceiling)"
                 .into(),
             Property::Ceiling => "|y| never exceeds the sanitised ceiling (compared in f32, as \
-                                  the engine clamps); the measurement says on how many samples \
-                                  the limiter acted"
+                                  the engine clamps), or the higher of the old and the new one \
+                                  during the 10 ms ramp to a new one; the measurement says on \
+                                  how many samples the limiter acted"
                 .into(),
             Property::Energy => format!(
                 "once no unit starts any more, the energy of consecutive {ENERGY_SPAN_S} s spans \
@@ -984,16 +986,38 @@ fn switch_config(
     };
     let before = timing::timed_render_on(&mut engine, &spec, inputs);
     engine.set_config(config);
-    let mut after = timing::timed_render_on(&mut engine, &spec, inputs);
-    // Each half answers to its own ceiling; a first half over the old one fails the case.
-    after.all_finite &= before.all_finite;
-    if before.peak > follow().ceiling as f32 {
+    // The ceiling moves to the new one along its ramp (MODEL.md §6): meanwhile the output
+    // answers to the higher of the two, then to the new one alone.
+    let ramp = (engine.sample_rate() * OUTPUT_RAMP_S).round() as u64;
+    let ramping = timing::timed_render_on(
+        &mut engine,
+        &RenderSpec {
+            len: ramp.min(half),
+            ..spec
+        },
+        inputs,
+    );
+    let mut after = timing::timed_render_on(
+        &mut engine,
+        &RenderSpec {
+            len: half - ramp.min(half),
+            ..spec
+        },
+        inputs,
+    );
+    // Each part answers to its own ceiling; a part over its own fails the case.
+    let old_ceiling = follow().ceiling as f32;
+    let ramp_ceiling = old_ceiling.max(engine.config().ceiling as f32);
+    if before.peak > old_ceiling || ramping.peak > ramp_ceiling {
         after.peak = f32::INFINITY;
     }
-    after.engine_time += before.engine_time;
-    after.limiter_events += before.limiter_events;
-    after.non_finite_before_limiter += before.non_finite_before_limiter;
-    after.max_sounding = after.max_sounding.max(before.max_sounding);
+    for part in [&before, &ramping] {
+        after.all_finite &= part.all_finite;
+        after.engine_time += part.engine_time;
+        after.limiter_events += part.limiter_events;
+        after.non_finite_before_limiter += part.non_finite_before_limiter;
+        after.max_sounding = after.max_sounding.max(part.max_sounding);
+    }
     Run {
         render: after,
         len: 2 * half,
