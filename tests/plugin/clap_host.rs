@@ -13,6 +13,9 @@ use clap_sys::events::{
     clap_event_header, clap_event_param_value, clap_input_events, clap_output_events,
     CLAP_CORE_EVENT_SPACE_ID, CLAP_EVENT_PARAM_VALUE,
 };
+use clap_sys::ext::audio_ports_config::{
+    clap_audio_ports_config, clap_plugin_audio_ports_config, CLAP_EXT_AUDIO_PORTS_CONFIG,
+};
 use clap_sys::ext::params::{clap_param_info, clap_plugin_params, CLAP_EXT_PARAMS};
 use clap_sys::ext::state::{clap_plugin_state, CLAP_EXT_STATE};
 use clap_sys::factory::plugin_factory::{clap_plugin_factory, CLAP_PLUGIN_FACTORY_ID};
@@ -28,6 +31,8 @@ pub struct ClapInstance {
     /// The plugin keeps a pointer to this for its whole life.
     _host: Box<clap_host>,
     activated: bool,
+    /// Channels of the main output in the selected audio ports configuration.
+    channels: u32,
 }
 
 unsafe extern "C" fn no_extension(_host: *const clap_host, _id: *const c_char) -> *const c_void {
@@ -71,6 +76,7 @@ impl ClapInstance {
                 plugin,
                 _host: host,
                 activated: false,
+                channels: 2,
             }
         }
     }
@@ -191,6 +197,47 @@ impl ClapInstance {
             .collect()
     }
 
+    /// The plugin's audio ports configurations as (name, main output channels), in order.
+    pub fn audio_ports_configs(&self) -> Vec<(String, u32)> {
+        let configs: &clap_plugin_audio_ports_config =
+            self.extension(CLAP_EXT_AUDIO_PORTS_CONFIG);
+        let count = unsafe { (configs.count.unwrap())(self.plugin) };
+        (0..count)
+            .map(|index| {
+                let mut config: clap_audio_ports_config = unsafe { std::mem::zeroed() };
+                assert!(unsafe { (configs.get.unwrap())(self.plugin, index, &mut config) });
+                let name = unsafe { CStr::from_ptr(config.name.as_ptr()) };
+                assert!(!config.has_main_input, "a generator takes no audio in");
+                (
+                    name.to_string_lossy().into_owned(),
+                    config.main_output_channel_count,
+                )
+            })
+            .collect()
+    }
+
+    /// Selects the first audio ports configuration whose main output has `channels` channels,
+    /// as a host does before activating; whether the plugin took it.
+    pub fn select_output_channels(&mut self, channels: u32) -> bool {
+        assert!(!self.activated, "a host selects a configuration before activating");
+        let Some(index) = self
+            .audio_ports_configs()
+            .iter()
+            .position(|(_, count)| *count == channels)
+        else {
+            return false;
+        };
+        let configs: &clap_plugin_audio_ports_config =
+            self.extension(CLAP_EXT_AUDIO_PORTS_CONFIG);
+        let mut config: clap_audio_ports_config = unsafe { std::mem::zeroed() };
+        assert!(unsafe { (configs.get.unwrap())(self.plugin, index as u32, &mut config) });
+        let selected = unsafe { (configs.select.unwrap())(self.plugin, config.id) };
+        if selected {
+            self.channels = channels;
+        }
+        selected
+    }
+
     /// Activates at `sample_rate` and starts processing.
     pub fn activate(&mut self, sample_rate: f64) {
         unsafe {
@@ -205,8 +252,8 @@ impl ClapInstance {
         self.activated = true;
     }
 
-    /// Renders `total` samples of the stereo output in blocks of `block`, with no events and no
-    /// transport; returns the left channel.
+    /// Renders `total` samples of the output in blocks of `block`, with no events and no
+    /// transport; returns the first channel (every channel carries the same signal).
     pub fn render(&mut self, total: usize, block: usize) -> Vec<f32> {
         self.render_automated(total, block, &[])
     }
@@ -221,16 +268,16 @@ impl ClapInstance {
     ) -> Vec<f32> {
         assert!(self.activated);
         let mut out = Vec::with_capacity(total);
-        let mut left = vec![0.0f32; block];
-        let mut right = vec![0.0f32; block];
+        let mut buffers = vec![vec![0.0f32; block]; self.channels as usize];
         let mut steady_time = 0;
         while out.len() < total {
             let len = block.min(total - out.len());
-            let mut channels = [left.as_mut_ptr(), right.as_mut_ptr()];
+            let mut channels: Vec<*mut f32> =
+                buffers.iter_mut().map(|buffer| buffer.as_mut_ptr()).collect();
             let mut output = clap_audio_buffer {
                 data32: channels.as_mut_ptr(),
                 data64: ptr::null_mut(),
-                channel_count: 2,
+                channel_count: self.channels,
                 latency: 0,
                 constant_mask: 0,
             };
@@ -255,12 +302,14 @@ impl ClapInstance {
                 out_events: &output_events,
             };
             unsafe { ((*self.plugin).process.unwrap())(self.plugin, &process) };
-            assert_eq!(
-                left[..len],
-                right[..len],
-                "both channels carry the same signal"
-            );
-            out.extend_from_slice(&left[..len]);
+            for channel in &buffers[1..] {
+                assert_eq!(
+                    channel[..len],
+                    buffers[0][..len],
+                    "every channel carries the same signal"
+                );
+            }
+            out.extend_from_slice(&buffers[0][..len]);
             steady_time += len as i64;
         }
         out
