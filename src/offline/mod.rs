@@ -18,3 +18,5 @@ pub use render::{
 };
 pub use scene::{LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S};
 pub use wav::{SampleFormat, WavError, WavFile};
+/// Every file the crate writes is first written as one of these, beside its target.
+pub(crate) use wav::temp_file_builder;

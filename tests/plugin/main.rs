@@ -20,3 +20,4 @@ mod realtime;
 mod reset;
 mod state;
 mod take;
+mod vstpreset;
