@@ -19,4 +19,5 @@ pub use render::{
 pub use scene::{LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S};
 pub use wav::{SampleFormat, WavError, WavFile};
 /// Every file the crate writes is first written as one of these, beside its target.
+#[cfg(feature = "plugin")]
 pub(crate) use wav::temp_file_builder;
