@@ -59,7 +59,9 @@ pub fn saved_state(params: &GlugParams) -> PluginState {
                     ParamPtr::FloatParam(param) => {
                         ParamValue::F32((*param).unmodulated_plain_value())
                     }
-                    ParamPtr::IntParam(param) => ParamValue::I32((*param).unmodulated_plain_value()),
+                    ParamPtr::IntParam(param) => {
+                        ParamValue::I32((*param).unmodulated_plain_value())
+                    }
                     ParamPtr::BoolParam(param) => {
                         ParamValue::Bool((*param).unmodulated_plain_value())
                     }

@@ -32,7 +32,8 @@ fn every_preset_file_is_the_presets_own_scene() {
         .unwrap()
         .filter(|entry| {
             let path = entry.as_ref().unwrap().path();
-            path.extension().is_some_and(|extension| extension == "toml")
+            path.extension()
+                .is_some_and(|extension| extension == "toml")
         })
         .count();
     assert_eq!(scene_files, PRESETS.len(), "no scene file without a preset");

@@ -54,7 +54,10 @@ fn write_vstpresets(folder: &std::path::Path) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(error) => {
-            eprintln!("error: writing the presets into {}: {error}", folder.display());
+            eprintln!(
+                "error: writing the presets into {}: {error}",
+                folder.display()
+            );
             ExitCode::FAILURE
         }
     }
