@@ -4,9 +4,11 @@
 mod feed;
 mod osc_input;
 mod params;
+pub mod presets;
 mod realtime;
 pub mod standalone;
 mod transport;
+pub mod vstpreset;
 
 #[cfg(feature = "editor")]
 mod editor;

@@ -28,8 +28,15 @@ fn every_preset_file_is_the_presets_own_scene() {
         };
         assert_eq!(values, preset.controls(tilted));
     }
-    let files = std::fs::read_dir(&folder).unwrap().count();
-    assert_eq!(files, PRESETS.len(), "no file without a preset");
+    let scene_files = std::fs::read_dir(&folder)
+        .unwrap()
+        .filter(|entry| {
+            let path = entry.as_ref().unwrap().path();
+            path.extension()
+                .is_some_and(|extension| extension == "toml")
+        })
+        .count();
+    assert_eq!(scene_files, PRESETS.len(), "no scene file without a preset");
 }
 
 #[test]
@@ -40,4 +47,32 @@ fn presets_differ_where_they_should() {
     assert_eq!(viscosity("thick"), 0.42);
     let capacity = |id: &str| PRESETS.iter().find(|p| p.id == id).unwrap().capacity_ml;
     assert!(capacity("small-bottle") < 300.0 && capacity("large-bottle") > 300.0);
+}
+
+/// `sake-glug presets --vstpreset DIR`, which `cargo xtask docs` runs, writes the committed
+/// `presets/vst3/` files, byte for byte (`tests/plugin/vstpreset.rs` checks what they hold).
+#[cfg(feature = "plugin")]
+#[test]
+fn the_vstpreset_command_writes_the_committed_files() {
+    use crate::command::{files_in, sake_glug};
+
+    let directory = tempfile::tempdir().unwrap();
+    let output = sake_glug(directory.path(), &["presets", "--vstpreset", "vst3"]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/vst3");
+    let written = directory.path().join("vst3");
+    let names = files_in(&written);
+    assert_eq!(names, files_in(&committed));
+    assert_eq!(names.len(), PRESETS.len());
+    for name in names {
+        assert!(
+            std::fs::read(written.join(&name)).unwrap()
+                == std::fs::read(committed.join(&name)).unwrap(),
+            "{name} differs from presets/vst3/{name} (run `cargo xtask docs`)"
+        );
+    }
 }

@@ -181,6 +181,28 @@ impl ClapInstance {
         panic!("no parameter named {name}");
     }
 
+    /// The text the plugin shows for the parameter named `name` at its current value, as a
+    /// host's parameter list shows it (the plugin's own value-to-text, with its unit).
+    pub fn shown(&self, name: &str) -> String {
+        let params: &clap_plugin_params = self.extension(CLAP_EXT_PARAMS);
+        let id = self.param_id(params, name);
+        let mut value = f64::NAN;
+        assert!(unsafe { (params.get_value.unwrap())(self.plugin, id, &mut value) });
+        let mut text = [0 as c_char; 256];
+        assert!(unsafe {
+            (params.value_to_text.unwrap())(
+                self.plugin,
+                id,
+                value,
+                text.as_mut_ptr(),
+                text.len() as u32,
+            )
+        });
+        unsafe { CStr::from_ptr(text.as_ptr()) }
+            .to_string_lossy()
+            .into_owned()
+    }
+
     /// Every parameter as (name, CLAP value, declared min, declared max).
     pub fn parameter_values(&self) -> Vec<(std::ffi::CString, f64, f64, f64)> {
         let params: &clap_plugin_params = self.extension(CLAP_EXT_PARAMS);

@@ -22,3 +22,4 @@ mod realtime;
 mod reset;
 mod state;
 mod take;
+mod vstpreset;

@@ -4,10 +4,10 @@
 //! - `cargo xtask test`: every test: formatting and lints, the Rust suites, then the bundles in a
 //!   real VST3 host and the standalone app under a JACK server.
 //! - `cargo xtask docs [--bench]`: regenerates every table and picture of docs/ from the current
-//!   code (the accuracy table and plot, the stability report, the pour plot, the presets),
-//!   stamped with the commit and the machine, and the cost figures of docs/scaling.md
-//!   (callgrind, when valgrind is installed; the render benchmark's last report, or a new one
-//!   with `--bench`).
+//!   code (the accuracy table and plot, the stability report, the pour plot, the presets as
+//!   scene files and VST3 preset files), stamped with the commit and the machine, and the cost
+//!   figures of docs/scaling.md (callgrind, when valgrind is installed; the render benchmark's
+//!   last report, or a new one with `--bench`).
 //! - `cargo xtask fuzz`: every fuzz target (tests named `fuzz_…`) with a million cases each
 //!   (`FUZZ_CASES` to change it), summarised in docs/fuzzing.md.
 //!
@@ -149,6 +149,22 @@ fn docs() -> nice_plug_xtask::Result<()> {
         std::fs::write(format!("presets/{id}.toml"), scene)?;
         println!("presets/{id}.toml written");
     }
+    // And as VST3 preset files: the plugin's saved state, so a CLI built with the plugin; then
+    // the CLI alone again, which the rest of the docs measure.
+    cargo(&[
+        "run",
+        "--release",
+        "--bin",
+        "sake-glug",
+        "--no-default-features",
+        "--features",
+        "cli,plugin",
+        "--",
+        "presets",
+        "--vstpreset",
+        "presets/vst3",
+    ])?;
+    build_cli()?;
     // The README's example of the pour plot: the default scene.
     let clip = target_dir().join("pour-plot.haptic");
     run(

@@ -5,6 +5,7 @@ use nice_plug::prelude::*;
 
 use crate::engine::{Preset, PRESETS};
 use crate::plugin::params::GlugParams;
+use crate::plugin::presets::preset_values;
 
 /// Shows the menu; `chosen` remembers the last preset picked, for its label.
 pub fn show(ui: &mut egui::Ui, params: &GlugParams, setter: &ParamSetter, chosen: &mut usize) {
@@ -30,18 +31,7 @@ pub fn show(ui: &mut egui::Ui, params: &GlugParams, setter: &ParamSetter, chosen
 
 /// Sets every parameter the preset holds.
 pub fn apply(preset: &Preset, params: &GlugParams, setter: &ParamSetter) {
-    let model = &params.model;
-    let values = [
-        (&params.viscosity, preset.viscosity),
-        (&params.pour_time, preset.pour_time_s),
-        (&model.capacity, preset.capacity_ml),
-        (&model.pocket, preset.pocket_ml),
-        (&model.f1, preset.frequency_hz[0]),
-        (&model.f2, preset.frequency_hz[1]),
-        (&model.b1, preset.decay_per_s[0]),
-        (&model.b2, preset.decay_per_s[1]),
-    ];
-    for (param, value) in values {
+    for (param, value) in preset_values(preset, params) {
         setter.begin_set_parameter(param);
         setter.set_parameter(param, value as f32);
         setter.end_set_parameter(param);

@@ -1,0 +1,216 @@
+//! The presets as VST3 preset files: `presets/vst3/<name>.vstpreset` is the code's own file for
+//! each preset (so the files cannot drift from the editor's menu), laid out as Steinberg's
+//! format says, and its component state is one nice-plug's real state path loads as the preset
+//! and saves back byte for byte.
+
+use std::path::{Path, PathBuf};
+
+use nice_plug::prelude::Vst3Plugin;
+use sake_glug::engine::{Preset, PRESETS};
+use sake_glug::plugin::knobs::{B1, B2, CAPACITY, F1, F2, POCKET, POUR_TIME, VISCOSITY};
+use sake_glug::plugin::{vstpreset, Knob};
+use sake_glug::SakeGlugVst3;
+
+use crate::clap_host::ClapInstance;
+
+fn folder() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/vst3")
+}
+
+fn committed(preset: &Preset) -> Vec<u8> {
+    let path = folder().join(format!("{}.vstpreset", preset.name));
+    std::fs::read(&path)
+        .unwrap_or_else(|error| panic!("{}: {error} (run `cargo xtask docs`)", path.display()))
+}
+
+/// A preset file read as a host's reader (Steinberg's `PresetFile`) reads it.
+struct PresetFile {
+    version: i32,
+    class_id: [u8; 16],
+    /// (chunk id, offset, size), as the chunk list gives them.
+    chunks: Vec<([u8; 4], usize, usize)>,
+}
+
+fn int32(bytes: &[u8], at: usize) -> i32 {
+    i32::from_le_bytes(bytes[at..at + 4].try_into().unwrap())
+}
+
+fn int64(bytes: &[u8], at: usize) -> usize {
+    let value = i64::from_le_bytes(bytes[at..at + 8].try_into().unwrap());
+    usize::try_from(value).expect("offsets and sizes are not negative")
+}
+
+/// Reads the header and the chunk list, checking what Steinberg's format requires of them.
+fn parse(bytes: &[u8]) -> PresetFile {
+    assert_eq!(&bytes[..4], b"VST3", "header id");
+    let version = int32(bytes, 4);
+    // 32 ASCII hex digits, two per byte, as the SDK's FUID::fromString reads them.
+    let digits = std::str::from_utf8(&bytes[8..40]).expect("the class ID is ASCII");
+    assert!(
+        digits
+            .chars()
+            .all(|c| c.is_ascii_digit() || ('A'..='F').contains(&c)),
+        "upper-case hex, as FUID::toString writes: {digits}"
+    );
+    let mut class_id = [0u8; 16];
+    for (index, byte) in class_id.iter_mut().enumerate() {
+        *byte = u8::from_str_radix(&digits[2 * index..2 * index + 2], 16).unwrap();
+    }
+    let list = int64(bytes, 40);
+    assert!(
+        (48..bytes.len()).contains(&list),
+        "the chunk list at {list} lies after the header, inside the file"
+    );
+    assert_eq!(&bytes[list..list + 4], b"List", "the chunk list's id");
+    let count = int32(bytes, list + 4) as usize;
+    let entries = list + 8;
+    assert_eq!(
+        entries + count * 20,
+        bytes.len(),
+        "the list's {count} entries end the file"
+    );
+    let chunks: Vec<_> = (0..count)
+        .map(|index| {
+            let entry = entries + index * 20;
+            let id: [u8; 4] = bytes[entry..entry + 4].try_into().unwrap();
+            (id, int64(bytes, entry + 4), int64(bytes, entry + 12))
+        })
+        .collect();
+    // The data area runs from the header to the list, each chunk after the one before.
+    let mut end = 48;
+    for &(id, offset, size) in &chunks {
+        assert!(
+            offset >= end && offset + size <= list,
+            "chunk {:?} at {offset}, {size} bytes, outside the data area 48..{list}",
+            String::from_utf8_lossy(&id)
+        );
+        end = offset + size;
+    }
+    PresetFile {
+        version,
+        class_id,
+        chunks,
+    }
+}
+
+/// The component state of a preset file: its 'Comp' chunk.
+fn component_state(bytes: &[u8]) -> &[u8] {
+    let file = parse(bytes);
+    let &(_, offset, size) = file
+        .chunks
+        .iter()
+        .find(|(id, _, _)| id == b"Comp")
+        .expect("a 'Comp' chunk");
+    &bytes[offset..offset + size]
+}
+
+/// The same state as the CLAP state stream carries it: its length, then the same JSON.
+fn clap_stream(component_state: &[u8]) -> Vec<u8> {
+    let mut bytes = (component_state.len() as u64).to_le_bytes().to_vec();
+    bytes.extend_from_slice(component_state);
+    bytes
+}
+
+/// Each parameter a preset sets, by the name a host lists, with its knob and the preset's value.
+fn preset_parameters(preset: &Preset) -> [(&'static str, Knob, f64); 8] {
+    [
+        ("Viscosity", VISCOSITY, preset.viscosity),
+        ("Pour time", POUR_TIME, preset.pour_time_s),
+        ("Capacity", CAPACITY, preset.capacity_ml),
+        ("Pocket volume", POCKET, preset.pocket_ml),
+        ("f1", F1, preset.frequency_hz[0]),
+        ("f2", F2, preset.frequency_hz[1]),
+        ("B1", B1, preset.decay_per_s[0]),
+        ("B2", B2, preset.decay_per_s[1]),
+    ]
+}
+
+#[test]
+fn every_vstpreset_file_is_the_presets_own() {
+    for preset in &PRESETS {
+        assert!(
+            committed(preset) == vstpreset::preset_file(preset),
+            "presets/vst3/{} is stale (run `cargo xtask docs`)",
+            vstpreset::file_name(preset)
+        );
+    }
+    let files = std::fs::read_dir(folder()).unwrap().count();
+    assert_eq!(files, PRESETS.len(), "no file without a preset");
+}
+
+#[test]
+fn each_file_is_laid_out_as_steinbergs_format_says() {
+    for preset in &PRESETS {
+        let bytes = committed(preset);
+        let file = parse(&bytes);
+        assert_eq!(file.version, 1, "{}", preset.name);
+        assert_eq!(
+            file.class_id,
+            SakeGlugVst3::VST3_CLASS_ID,
+            "{}: the class ID the VST3 plugin registers",
+            preset.name
+        );
+        let ids: Vec<_> = file.chunks.iter().map(|(id, _, _)| id).collect();
+        assert_eq!(ids, [b"Comp"], "{}: the component state only", preset.name);
+        assert_eq!(
+            file.chunks[0].1, 48,
+            "{}: the state right after the header",
+            preset.name
+        );
+    }
+}
+
+#[test]
+fn each_files_state_loads_in_the_plugin_as_the_preset() {
+    let fresh = ClapInstance::new();
+    let names: Vec<String> = fresh
+        .parameter_values()
+        .into_iter()
+        .map(|(name, ..)| name.into_string().unwrap())
+        .collect();
+    for preset in &PRESETS {
+        let bytes = committed(preset);
+        let state = component_state(&bytes);
+        // An instance a user has already moved away from the defaults: the preset must bring
+        // back every parameter it does not set, not only set its own.
+        let instance = ClapInstance::new();
+        instance.set_text("Tilt", "120");
+        instance.set_text("Output gain", "-20");
+        instance.set_text("Seed", "77");
+        assert!(
+            instance.load(&clap_stream(state)),
+            "{}: the plugin refused the state",
+            preset.name
+        );
+
+        let expected = preset_parameters(preset);
+        for name in &names {
+            let shown = instance.shown(name);
+            match expected.iter().find(|(set, ..)| set == name) {
+                Some((_, knob, value)) => {
+                    let number: f32 = shown.split_whitespace().next().unwrap().parse().unwrap();
+                    assert_eq!(
+                        knob.exact(number),
+                        *value,
+                        "{}: {name} shows {shown}",
+                        preset.name
+                    );
+                }
+                None => assert_eq!(
+                    shown,
+                    fresh.shown(name),
+                    "{}: {name} is not at its default",
+                    preset.name
+                ),
+            }
+        }
+        // What the plugin saves holding the preset is the file's state, to the byte: the
+        // persisted fields at their defaults too, and nothing the wrapper would not write.
+        assert_eq!(
+            String::from_utf8_lossy(&instance.save()[8..]),
+            String::from_utf8_lossy(state),
+            "{}",
+            preset.name
+        );
+    }
+}
