@@ -186,6 +186,7 @@ impl OutputStage {
 
     /// Output gain, then the guarantees of MODEL.md §6: finite, within the ceiling, no denormal.
     /// Counts what the limiter did, so that a check can look past it.
+    #[inline]
     pub fn apply(&mut self, gain_db: &Lane, ceiling: f64, out: &mut [f32]) {
         if out.is_empty() {
             return;
