@@ -221,8 +221,7 @@ impl ClapInstance {
 
     /// The plugin's audio ports configurations as (name, main output channels), in order.
     pub fn audio_ports_configs(&self) -> Vec<(String, u32)> {
-        let configs: &clap_plugin_audio_ports_config =
-            self.extension(CLAP_EXT_AUDIO_PORTS_CONFIG);
+        let configs: &clap_plugin_audio_ports_config = self.extension(CLAP_EXT_AUDIO_PORTS_CONFIG);
         let count = unsafe { (configs.count.unwrap())(self.plugin) };
         (0..count)
             .map(|index| {
@@ -241,7 +240,10 @@ impl ClapInstance {
     /// Selects the first audio ports configuration whose main output has `channels` channels,
     /// as a host does before activating; whether the plugin took it.
     pub fn select_output_channels(&mut self, channels: u32) -> bool {
-        assert!(!self.activated, "a host selects a configuration before activating");
+        assert!(
+            !self.activated,
+            "a host selects a configuration before activating"
+        );
         let Some(index) = self
             .audio_ports_configs()
             .iter()
@@ -249,8 +251,7 @@ impl ClapInstance {
         else {
             return false;
         };
-        let configs: &clap_plugin_audio_ports_config =
-            self.extension(CLAP_EXT_AUDIO_PORTS_CONFIG);
+        let configs: &clap_plugin_audio_ports_config = self.extension(CLAP_EXT_AUDIO_PORTS_CONFIG);
         let mut config: clap_audio_ports_config = unsafe { std::mem::zeroed() };
         assert!(unsafe { (configs.get.unwrap())(self.plugin, index as u32, &mut config) });
         let selected = unsafe { (configs.select.unwrap())(self.plugin, config.id) };
@@ -294,8 +295,10 @@ impl ClapInstance {
         let mut steady_time = 0;
         while out.len() < total {
             let len = block.min(total - out.len());
-            let mut channels: Vec<*mut f32> =
-                buffers.iter_mut().map(|buffer| buffer.as_mut_ptr()).collect();
+            let mut channels: Vec<*mut f32> = buffers
+                .iter_mut()
+                .map(|buffer| buffer.as_mut_ptr())
+                .collect();
             let mut output = clap_audio_buffer {
                 data32: channels.as_mut_ptr(),
                 data64: ptr::null_mut(),
