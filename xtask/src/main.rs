@@ -8,6 +8,9 @@
 //!   scene files and VST3 preset files), stamped with the commit and the machine, and the cost
 //!   figures of docs/scaling.md (callgrind, when valgrind is installed; the render benchmark's
 //!   last report, or a new one with `--bench`).
+//! - `cargo xtask screenshots`: the editor in a real window (the standalone app under Xvfb), idle
+//!   and while a phone's OSC gravity pours, written to docs/editor-idle.png and
+//!   docs/editor-pouring.png.
 //! - `cargo xtask fuzz`: every fuzz target (tests named `fuzz_…`) with a million cases each
 //!   (`FUZZ_CASES` to change it), summarised in docs/fuzzing.md.
 //!
@@ -17,6 +20,8 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+mod screenshots;
 
 fn main() -> nice_plug_xtask::Result<()> {
     // Read before nice-plug's bundler runs: it clears cargo's variables for its own builds.
@@ -58,6 +63,11 @@ fn main() -> nice_plug_xtask::Result<()> {
             nice_plug_xtask::chdir_workspace_root()?;
             fuzz()
         }
+        Some("screenshots") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            build_standalone()?;
+            screenshots::screenshots(&target_dir().join("release/sake-glug-standalone"))
+        }
         _ => nice_plug_xtask::main(),
     }
 }
@@ -78,7 +88,11 @@ fn build_release() -> nice_plug_xtask::Result<()> {
         .map(String::from),
     )?;
     build_cli()?;
-    // The standalone app (JACK and ALSA: libjack and libasound at build time).
+    build_standalone()
+}
+
+/// The standalone app (JACK and ALSA: libjack and libasound at build time).
+fn build_standalone() -> nice_plug_xtask::Result<()> {
     cargo(&[
         "build",
         "--release",
