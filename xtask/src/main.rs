@@ -66,7 +66,8 @@ fn main() -> nice_plug_xtask::Result<()> {
         Some("screenshots") => {
             nice_plug_xtask::chdir_workspace_root()?;
             build_standalone()?;
-            screenshots::screenshots(&target_dir().join("release/sake-glug-standalone"))
+            let cpu = screenshots::screenshots(&target_dir().join("release/sake-glug-standalone"))?;
+            replace_block("README.md", "editor-cpu", &format!("{cpu}.\n"))
         }
         _ => nice_plug_xtask::main(),
     }

@@ -20,6 +20,9 @@ const WINDOW_NAME: &str = "^Sake Glug$";
 const GRAVITY_AT_135: [f32; 3] = [0.0, std::f32::consts::FRAC_1_SQRT_2, -0.707_106_77];
 /// How long the pour runs before the shot: the scope shows the last 0.6 s, full of glugs by then.
 const POURING_FOR: Duration = Duration::from_millis(1_500);
+/// How long the app's CPU time is counted, idle and then pouring (a full bottle glugs for about
+/// 3.5 s at 135°).
+const COUNTED_FOR: Duration = Duration::from_secs(3);
 
 /// A child process ended when the guard goes, whatever happened: asked with SIGTERM first, so
 /// that Xvfb removes its socket and lock file, killed if it has not ended a second later.
@@ -42,8 +45,9 @@ impl Drop for Running {
     }
 }
 
-/// Builds the app, runs it under Xvfb and writes the two screenshots under docs/.
-pub fn screenshots(app: &Path) -> nice_plug_xtask::Result<()> {
+/// Runs the app under Xvfb, writes the two screenshots under docs/, and returns a sentence on
+/// the app's CPU time idle and pouring (whether the editor repaints only on change).
+pub fn screenshots(app: &Path) -> nice_plug_xtask::Result<String> {
     for (tool, package) in [
         ("Xvfb", "xvfb"),
         ("import", "imagemagick"),
@@ -78,7 +82,7 @@ pub fn screenshots(app: &Path) -> nice_plug_xtask::Result<()> {
     })?;
 
     let port = UdpSocket::bind("127.0.0.1:0")?.local_addr()?.port();
-    let _app = spawn(
+    let app = spawn(
         Command::new(app)
             .env("DISPLAY", &display)
             .args(["--backend", "dummy", "--osc-axis", "+y", "--osc-port"])
@@ -102,6 +106,8 @@ pub fn screenshots(app: &Path) -> nice_plug_xtask::Result<()> {
         Ok((colours(idle)? > 16).then_some(()))
     })?;
 
+    let idle_cpu = cpu_seconds_over(&app, COUNTED_FOR, || Ok(()))?;
+
     // The phone tilts the bottle; packets keep coming as a phone sends them.
     let sender = UdpSocket::bind("127.0.0.1:0")?;
     let gravity = encoder::encode(&OscPacket::Message(OscMessage {
@@ -109,13 +115,50 @@ pub fn screenshots(app: &Path) -> nice_plug_xtask::Result<()> {
         args: GRAVITY_AT_135.iter().map(|g| OscType::Float(*g)).collect(),
     }))?;
     let start = Instant::now();
-    while start.elapsed() < POURING_FOR {
+    let mut shot = false;
+    let pouring_cpu = cpu_seconds_over(&app, COUNTED_FOR, || {
         sender.send_to(&gravity, ("127.0.0.1", port))?;
+        if !shot && start.elapsed() >= POURING_FOR {
+            shoot(&display, &window, Path::new("docs/editor-pouring.png"))?;
+            shot = true;
+        }
+        Ok(())
+    })?;
+    if !shot {
+        bail!("the pour ended before its screenshot");
+    }
+    println!("wrote docs/editor-idle.png and docs/editor-pouring.png");
+    let seconds = COUNTED_FOR.as_secs_f64();
+    Ok(format!(
+        "the app used {idle_cpu:.2} s of CPU in {seconds} s upright and idle, \
+         {pouring_cpu:.2} s in {seconds} s of pouring (software OpenGL included)"
+    ))
+}
+
+/// The app's CPU time (user and system, in seconds) over `span`, calling `meanwhile` every
+/// 50 ms.
+fn cpu_seconds_over(
+    app: &Running,
+    span: Duration,
+    mut meanwhile: impl FnMut() -> nice_plug_xtask::Result<()>,
+) -> nice_plug_xtask::Result<f64> {
+    let before = cpu_seconds(app)?;
+    let start = Instant::now();
+    while start.elapsed() < span {
+        meanwhile()?;
         sleep(Duration::from_millis(50));
     }
-    shoot(&display, &window, Path::new("docs/editor-pouring.png"))?;
-    println!("wrote docs/editor-idle.png and docs/editor-pouring.png");
-    Ok(())
+    Ok(cpu_seconds(app)? - before)
+}
+
+/// utime + stime of /proc/<pid>/stat (fields 14 and 15, in clock ticks of 1/100 s on Linux).
+fn cpu_seconds(app: &Running) -> nice_plug_xtask::Result<f64> {
+    let stat = std::fs::read_to_string(format!("/proc/{}/stat", app.0.id()))?;
+    // The command name (field 2) may hold spaces; the fields after it are plain numbers.
+    let after_name = &stat[stat.rfind(')').context("no command name in /proc stat")? + 2..];
+    let fields: Vec<&str> = after_name.split(' ').collect();
+    let ticks: u64 = fields[11].parse::<u64>()? + fields[12].parse::<u64>()?;
+    Ok(ticks as f64 / 100.0)
 }
 
 fn spawn(command: &mut Command, name: &'static str) -> nice_plug_xtask::Result<Running> {
