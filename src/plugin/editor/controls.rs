@@ -5,16 +5,22 @@ use nice_plug_egui::widgets::ParamSlider;
 
 use crate::plugin::params::GlugParams;
 
+/// The main group's sliders.
+const MAIN_SLIDER_WIDTH: f32 = 170.0;
+/// The model group's: narrower, as its names are longer and the group is indented, so that its
+/// rows fit the column as the main group's do.
+const MODEL_SLIDER_WIDTH: f32 = 110.0;
+
 pub fn show(ui: &mut egui::Ui, params: &GlugParams, setter: &ParamSetter) {
     egui::Grid::new("main_group")
         .num_columns(2)
         .spacing([8.0, 6.0])
         .show(ui, |ui| {
-            row(ui, &params.tilt, setter);
-            row(ui, &params.viscosity, setter);
-            row(ui, &params.fill, setter);
-            row(ui, &params.pour_time, setter);
-            row(ui, &params.gain, setter);
+            row(ui, &params.tilt, setter, MAIN_SLIDER_WIDTH);
+            row(ui, &params.viscosity, setter, MAIN_SLIDER_WIDTH);
+            row(ui, &params.fill, setter, MAIN_SLIDER_WIDTH);
+            row(ui, &params.pour_time, setter, MAIN_SLIDER_WIDTH);
+            row(ui, &params.gain, setter, MAIN_SLIDER_WIDTH);
         });
     egui::CollapsingHeader::new("Model").show(ui, |ui| {
         let model = &params.model;
@@ -30,7 +36,7 @@ pub fn show(ui: &mut egui::Ui, params: &GlugParams, setter: &ParamSetter) {
                     &model.pocket,
                     &model.capacity,
                 ] {
-                    row(ui, param, setter);
+                    row(ui, param, setter, MODEL_SLIDER_WIDTH);
                 }
                 for param in [
                     &model.timing_jitter,
@@ -38,16 +44,16 @@ pub fn show(ui: &mut egui::Ui, params: &GlugParams, setter: &ParamSetter) {
                     &model.decay_sigma,
                     &model.ceiling,
                 ] {
-                    row(ui, param, setter);
+                    row(ui, param, setter, MODEL_SLIDER_WIDTH);
                 }
-                row(ui, &model.seed, setter);
-                row(ui, &model.drain, setter);
+                row(ui, &model.seed, setter, MODEL_SLIDER_WIDTH);
+                row(ui, &model.drain, setter, MODEL_SLIDER_WIDTH);
             });
     });
 }
 
-fn row<P: Param>(ui: &mut egui::Ui, param: &P, setter: &ParamSetter) {
+fn row<P: Param>(ui: &mut egui::Ui, param: &P, setter: &ParamSetter, width: f32) {
     ui.label(param.name());
-    ui.add(ParamSlider::for_param(param, setter).with_width(170.0));
+    ui.add(ParamSlider::for_param(param, setter).with_width(width));
     ui.end_row();
 }

@@ -7,6 +7,8 @@ use crate::plugin::feed::Feed;
 
 const SPAN_S: f32 = 0.15;
 const POINTS: usize = 60;
+/// The label's line at the top of the panel (12 px text, 2 px from the top, and a gap).
+const LABEL_HEIGHT: f32 = 18.0;
 
 pub fn show(ui: &mut egui::Ui, feed: &Feed, size: Vec2) {
     let (rect, _) = ui.allocate_exact_size(size, egui::Sense::hover());
@@ -41,9 +43,10 @@ pub fn show(ui: &mut egui::Ui, feed: &Feed, size: Vec2) {
         }
         let age = unit.age_s as f32;
         if (0.0..SPAN_S).contains(&age) {
+            // Below the label, so that no marker runs through its text.
             painter.vline(
                 x(age),
-                rect.y_range(),
+                rect.top() + LABEL_HEIGHT..=rect.bottom(),
                 Stroke::new(1.0, Color32::from_gray(90).gamma_multiply(fade)),
             );
         }

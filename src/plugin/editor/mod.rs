@@ -24,6 +24,15 @@ use crate::plugin::params::GlugParams;
 pub const WIDTH: f64 = 760.0;
 pub const HEIGHT: f64 = 640.0;
 
+/// The space between the window's edges and the content.
+const MARGIN: f32 = 8.0;
+/// The column of controls, MIDI and OSC settings: as wide as a slider row.
+const CONTROLS_WIDTH: f32 = 320.0;
+/// The scope's and the envelopes' height.
+const PANEL_HEIGHT: f32 = 200.0;
+/// What `ui.separator()` takes (its default spacing).
+const SEPARATOR_HEIGHT: f32 = 6.0;
+
 pub struct GlugEditor {
     params: Arc<GlugParams>,
     feed: Arc<Feed>,
@@ -79,29 +88,42 @@ impl NiceEguiApp for GlugEditor {
             return;
         };
         let setter = gui.param_setter();
-        ui.heading("Sake Glug");
-        ui.horizontal_top(|ui| {
-            ui.vertical(|ui| {
-                ui.set_width(300.0);
-                presets::show(ui, &self.params, &setter, &mut self.preset);
-                controls::show(ui, &self.params, &setter);
-                ui.separator();
-                self.midi_edited |= midi_settings::show(ui, &self.params);
-                ui.separator();
-                osc_settings::show(ui, &self.params, &self.osc);
+        // The root Ui is the whole window, edge to edge: keep the content off the edges.
+        egui::Frame::new().inner_margin(MARGIN).show(ui, |ui| {
+            ui.heading("Sake Glug");
+            // Unfolding the model group makes the controls taller than the window: they
+            // scroll, so the scope and envelopes below stay in view.
+            let controls_height = ui.available_height()
+                - PANEL_HEIGHT
+                - 2.0 * ui.spacing().item_spacing.y
+                - SEPARATOR_HEIGHT;
+            ui.horizontal_top(|ui| {
+                ui.vertical(|ui| {
+                    ui.set_width(CONTROLS_WIDTH);
+                    egui::ScrollArea::vertical()
+                        .max_height(controls_height)
+                        .show(ui, |ui| {
+                            presets::show(ui, &self.params, &setter, &mut self.preset);
+                            controls::show(ui, &self.params, &setter);
+                            ui.separator();
+                            self.midi_edited |= midi_settings::show(ui, &self.params);
+                            ui.separator();
+                            osc_settings::show(ui, &self.params, &self.osc);
+                        });
+                });
+                let width = ui.available_width();
+                bottle::show(ui, &self.feed, egui::vec2(width, 220.0));
             });
-            ui.vertical(|ui| {
-                bottle::show(ui, &self.feed, egui::vec2(420.0, 220.0));
+            if self.midi_edited && !ui.input(|input| input.pointer.any_down()) {
+                self.midi_edited = false;
+                midi_settings::tell_host(gui);
+            }
+            ui.separator();
+            ui.horizontal_top(|ui| {
+                let width = (ui.available_width() - ui.spacing().item_spacing.x) / 2.0;
+                scope::show(ui, &self.feed, egui::vec2(width, PANEL_HEIGHT));
+                envelopes::show(ui, &self.feed, egui::vec2(width, PANEL_HEIGHT));
             });
-        });
-        if self.midi_edited && !ui.input(|input| input.pointer.any_down()) {
-            self.midi_edited = false;
-            midi_settings::tell_host(gui);
-        }
-        ui.separator();
-        ui.horizontal_top(|ui| {
-            scope::show(ui, &self.feed, egui::vec2(370.0, 200.0));
-            envelopes::show(ui, &self.feed, egui::vec2(370.0, 200.0));
         });
     }
 

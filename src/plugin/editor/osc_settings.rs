@@ -42,7 +42,8 @@ pub fn show(ui: &mut egui::Ui, params: &GlugParams, osc: &OscInput) {
     let status = match osc.status() {
         OscStatus::Off => "off".to_owned(),
         OscStatus::Listening(address) => {
-            format!("on {address}: {packets} packets, {malformed} malformed")
+            let plural = if packets == 1 { "" } else { "s" };
+            format!("on {address}: {packets} packet{plural}, {malformed} malformed")
         }
         OscStatus::Failed { port, error } => format!("port {port} failed: {error}"),
     };

@@ -4,6 +4,9 @@ use egui::{pos2, Color32, Stroke, Vec2};
 
 use crate::plugin::feed::{Feed, SCOPE_COLUMNS, SCOPE_COLUMN_S};
 
+/// The label's line at the top of the panel (12 px text, 2 px from the top, and a gap).
+const LABEL_HEIGHT: f32 = 18.0;
+
 pub fn show(ui: &mut egui::Ui, feed: &Feed, size: Vec2) {
     let (rect, _) = ui.allocate_exact_size(size, egui::Sense::hover());
     let painter = ui.painter_at(rect);
@@ -14,7 +17,9 @@ pub fn show(ui: &mut egui::Ui, feed: &Feed, size: Vec2) {
         .fold(1e-6f32, |peak, &(min, max)| peak.max(-min).max(max));
     let x_step = rect.width() / SCOPE_COLUMNS as f32;
     let first_x = rect.right() - columns.len() as f32 * x_step;
-    let y = |value: f32| rect.center().y - value / peak * rect.height() * 0.45;
+    // The trace keeps below the label, so that it never runs through the text.
+    let plot = rect.with_min_y(rect.top() + LABEL_HEIGHT);
+    let y = |value: f32| plot.center().y - value / peak * plot.height() * 0.45;
     for (index, &(min, max)) in columns.iter().enumerate() {
         let x = first_x + index as f32 * x_step;
         painter.line_segment(
