@@ -65,8 +65,12 @@ fn main() -> nice_plug_xtask::Result<()> {
         }
         Some("screenshots") => {
             nice_plug_xtask::chdir_workspace_root()?;
+            screenshots::check_tools()?;
             build_standalone()?;
-            let cpu = screenshots::screenshots(&target_dir().join("release/sake-glug-standalone"))?;
+            let cpu = screenshots::screenshots(
+                &target_dir().join("release/sake-glug-standalone"),
+                &target_dir().join("screenshots"),
+            )?;
             replace_block("README.md", "editor-cpu", &format!("{cpu}.\n"))
         }
         _ => nice_plug_xtask::main(),
