@@ -70,6 +70,11 @@ impl Ramp {
     }
 }
 
+/// G of MODEL.md §6 for an output gain in dB, brought into range first (§11).
+fn linear(gain_db: f64) -> f64 {
+    db_to_gain(GAIN_DB.sanitize(gain_db))
+}
+
 /// Counts kept by the output stage, since the last reset.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct LimiterCounts {
@@ -97,7 +102,7 @@ pub(super) struct OutputStage {
 impl OutputStage {
     pub fn new(sample_rate: f64) -> Self {
         let ramp_len = ((sample_rate * OUTPUT_RAMP_S).round() as u32).max(1);
-        let gain_db = (GAIN_DB.default, db_to_gain(GAIN_DB.default));
+        let gain_db = (GAIN_DB.default, linear(GAIN_DB.default));
         Self {
             ramp_len,
             gain_db,
@@ -126,7 +131,7 @@ impl OutputStage {
     /// The gain (linear) the output will have at sample `index` of a block about to be applied
     /// with `gain_db`: what a unit starting there is heard at. Changes nothing.
     pub fn gain_ahead(&self, gain_db: &Lane, index: usize) -> f64 {
-        let target = |index: usize| db_to_gain(GAIN_DB.sanitize(gain_db.at(index)));
+        let target = |index: usize| linear(gain_db.at(index));
         let mut gain = if self.fresh {
             Ramp::settled_at(target(0), self.ramp_len)
         } else {
@@ -159,7 +164,7 @@ impl OutputStage {
     #[inline]
     fn linear_gain(&mut self, gain_db: f64) -> f64 {
         if gain_db.to_bits() != self.gain_db.0.to_bits() {
-            self.gain_db = (gain_db, db_to_gain(GAIN_DB.sanitize(gain_db)));
+            self.gain_db = (gain_db, linear(gain_db));
         }
         self.gain_db.1
     }

@@ -2,7 +2,7 @@
 //! them while glugs ring does not click, and the ramp depends only on the targets sample by
 //! sample: the same samples at every block size, through silence as well.
 
-use crate::support::{error_db, reference_render, render_in_blocks};
+use crate::support::{error_db, largest_step, reference_render, render_in_blocks};
 use sake_glug::engine::config::OUTPUT_RAMP_S;
 use sake_glug::engine::{ControlValues, Controls, Engine, Lane, ModelConfig};
 use sake_glug::offline::Scene;
@@ -64,13 +64,6 @@ fn gain_step(from_db: f64, to_db: f64) -> Vec<f64> {
     (0..LEN)
         .map(|n| if n < MOVE_AT { from_db } else { to_db })
         .collect()
-}
-
-fn largest_step(samples: &[f32]) -> f32 {
-    samples
-        .windows(2)
-        .map(|pair| (pair[1] - pair[0]).abs())
-        .fold(0.0, f32::max)
 }
 
 #[test]

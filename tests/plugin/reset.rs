@@ -5,6 +5,7 @@
 use nice_plug::prelude::Plugin;
 
 use crate::host::{cc, note_on, peak, Playhead, TestHost};
+use crate::support::largest_step;
 use sake_glug::engine::{Controls, Engine};
 use sake_glug::plugin::FADE_S;
 
@@ -91,14 +92,6 @@ fn a_bounce_from_silence_equals_the_offline_render_from_its_first_sample() {
     let mut host = pouring_host();
     let first = play(&mut host, 0, 60);
     assert_eq!(first, engine_render(&host, first.len()));
-}
-
-/// The largest step between neighbouring samples.
-fn largest_step(samples: &[f32]) -> f32 {
-    samples
-        .windows(2)
-        .map(|pair| (pair[1] - pair[0]).abs())
-        .fold(0.0, f32::max)
 }
 
 #[test]

@@ -35,6 +35,14 @@ pub fn reference_render(scene: &Scene, len: usize) -> Vec<f64> {
     reference::evaluate(scene.sample_rate as f64, scene.config, scene, 0..len as u64).samples
 }
 
+/// The largest step between neighbouring samples: how a click shows.
+pub fn largest_step(samples: &[f32]) -> f32 {
+    samples
+        .windows(2)
+        .map(|pair| (pair[1] - pair[0]).abs())
+        .fold(0.0, f32::max)
+}
+
 /// Largest absolute error relative to the reference's peak, in dB.
 pub fn error_db(fast: &[f32], reference: &[f64]) -> f64 {
     assert!(
