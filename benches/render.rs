@@ -169,7 +169,7 @@ fn numpy_synthesis(scene: &Scene, samples: usize) -> Result<(f64, f64), String> 
         let [a1, a2] = unit.component_amplitudes();
         let [f1, f2] = unit.shape.frequency_hz;
         let [b1, b2] = unit.shape.decay_per_s;
-        let gain_db = scene.gain_db.value_at(onset_s);
+        let gain_db = scene.lanes.gain_db.value_at(onset_s);
         for value in [onset_s, a1, a2, f1, f2, b1, b2, gain_db] {
             table.extend_from_slice(&value.to_le_bytes());
         }

@@ -64,7 +64,10 @@ fn render_hours(
         };
         let controls = Controls {
             tilt_deg: tilt,
-            ..Controls::constant(ControlValues::default(), -6.0)
+            ..Controls::constant(ControlValues {
+                gain_db: -6.0,
+                ..ControlValues::default()
+            })
         };
         engine.process(&controls, &mut out[..n]);
         done += n;

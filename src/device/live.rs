@@ -10,40 +10,38 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use crate::device::midi::Target;
-use crate::engine::config::{Range, FILL_PERCENT, TILT_DEG, VISCOSITY};
+use crate::engine::{Control, PerControl};
 
-const TARGETS: [Target; 3] = [Target::Tilt, Target::Viscosity, Target::Fill];
-
-fn range(target: Target) -> Range {
-    match target {
-        Target::Tilt => TILT_DEG,
-        Target::Viscosity => VISCOSITY,
-        Target::Fill => FILL_PERCENT,
-    }
-}
-
-/// Tilt, viscosity and fill as a live input last set them, and how many refills it asked for.
-#[derive(Debug, Default)]
+/// Each control as a live input last set it, and how many refills it asked for.
+#[derive(Debug)]
 pub struct LiveControls {
-    /// f64 bits of each control, in the order of [`Target`].
-    values: [AtomicU64; 3],
+    /// f64 bits of each control.
+    values: PerControl<AtomicU64>,
     /// How many times each control was set.
-    changes: [AtomicU64; 3],
+    changes: PerControl<AtomicU64>,
     refills: AtomicU64,
 }
 
+impl Default for LiveControls {
+    fn default() -> Self {
+        Self {
+            values: PerControl::from_fn(|_| AtomicU64::new(0)),
+            changes: PerControl::from_fn(|_| AtomicU64::new(0)),
+            refills: AtomicU64::new(0),
+        }
+    }
+}
+
 impl LiveControls {
-    /// Sets `target` to `value`, clamped to the control's range (a NaN is ignored).
-    pub fn set(&self, target: Target, value: f64) {
+    /// Sets `control` to `value`, clamped to the control's range (a NaN is ignored).
+    pub fn set(&self, control: Control, value: f64) {
         if value.is_nan() {
             return;
         }
-        let range = range(target);
+        let range = control.range();
         let value = value.clamp(range.min, range.max);
-        let index = target as usize;
-        self.values[index].store(value.to_bits(), Ordering::Relaxed);
-        self.changes[index].fetch_add(1, Ordering::Release);
+        self.values[control].store(value.to_bits(), Ordering::Relaxed);
+        self.changes[control].fetch_add(1, Ordering::Release);
     }
 
     /// Asks for one refill of the bottle (MODEL.md §8).
@@ -51,15 +49,15 @@ impl LiveControls {
         self.refills.fetch_add(1, Ordering::Release);
     }
 
-    /// How many times `target` has been set.
-    pub fn changes(&self, target: Target) -> u64 {
-        self.changes[target as usize].load(Ordering::Acquire)
+    /// How many times `control` has been set.
+    pub fn changes(&self, control: Control) -> u64 {
+        self.changes[control].load(Ordering::Acquire)
     }
 
-    /// The last value of `target`, if it was ever set.
-    pub fn value(&self, target: Target) -> Option<f64> {
-        (self.changes(target) > 0)
-            .then(|| f64::from_bits(self.values[target as usize].load(Ordering::Relaxed)))
+    /// The last value of `control`, if it was ever set.
+    pub fn value(&self, control: Control) -> Option<f64> {
+        (self.changes(control) > 0)
+            .then(|| f64::from_bits(self.values[control].load(Ordering::Relaxed)))
     }
 
     /// How many refills were asked for.
@@ -69,43 +67,60 @@ impl LiveControls {
 }
 
 /// What changed since a [`LiveReader`] last looked.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LiveChanges {
-    /// The new value of tilt, viscosity and fill (in the order of [`Target`]), where one came.
-    pub values: [Option<f64>; 3],
+    /// The new value of each control, where one came.
+    pub values: PerControl<Option<f64>>,
     /// Whether at least one refill was asked for (several in between count as one: the bottle
     /// is full after the first).
     pub refill: bool,
 }
 
+impl Default for LiveChanges {
+    /// Nothing changed.
+    fn default() -> Self {
+        Self {
+            values: PerControl::splat(None),
+            refill: false,
+        }
+    }
+}
+
 impl LiveChanges {
     /// Each new value with its control.
-    pub fn set_values(&self) -> impl Iterator<Item = (Target, f64)> + '_ {
-        TARGETS
-            .into_iter()
-            .zip(self.values)
-            .filter_map(|(target, value)| Some((target, value?)))
+    pub fn set_values(&self) -> impl Iterator<Item = (Control, f64)> + '_ {
+        self.values
+            .iter()
+            .filter_map(|(control, value)| Some((control, value?)))
     }
 }
 
 /// The audio thread's side: remembers what it has already applied.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 pub struct LiveReader {
-    seen: [u64; 3],
+    seen: PerControl<u64>,
     refills_seen: u64,
+}
+
+impl Default for LiveReader {
+    fn default() -> Self {
+        Self {
+            seen: PerControl::splat(0),
+            refills_seen: 0,
+        }
+    }
 }
 
 impl LiveReader {
     /// What changed since the last call; real-time safe (atomic loads only).
     pub fn poll(&mut self, live: &LiveControls) -> LiveChanges {
         let mut changes = LiveChanges::default();
-        for target in TARGETS {
-            let index = target as usize;
-            let count = live.changes(target);
-            if count != self.seen[index] {
-                self.seen[index] = count;
-                changes.values[index] =
-                    Some(f64::from_bits(live.values[index].load(Ordering::Relaxed)));
+        for &control in Control::ALL {
+            let count = live.changes(control);
+            if count != self.seen[control] {
+                self.seen[control] = count;
+                changes.values[control] =
+                    Some(f64::from_bits(live.values[control].load(Ordering::Relaxed)));
             }
         }
         let refills = live.refills();

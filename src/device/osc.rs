@@ -17,6 +17,7 @@ use rosc::{OscMessage, OscPacket, OscType};
 use thiserror::Error;
 
 use super::axis::{tilt_from_gravity, Axis};
+use crate::engine::Control;
 
 /// How deep bundles may nest: a bundle directly in the packet is at depth 1.
 pub const MAX_BUNDLE_DEPTH: usize = 8;
@@ -26,12 +27,6 @@ pub const MAX_BUNDLE_DEPTH: usize = 8;
 /// tens of thousands deep.
 pub const MAX_ARRAY_DEPTH: usize = 8;
 
-/// The tilt, in degrees.
-pub const TILT_ADDRESS: &str = "/sakeglug/tilt";
-/// The viscosity.
-pub const VISCOSITY_ADDRESS: &str = "/sakeglug/viscosity";
-/// The fill, in percent.
-pub const FILL_ADDRESS: &str = "/sakeglug/fill";
 /// Refill the bottle, whatever the arguments.
 pub const REFILL_ADDRESS: &str = "/sakeglug/refill";
 /// Which way a sensor app's vector points when the phone is at rest.
@@ -59,12 +54,9 @@ const BUNDLE_TAG: &[u8; 8] = b"#bundle\0";
 /// A control set over OSC.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum OscControl {
-    /// The tilt in degrees, sent as such or worked out from a gravity vector.
-    Tilt(f64),
-    /// The viscosity.
-    Viscosity(f64),
-    /// The fill in percent.
-    Fill(f64),
+    /// A control set to a value in its own unit: at its own address (the control table's
+    /// `osc_address`), or the tilt worked out from a gravity vector.
+    Set(Control, f64),
     /// Refill the bottle.
     Refill,
 }
@@ -242,10 +234,12 @@ fn check_array_depth(message: &[u8]) -> Result<(), OscError> {
 /// The control a message sets, if its address is known.
 fn control_from(message: &OscMessage, axis: Axis) -> Result<Option<OscControl>, OscError> {
     let address = message.addr.as_str();
+    if let Some((control, _)) =
+        Control::device_inputs().find(|(_, device)| device.osc_address == address)
+    {
+        return Ok(Some(OscControl::Set(control, single_number(message)?)));
+    }
     let control = match (address, gravity_pointing(address)) {
-        (TILT_ADDRESS, _) => OscControl::Tilt(single_number(message)?),
-        (VISCOSITY_ADDRESS, _) => OscControl::Viscosity(single_number(message)?),
-        (FILL_ADDRESS, _) => OscControl::Fill(single_number(message)?),
         (REFILL_ADDRESS, _) => OscControl::Refill,
         (_, Some(pointing)) => {
             let [x, y, z] = message.args.as_slice() else {
@@ -264,7 +258,7 @@ fn control_from(message: &OscMessage, axis: Axis) -> Result<Option<OscControl>, 
             let tilt = tilt_from_gravity(reading, axis).ok_or_else(|| OscError::ZeroVector {
                 address: address.to_owned(),
             })?;
-            OscControl::Tilt(tilt)
+            OscControl::Set(Control::Tilt, tilt)
         }
         _ => return Ok(None),
     };

@@ -14,7 +14,6 @@ use std::time::Duration;
 
 use crate::device::axis::Axis;
 use crate::device::live::LiveControls;
-use crate::device::midi::Target;
 use crate::device::osc::{decode_osc, OscControl};
 
 /// How often the thread looks whether it should stop, while no packet comes.
@@ -140,9 +139,7 @@ fn listen(
         };
         stats.packets.fetch_add(1, Ordering::Relaxed);
         let applied = decode_osc(&buffer[..size], axis, &mut |control| match control {
-            OscControl::Tilt(degrees) => live.set(Target::Tilt, degrees),
-            OscControl::Viscosity(c) => live.set(Target::Viscosity, c),
-            OscControl::Fill(percent) => live.set(Target::Fill, percent),
+            OscControl::Set(control, value) => live.set(control, value),
             OscControl::Refill => live.refill(),
         });
         if let Err(error) = applied {

@@ -1,5 +1,7 @@
-//! The model's constants and the allowed range of every input, shared by the engine's sanitising,
-//! the scene validator and the plugin's parameters so that all three agree.
+//! The model's constants, each declared once in [`declare_constants!`]'s table below with its scene
+//! key, parameter id, range, default and knob, and the ranges of the settings that are no plain
+//! number (sample rate, seed, ceiling). The engine's sanitising, the scene validator, the
+//! plugin's parameters and the presets all read them here, so that all agree.
 
 /// An input's allowed closed range and its default (MODEL.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -13,7 +15,8 @@ pub struct Range {
 }
 
 impl Range {
-    const fn new(min: f64, max: f64, default: f64) -> Self {
+    /// The range `[min, max]` with its `default`.
+    pub const fn new(min: f64, max: f64, default: f64) -> Self {
         Self { min, max, default }
     }
 
@@ -35,40 +38,262 @@ impl Range {
 
 /// Sample rate fs of a render (Hz).
 pub const SAMPLE_RATE_HZ: Range = Range::new(1_000.0, 768_000.0, 48_000.0);
-/// Tilt θ of the bottle (degrees): 0 upright, 90 horizontal, 180 upside down.
-pub const TILT_DEG: Range = Range::new(0.0, 180.0, 0.0);
-/// Viscosity ratio c (dimensionless, 0…1): the share of the f1 component; water 0.33.
-pub const VISCOSITY: Range = Range::new(0.0, 1.0, 0.33);
-/// Fill level φ (percent of capacity C) that the bottle is (re)filled to.
-pub const FILL_PERCENT: Range = Range::new(0.0, 100.0, 100.0);
-/// Pour time T (s): how long a full bottle takes to empty at the reference tilt 135°.
-pub const POUR_TIME_S: Range = Range::new(0.01, 3600.0, 5.0);
-/// Output gain (dB): G = 10^(gain/20).
-pub const GAIN_DB: Range = Range::new(-120.0, 24.0, -6.0);
-/// Bottle capacity C (ml).
-pub const CAPACITY_ML: Range = Range::new(1.0, 100_000.0, 300.0);
-/// Mean volume b of the air pocket one glug lets in (ml).
-pub const POCKET_ML: Range = Range::new(0.001, 1_000.0, 5.0);
-/// Frequency f1 of the first component, the air pocket bouncing in the neck (Hz).
-pub const F1_HZ: Range = Range::new(0.0, 400_000.0, 80.0);
-/// Frequency f2 of the second component, the free pocket's Minnaert ring (Hz).
-pub const F2_HZ: Range = Range::new(0.0, 400_000.0, 300.0);
-/// Amplitude decay rate B1 of the first component (1/s).
-pub const B1_PER_S: Range = Range::new(0.0, 1e9, 45.0);
-/// Amplitude decay rate B2 of the second component (1/s).
-pub const B2_PER_S: Range = Range::new(0.0, 1e9, 40.0);
-/// Below 1 so that a pocket volume b·(1 + j·u) is always positive.
-pub const TIMING_JITTER: Range = Range::new(0.0, 0.95, 0.15);
-/// Relative spread j_f of each unit's f1, f2 (dimensionless): f·(1 + j_f·u), u in [−1, 1].
-pub const FREQ_JITTER: Range = Range::new(0.0, 1.0, 0.05);
-/// Log-normal spread σ of each unit's B1, B2 (dimensionless): B·exp(σ·z), z standard normal.
-pub const DECAY_SIGMA: Range = Range::new(0.0, 3.0, 0.35);
 /// Hard output ceiling (linear amplitude): every output sample stays within ±ceiling.
 pub const CEILING: Range = Range::new(0.001, 1.0, 1.0);
+/// The seed of the random generator of §7 (the plugin's Seed parameter spans it).
+pub const SEED: Range = Range::new(0.0, 999_999.0, 1.0);
 /// How long the output gain and the ceiling take to reach a new value (s), MODEL.md §6: long
 /// enough that a jump does not click (the 80 Hz component turns by a quarter of its period in it),
 /// short enough to follow a fader.
 pub const OUTPUT_RAMP_S: f64 = 0.010;
+
+/// How a quantity is shown on a plugin knob: the part of its range the knob spans, the decimals
+/// shown (the value snaps to steps of 10^−decimals) and the skew. Plain data: the plugin turns it
+/// into a parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Knob {
+    /// Lowest value on the knob; `None`: the range's minimum.
+    pub min: Option<f64>,
+    /// Highest value on the knob; `None`: the range's maximum.
+    pub max: Option<f64>,
+    /// Decimals shown; the value snaps to steps of 10^−decimals.
+    pub decimals: i32,
+    /// `None` for a linear knob, else nice-plug's skew exponent (negative: finer at the bottom).
+    pub skew: Option<f32>,
+}
+
+impl Knob {
+    /// A linear knob over the whole range, with `decimals` decimals.
+    pub const fn full(decimals: i32) -> Self {
+        Self {
+            min: None,
+            max: None,
+            decimals,
+            skew: None,
+        }
+    }
+
+    /// A knob narrower than the engine's range, where the full range is absurd on a knob.
+    pub const fn within(self, min: f64, max: f64) -> Self {
+        Self {
+            min: Some(min),
+            max: Some(max),
+            ..self
+        }
+    }
+
+    /// The same knob with a skew.
+    pub const fn skewed(self, factor: f32) -> Self {
+        Self {
+            skew: Some(factor),
+            ..self
+        }
+    }
+}
+
+/// A number the model takes, as every part of the product names and bounds it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Quantity {
+    /// The name a host and the editor show.
+    pub name: &'static str,
+    /// The unit shown after the value (with its leading space, if any).
+    pub unit: &'static str,
+    /// Its key in a scene file (`section.key` inside a table).
+    pub scene_key: &'static str,
+    /// The plugin parameter's stable id (saved states and automation depend on it).
+    pub param_id: &'static str,
+    /// The allowed range and the default.
+    pub range: Range,
+    /// How the plugin shows it.
+    pub knob: Knob,
+}
+
+impl Quantity {
+    /// The knob's lowest and highest value.
+    pub fn knob_bounds(&self) -> (f64, f64) {
+        (
+            self.knob.min.unwrap_or(self.range.min),
+            self.knob.max.unwrap_or(self.range.max),
+        )
+    }
+}
+
+/// One model constant: what it is, and where it lives in a [`ModelConfig`].
+#[derive(Debug, Clone, Copy)]
+pub struct ConstantSpec {
+    /// Name, scene key, parameter id, range, default and knob.
+    pub quantity: Quantity,
+    /// Its value in a configuration.
+    pub get: fn(&ModelConfig) -> f64,
+    /// Sets it in a configuration.
+    pub set: fn(&mut ModelConfig, f64),
+}
+
+macro_rules! declare_constants {
+    ($( $(#[$doc:meta])* $variant:ident => $spec:expr; )*) => {
+        /// A constant of the model that a scene, a preset or the plugin sets (MODEL.md §2–§7).
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Constant {
+            $( $(#[$doc])* $variant, )*
+        }
+
+        impl Constant {
+            /// Every constant, in table order (the order of the plugin's Model group).
+            pub const ALL: &'static [Constant] = &[$( Constant::$variant ),*];
+
+            /// Everything declared about this constant.
+            pub const fn spec(self) -> &'static ConstantSpec {
+                static SPECS: &[ConstantSpec] = &[$( $spec ),*];
+                &SPECS[self as usize]
+            }
+        }
+    };
+}
+
+declare_constants! {
+    /// Frequency f1 of the first component, the air pocket bouncing in the neck (Hz).
+    F1 => ConstantSpec {
+        quantity: Quantity {
+            name: "f1",
+            unit: " Hz",
+            scene_key: "glug.f1_hz",
+            param_id: "f1",
+            range: Range::new(0.0, 400_000.0, 80.0),
+            // Narrower than the engine's range (which only guards against nonsense) but wide
+            // enough to reach past Nyquist at 44.1 kHz.
+            knob: Knob::full(1).within(10.0, 24_000.0).skewed(-2.0),
+        },
+        get: |config| config.frequency_hz[0],
+        set: |config, value| config.frequency_hz[0] = value,
+    };
+    /// Frequency f2 of the second component, the free pocket's Minnaert ring (Hz).
+    F2 => ConstantSpec {
+        quantity: Quantity {
+            name: "f2",
+            unit: " Hz",
+            scene_key: "glug.f2_hz",
+            param_id: "f2",
+            range: Range::new(0.0, 400_000.0, 300.0),
+            knob: Knob::full(1).within(10.0, 24_000.0).skewed(-2.0),
+        },
+        get: |config| config.frequency_hz[1],
+        set: |config, value| config.frequency_hz[1] = value,
+    };
+    /// Amplitude decay rate B1 of the first component (1/s).
+    B1 => ConstantSpec {
+        quantity: Quantity {
+            name: "B1",
+            unit: " /s",
+            scene_key: "glug.b1_per_s",
+            param_id: "b1",
+            range: Range::new(0.0, 1e9, 45.0),
+            knob: Knob::full(1).within(1.0, 1_000.0).skewed(-1.5),
+        },
+        get: |config| config.decay_per_s[0],
+        set: |config, value| config.decay_per_s[0] = value,
+    };
+    /// Amplitude decay rate B2 of the second component (1/s).
+    B2 => ConstantSpec {
+        quantity: Quantity {
+            name: "B2",
+            unit: " /s",
+            scene_key: "glug.b2_per_s",
+            param_id: "b2",
+            range: Range::new(0.0, 1e9, 40.0),
+            knob: Knob::full(1).within(1.0, 1_000.0).skewed(-1.5),
+        },
+        get: |config| config.decay_per_s[1],
+        set: |config, value| config.decay_per_s[1] = value,
+    };
+    /// Mean volume b of the air pocket one glug lets in (ml).
+    Pocket => ConstantSpec {
+        quantity: Quantity {
+            name: "Pocket volume",
+            unit: " ml",
+            scene_key: "bottle.pocket_ml",
+            param_id: "pocket",
+            range: Range::new(0.001, 1_000.0, 5.0),
+            knob: Knob::full(2).within(0.1, 100.0).skewed(-1.5),
+        },
+        get: |config| config.pocket_ml,
+        set: |config, value| config.pocket_ml = value,
+    };
+    /// Bottle capacity C (ml).
+    Capacity => ConstantSpec {
+        quantity: Quantity {
+            name: "Capacity",
+            unit: " ml",
+            scene_key: "bottle.capacity_ml",
+            param_id: "cap",
+            range: Range::new(1.0, 100_000.0, 300.0),
+            knob: Knob::full(0).within(10.0, 5_000.0).skewed(-1.5),
+        },
+        get: |config| config.capacity_ml,
+        set: |config, value| config.capacity_ml = value,
+    };
+    /// Relative spread j_t of each unit's pocket volume: below 1 so that a pocket volume
+    /// b·(1 + j·u) is always positive.
+    TimingJitter => ConstantSpec {
+        quantity: Quantity {
+            name: "Timing spread",
+            unit: "",
+            scene_key: "glug.timing_jitter",
+            param_id: "tjit",
+            range: Range::new(0.0, 0.95, 0.15),
+            knob: Knob::full(3),
+        },
+        get: |config| config.timing_jitter,
+        set: |config, value| config.timing_jitter = value,
+    };
+    /// Relative spread j_f of each unit's f1, f2 (dimensionless): f·(1 + j_f·u), u in [−1, 1].
+    FreqJitter => ConstantSpec {
+        quantity: Quantity {
+            name: "Frequency spread",
+            unit: "",
+            scene_key: "glug.freq_jitter",
+            param_id: "fjit",
+            range: Range::new(0.0, 1.0, 0.05),
+            knob: Knob::full(3),
+        },
+        get: |config| config.freq_jitter,
+        set: |config, value| config.freq_jitter = value,
+    };
+    /// Log-normal spread σ of each unit's B1, B2 (dimensionless): B·exp(σ·z), z standard normal.
+    DecaySigma => ConstantSpec {
+        quantity: Quantity {
+            name: "Decay spread",
+            unit: "",
+            scene_key: "glug.decay_sigma",
+            param_id: "dsig",
+            range: Range::new(0.0, 3.0, 0.35),
+            knob: Knob::full(3),
+        },
+        get: |config| config.decay_sigma,
+        set: |config, value| config.decay_sigma = value,
+    };
+}
+
+impl Constant {
+    /// The constant's name, scene key, parameter id, range and knob.
+    pub const fn quantity(self) -> &'static Quantity {
+        &self.spec().quantity
+    }
+
+    /// The constant's allowed range and default.
+    pub const fn range(self) -> Range {
+        self.spec().quantity.range
+    }
+
+    /// Its value in `config`.
+    pub fn get(self, config: &ModelConfig) -> f64 {
+        (self.spec().get)(config)
+    }
+
+    /// Sets it to `value` in `config`.
+    pub fn set(self, config: &mut ModelConfig, value: f64) {
+        (self.spec().set)(config, value)
+    }
+}
 
 /// How the residual volume evolves (MODEL.md §8). Scenes name it in lower case (`"simulate"`,
 /// `"follow"`); the plugin's Drain mode parameter is this same type.
@@ -109,18 +334,22 @@ pub struct ModelConfig {
 
 impl Default for ModelConfig {
     fn default() -> Self {
-        Self {
-            capacity_ml: CAPACITY_ML.default,
-            pocket_ml: POCKET_ML.default,
-            frequency_hz: [F1_HZ.default, F2_HZ.default],
-            decay_per_s: [B1_PER_S.default, B2_PER_S.default],
-            timing_jitter: TIMING_JITTER.default,
-            freq_jitter: FREQ_JITTER.default,
-            decay_sigma: DECAY_SIGMA.default,
-            seed: 1,
+        let mut config = Self {
+            capacity_ml: 0.0,
+            pocket_ml: 0.0,
+            frequency_hz: [0.0; 2],
+            decay_per_s: [0.0; 2],
+            timing_jitter: 0.0,
+            freq_jitter: 0.0,
+            decay_sigma: 0.0,
+            seed: SEED.default as u64,
             drain: DrainMode::Simulate,
             ceiling: CEILING.default,
+        };
+        for &constant in Constant::ALL {
+            constant.set(&mut config, constant.range().default);
         }
+        config
     }
 }
 
@@ -136,61 +365,13 @@ impl ModelConfig {
     }
 
     /// Every field brought into its range, so that no input can make the engine misbehave.
-    pub fn sanitized(self) -> Self {
-        Self {
-            capacity_ml: CAPACITY_ML.sanitize(self.capacity_ml),
-            pocket_ml: POCKET_ML.sanitize(self.pocket_ml),
-            frequency_hz: [
-                F1_HZ.sanitize(self.frequency_hz[0]),
-                F2_HZ.sanitize(self.frequency_hz[1]),
-            ],
-            decay_per_s: [
-                B1_PER_S.sanitize(self.decay_per_s[0]),
-                B2_PER_S.sanitize(self.decay_per_s[1]),
-            ],
-            timing_jitter: TIMING_JITTER.sanitize(self.timing_jitter),
-            freq_jitter: FREQ_JITTER.sanitize(self.freq_jitter),
-            decay_sigma: DECAY_SIGMA.sanitize(self.decay_sigma),
-            ceiling: CEILING.sanitize(self.ceiling),
-            ..self
+    pub fn sanitized(mut self) -> Self {
+        for &constant in Constant::ALL {
+            let value = constant.range().sanitize(constant.get(&self));
+            constant.set(&mut self, value);
         }
-    }
-}
-
-/// The per-sample inputs of the model (MODEL.md §1), as one sample sees them.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ControlValues {
-    /// Tilt θ (degrees).
-    pub tilt_deg: f64,
-    /// Viscosity ratio c (0…1).
-    pub viscosity: f64,
-    /// Fill level φ (percent of capacity).
-    pub fill_percent: f64,
-    /// Pour time T of a full bottle at 135° (s).
-    pub pour_time_s: f64,
-}
-
-impl Default for ControlValues {
-    fn default() -> Self {
-        Self {
-            tilt_deg: TILT_DEG.default,
-            viscosity: VISCOSITY.default,
-            fill_percent: FILL_PERCENT.default,
-            pour_time_s: POUR_TIME_S.default,
-        }
-    }
-}
-
-impl ControlValues {
-    /// Every value brought into its range (see [`Range::sanitize`]).
-    #[inline]
-    pub fn sanitized(self) -> Self {
-        Self {
-            tilt_deg: TILT_DEG.sanitize(self.tilt_deg),
-            viscosity: VISCOSITY.sanitize(self.viscosity),
-            fill_percent: FILL_PERCENT.sanitize(self.fill_percent),
-            pour_time_s: POUR_TIME_S.sanitize(self.pour_time_s),
-        }
+        self.ceiling = CEILING.sanitize(self.ceiling);
+        self
     }
 }
 
@@ -200,11 +381,12 @@ mod tests {
 
     #[test]
     fn sanitize_maps_nan_to_default_and_infinities_to_bounds() {
-        assert_eq!(TILT_DEG.sanitize(f64::NAN), 0.0);
-        assert_eq!(TILT_DEG.sanitize(f64::INFINITY), 180.0);
-        assert_eq!(POUR_TIME_S.sanitize(f64::NEG_INFINITY), 0.01);
-        assert_eq!(VISCOSITY.sanitize(-3.0), 0.0);
-        assert_eq!(VISCOSITY.sanitize(0.5), 0.5);
+        let tilt = Range::new(0.0, 180.0, 0.0);
+        assert_eq!(tilt.sanitize(f64::NAN), 0.0);
+        assert_eq!(tilt.sanitize(f64::INFINITY), 180.0);
+        assert_eq!(tilt.sanitize(f64::NEG_INFINITY), 0.0);
+        assert_eq!(tilt.sanitize(-3.0), 0.0);
+        assert_eq!(tilt.sanitize(90.5), 90.5);
     }
 
     #[test]

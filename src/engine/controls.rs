@@ -1,16 +1,262 @@
-//! The per-sample inputs of a block: each a constant or one value per sample.
+//! The model's automatable inputs, each declared once in [`declare_controls!`]'s table below: its
+//! scene key, plugin parameter id, display name and unit, range and default, knob, and the
+//! device (MIDI CC, OSC address) that may drive it. Every per-control array in the code is a
+//! [`PerControl`], indexable by [`Control`], and scene parsing, automation lanes, the plugin's
+//! parameters, MIDI and OSC targets, live overrides, presets and the reports read this table.
 
-use super::config::{ControlValues, GAIN_DB};
+use std::ops::{Index, IndexMut};
+
+use super::config::{Knob, Quantity, Range};
+
+/// How a tilt device reaches a control: the MIDI setting that names its CC, and its OSC address.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DeviceInput {
+    /// The saved MIDI setting (plugin state and a scene's `[midi]` table) holding its CC number.
+    pub midi_setting: &'static str,
+    /// The CC number it listens to by default (a general-purpose controller).
+    pub default_cc: u8,
+    /// Its OSC address.
+    pub osc_address: &'static str,
+}
+
+/// One automatable input, as every part of the product knows it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControlSpec {
+    /// Name, scene key, parameter id, range, default and knob.
+    pub quantity: Quantity,
+    /// Whether it drives the pour (the output gain drives only the output stage, §6).
+    pub drives_pour: bool,
+    /// A tilt device's way in, where it has one.
+    pub device: Option<DeviceInput>,
+}
+
+macro_rules! declare_controls {
+    ($( $(#[$doc:meta])* $variant:ident, $field:ident => $spec:expr; )*) => {
+        /// One automatable input of the model (MODEL.md §1, §6).
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Control {
+            $( $(#[$doc])* $variant, )*
+        }
+
+        impl Control {
+            /// Every control, in table order (the order of the plugin's main group).
+            pub const ALL: &'static [Control] = &[$( Control::$variant ),*];
+
+            /// Everything declared about this control.
+            pub const fn spec(self) -> &'static ControlSpec {
+                static SPECS: &[ControlSpec] = &[$( $spec ),*];
+                &SPECS[self as usize]
+            }
+        }
+
+        /// One `T` per [`Control`], by name or indexed by the control.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        pub struct PerControl<T> {
+            $( $(#[$doc])* pub $field: T, )*
+        }
+
+        impl<T> PerControl<T> {
+            /// Each control's value from `value_of`.
+            #[inline]
+            pub fn from_fn(mut value_of: impl FnMut(Control) -> T) -> Self {
+                Self { $( $field: value_of(Control::$variant), )* }
+            }
+
+            /// Each control's value, taken by value through `map`.
+            #[inline]
+            pub fn into_map<U>(self, mut map: impl FnMut(Control, T) -> U) -> PerControl<U> {
+                PerControl { $( $field: map(Control::$variant, self.$field), )* }
+            }
+
+            /// A mutable reference to each control's value.
+            #[inline]
+            pub fn each_mut(&mut self) -> PerControl<&mut T> {
+                PerControl { $( $field: &mut self.$field, )* }
+            }
+        }
+
+        impl<T> Index<Control> for PerControl<T> {
+            type Output = T;
+            #[inline]
+            fn index(&self, control: Control) -> &T {
+                match control {
+                    $( Control::$variant => &self.$field, )*
+                }
+            }
+        }
+
+        impl<T> IndexMut<Control> for PerControl<T> {
+            #[inline]
+            fn index_mut(&mut self, control: Control) -> &mut T {
+                match control {
+                    $( Control::$variant => &mut self.$field, )*
+                }
+            }
+        }
+    };
+}
+
+declare_controls! {
+    /// Tilt θ (degrees): 0 upright, 90 horizontal, 180 upside down.
+    Tilt, tilt_deg => ControlSpec {
+        quantity: Quantity {
+            name: "Tilt",
+            unit: "°",
+            scene_key: "tilt_deg",
+            param_id: "tilt",
+            range: Range::new(0.0, 180.0, 0.0),
+            knob: Knob::full(2),
+        },
+        drives_pour: true,
+        device: Some(DeviceInput {
+            midi_setting: "midi_cc_tilt",
+            default_cc: 16,
+            osc_address: "/sakeglug/tilt",
+        }),
+    };
+    /// Viscosity ratio c (0…1): the share of the f1 component; water 0.33.
+    Viscosity, viscosity => ControlSpec {
+        quantity: Quantity {
+            name: "Viscosity",
+            unit: "",
+            scene_key: "viscosity_c",
+            param_id: "visc",
+            range: Range::new(0.0, 1.0, 0.33),
+            knob: Knob::full(3),
+        },
+        drives_pour: true,
+        device: Some(DeviceInput {
+            midi_setting: "midi_cc_viscosity",
+            default_cc: 17,
+            osc_address: "/sakeglug/viscosity",
+        }),
+    };
+    /// Fill level φ (percent of capacity C) that the bottle is (re)filled to.
+    Fill, fill_percent => ControlSpec {
+        quantity: Quantity {
+            name: "Fill level",
+            unit: " %",
+            scene_key: "fill_percent",
+            param_id: "fill",
+            range: Range::new(0.0, 100.0, 100.0),
+            knob: Knob::full(1),
+        },
+        drives_pour: true,
+        device: Some(DeviceInput {
+            midi_setting: "midi_cc_fill",
+            default_cc: 18,
+            osc_address: "/sakeglug/fill",
+        }),
+    };
+    /// Pour time T (s): how long a full bottle takes to empty at the reference tilt 135°.
+    PourTime, pour_time_s => ControlSpec {
+        quantity: Quantity {
+            name: "Pour time",
+            unit: " s",
+            scene_key: "pour_time_s",
+            param_id: "pour",
+            range: Range::new(0.01, 3600.0, 5.0),
+            // Below 0.1 s or above 2 minutes is no pour.
+            knob: Knob::full(2).within(0.1, 120.0).skewed(-1.5),
+        },
+        drives_pour: true,
+        device: None,
+    };
+    /// Output gain (dB): G = 10^(gain/20).
+    Gain, gain_db => ControlSpec {
+        quantity: Quantity {
+            name: "Output gain",
+            unit: " dB",
+            scene_key: "output.gain_db",
+            param_id: "gain",
+            range: Range::new(-120.0, 24.0, -6.0),
+            // The engine's whole range would make the knob coarse.
+            knob: Knob::full(2).within(-60.0, 12.0),
+        },
+        drives_pour: false,
+        device: None,
+    };
+}
+
+impl Control {
+    /// The control's name, scene key, parameter id, range and knob.
+    pub const fn quantity(self) -> &'static Quantity {
+        &self.spec().quantity
+    }
+
+    /// The control's allowed range and default.
+    pub const fn range(self) -> Range {
+        self.spec().quantity.range
+    }
+
+    /// The controls that drive the pour (all but the output gain).
+    pub fn pour() -> impl Iterator<Item = Control> {
+        Control::ALL
+            .iter()
+            .copied()
+            .filter(|control| control.spec().drives_pour)
+    }
+
+    /// The controls a tilt device can set, with how it reaches them.
+    pub fn device_inputs() -> impl Iterator<Item = (Control, &'static DeviceInput)> {
+        Control::ALL
+            .iter()
+            .filter_map(|&control| Some((control, control.spec().device.as_ref()?)))
+    }
+}
+
+impl<T: Copy> PerControl<T> {
+    /// The same value for every control.
+    pub fn splat(value: T) -> Self {
+        Self::from_fn(|_| value)
+    }
+
+    /// Each value through `map`.
+    #[inline]
+    pub fn map<U>(&self, mut map: impl FnMut(Control, T) -> U) -> PerControl<U> {
+        PerControl::from_fn(|control| map(control, self[control]))
+    }
+
+    /// Each control with its value, in table order.
+    pub fn iter(&self) -> impl Iterator<Item = (Control, T)> + '_ {
+        Control::ALL.iter().map(|&control| (control, self[control]))
+    }
+}
+
+/// The inputs of the model as one sample sees them (MODEL.md §1, §6).
+pub type ControlValues = PerControl<f64>;
+
+impl Default for ControlValues {
+    /// Every control at its default.
+    fn default() -> Self {
+        Self::from_fn(|control| control.range().default)
+    }
+}
+
+impl ControlValues {
+    /// Every value brought into its range (see [`Range::sanitize`]).
+    #[inline]
+    pub fn sanitized(self) -> Self {
+        self.map(|control, value| control.range().sanitize(value))
+    }
+
+    /// Whether the controls that drive the pour are equal to those of `other` (the output gain
+    /// aside).
+    #[inline]
+    pub fn same_pour_as(&self, other: &Self) -> bool {
+        Control::pour().all(|control| self[control] == other[control])
+    }
+}
 
 /// The model's inputs as a function of the sample index: how the reference and the timed
 /// renders read a scene, sample by sample.
 pub trait ControlSource {
-    /// The inputs and the output gain in dB at `sample`.
-    fn at(&self, sample: u64) -> (ControlValues, f64);
+    /// The inputs (the output gain in dB among them) at `sample`.
+    fn at(&self, sample: u64) -> ControlValues;
 }
 
-impl<F: Fn(u64) -> (ControlValues, f64)> ControlSource for F {
-    fn at(&self, sample: u64) -> (ControlValues, f64) {
+impl<F: Fn(u64) -> ControlValues> ControlSource for F {
+    fn at(&self, sample: u64) -> ControlValues {
         self(sample)
     }
 }
@@ -58,80 +304,68 @@ impl Lane<'_> {
     }
 }
 
-/// The automatable inputs of the model for one block (MODEL.md §1, §5).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Controls<'a> {
-    /// Tilt θ (degrees).
-    pub tilt_deg: Lane<'a>,
-    /// Viscosity ratio c.
-    pub viscosity: Lane<'a>,
-    /// Fill level φ (percent of capacity).
-    pub fill_percent: Lane<'a>,
-    /// Pour time T (s).
-    pub pour_time_s: Lane<'a>,
-    /// Output gain (dB).
-    pub gain_db: Lane<'a>,
-}
+/// The automatable inputs of the model for one block (MODEL.md §1, §5, §6).
+pub type Controls<'a> = PerControl<Lane<'a>>;
 
 impl Default for Controls<'_> {
     fn default() -> Self {
-        Self::constant(ControlValues::default(), GAIN_DB.default)
+        Self::constant(ControlValues::default())
     }
 }
 
 impl<'a> Controls<'a> {
-    /// Controls held at `values` and `gain_db` for the whole block.
-    pub fn constant(values: ControlValues, gain_db: f64) -> Self {
-        Self {
-            tilt_deg: Lane::Constant(values.tilt_deg),
-            viscosity: Lane::Constant(values.viscosity),
-            fill_percent: Lane::Constant(values.fill_percent),
-            pour_time_s: Lane::Constant(values.pour_time_s),
-            gain_db: Lane::Constant(gain_db),
-        }
+    /// Controls held at `values` for the whole block.
+    pub fn constant(values: ControlValues) -> Self {
+        values.map(|_, value| Lane::Constant(value))
     }
 
     /// The values the model sees at sample `index` of the block.
     #[inline]
     pub fn values_at(&self, index: usize) -> ControlValues {
-        ControlValues {
-            tilt_deg: self.tilt_deg.at(index),
-            viscosity: self.viscosity.at(index),
-            fill_percent: self.fill_percent.at(index),
-            pour_time_s: self.pour_time_s.at(index),
-        }
+        self.map(|_, lane| lane.at(index))
     }
 
     /// Whether the pour inputs are constant over the block (the output gain aside).
     pub fn pour_is_constant(&self) -> bool {
-        self.tilt_deg.is_constant()
-            && self.viscosity.is_constant()
-            && self.fill_percent.is_constant()
-            && self.pour_time_s.is_constant()
+        Control::pour().all(|control| self[control].is_constant())
     }
 
     /// Whether the pour inputs hold the very same values over the first `len` samples, as
     /// constants or as samples that do not change (the output gain aside).
     pub fn pour_is_constant_over(&self, len: usize) -> bool {
-        self.tilt_deg.is_constant_over(len)
-            && self.viscosity.is_constant_over(len)
-            && self.fill_percent.is_constant_over(len)
-            && self.pour_time_s.is_constant_over(len)
+        Control::pour().all(|control| self[control].is_constant_over(len))
     }
 
     /// A block of the same controls starting `offset` samples later.
     pub fn offset(&self, offset: usize) -> Self {
-        let shift = |lane: Lane<'a>| match lane {
+        self.map(|_, lane| match lane {
             Lane::Samples(values) if offset < values.len() => Lane::Samples(&values[offset..]),
             Lane::Samples(values) => Lane::Constant(values.last().copied().unwrap_or(f64::NAN)),
             constant => constant,
-        };
-        Self {
-            tilt_deg: shift(self.tilt_deg),
-            viscosity: shift(self.viscosity),
-            fill_percent: shift(self.fill_percent),
-            pour_time_s: shift(self.pour_time_s),
-            gain_db: shift(self.gain_db),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_control_is_indexed_by_its_own_field() {
+        let values = ControlValues::from_fn(|control| control as usize as f64);
+        for (index, &control) in Control::ALL.iter().enumerate() {
+            assert_eq!(values[control], index as f64);
+        }
+        assert_eq!(values.viscosity, Control::Viscosity as usize as f64);
+    }
+
+    #[test]
+    fn keys_and_ids_are_unique() {
+        for (index, a) in Control::ALL.iter().enumerate() {
+            for b in &Control::ALL[index + 1..] {
+                assert_ne!(a.quantity().scene_key, b.quantity().scene_key);
+                assert_ne!(a.quantity().param_id, b.quantity().param_id);
+            }
         }
     }
 }

@@ -14,11 +14,13 @@ mod presets;
 pub mod synthesis;
 
 pub use amplitude::unit_amplitude;
-pub use config::{ControlValues, DrainMode, ModelConfig, Range};
-pub use controls::{ControlSource, Controls, Lane};
+pub use config::{Constant, ConstantSpec, DrainMode, Knob, ModelConfig, Quantity, Range};
+pub use controls::{
+    Control, ControlSource, ControlSpec, ControlValues, Controls, DeviceInput, Lane, PerControl,
+};
 use output::OutputStage;
 pub use pour::{Pour, PourStats, UnitOnset};
-pub use presets::{Preset, PRESETS};
+pub use presets::{Preset, PresetValue, PRESETS};
 pub use synthesis::{RecursiveF32, RecursiveF64, Synthesis, VoiceBank, GRID};
 
 /// Renders the model into caller-provided buffers; allocation-free after construction.
@@ -298,7 +300,10 @@ impl<S: Synthesis> Engine<S> {
     /// Whether the pour rests under `controls`, the same constant ones as its last step: then
     /// stepping it would change nothing.
     fn rests_under(&self, controls: &Controls) -> bool {
-        controls.pour_is_constant() && self.resting_under == Some(controls.values_at(0))
+        controls.pour_is_constant()
+            && self
+                .resting_under
+                .is_some_and(|resting| resting.same_pour_as(&controls.values_at(0)))
     }
 
     fn advance_position(&mut self, len: usize) {

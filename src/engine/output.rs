@@ -4,8 +4,8 @@
 //! the same automation gives the same samples however time is cut into blocks.
 
 use super::amplitude::db_to_gain;
-use super::config::{GAIN_DB, OUTPUT_RAMP_S};
-use super::controls::Lane;
+use super::config::OUTPUT_RAMP_S;
+use super::controls::{Control, Lane};
 
 /// A value that goes to each new target in a straight line of `len` samples.
 ///
@@ -72,7 +72,7 @@ impl Ramp {
 
 /// G of MODEL.md §6 for an output gain in dB, brought into range first (§11).
 fn linear(gain_db: f64) -> f64 {
-    db_to_gain(GAIN_DB.sanitize(gain_db))
+    db_to_gain(Control::Gain.range().sanitize(gain_db))
 }
 
 /// Counts kept by the output stage, since the last reset.
@@ -102,7 +102,8 @@ pub(super) struct OutputStage {
 impl OutputStage {
     pub fn new(sample_rate: f64) -> Self {
         let ramp_len = ((sample_rate * OUTPUT_RAMP_S).round() as u32).max(1);
-        let gain_db = (GAIN_DB.default, linear(GAIN_DB.default));
+        let default_db = Control::Gain.range().default;
+        let gain_db = (default_db, linear(default_db));
         Self {
             ramp_len,
             gain_db,

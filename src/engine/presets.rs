@@ -7,9 +7,19 @@
 //! bottles keep the model's shape and scale it: a smaller bottle glugs higher, faster and with
 //! smaller pockets; those values are chosen by ear, not measured.
 
-use super::config::{ControlValues, ModelConfig};
+use super::config::{Constant, ModelConfig};
+use super::controls::{Control, ControlValues};
 
-/// A named set of constants and inputs.
+/// One value a preset sets: a control or a model constant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PresetValue {
+    /// A control's value (held for the whole pour).
+    Control(Control, f64),
+    /// A model constant's value.
+    Constant(Constant, f64),
+}
+
+/// A named set of values; everything it does not name keeps its default.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Preset {
     /// The name shown in menus.
@@ -18,89 +28,114 @@ pub struct Preset {
     pub id: &'static str,
     /// What it is for.
     pub description: &'static str,
-    /// Viscosity ratio c.
-    pub viscosity: f64,
-    /// Bottle capacity C (ml).
-    pub capacity_ml: f64,
-    /// Air pocket per glug b (ml).
-    pub pocket_ml: f64,
-    /// Time to empty a full bottle at 135° (s).
-    pub pour_time_s: f64,
-    /// f1 and f2 (Hz).
-    pub frequency_hz: [f64; 2],
-    /// B1 and B2 (1/s).
-    pub decay_per_s: [f64; 2],
+    /// What it sets, each value once.
+    pub values: &'static [PresetValue],
 }
 
-/// The 300 ml bottle of the paper with its measured glug.
-const PAPER_BOTTLE: Preset = Preset {
-    name: "Water",
-    id: "water",
-    description: "c = 0.33 in the paper's 300 ml bottle",
-    viscosity: 0.33,
-    capacity_ml: 300.0,
-    pocket_ml: 5.0,
-    pour_time_s: 5.0,
-    frequency_hz: [80.0, 300.0],
-    decay_per_s: [45.0, 40.0],
-};
+use PresetValue::{Constant as K, Control as C};
+
+/// The 300 ml bottle of the paper with its measured glug: every preset sets these, so that
+/// picking one after another leaves nothing of the first.
+const PAPER_BOTTLE: [PresetValue; 8] = [
+    C(Control::Viscosity, 0.33),
+    C(Control::PourTime, 5.0),
+    K(Constant::Capacity, 300.0),
+    K(Constant::Pocket, 5.0),
+    K(Constant::F1, 80.0),
+    K(Constant::F2, 300.0),
+    K(Constant::B1, 45.0),
+    K(Constant::B2, 40.0),
+];
+
+/// The paper's bottle with `changes` made to it.
+const fn paper_bottle_with<const N: usize>(changes: [PresetValue; N]) -> [PresetValue; 8] {
+    let mut values = PAPER_BOTTLE;
+    let mut change = 0;
+    while change < N {
+        let mut slot = 0;
+        while slot < values.len() {
+            if same_target(values[slot], changes[change]) {
+                values[slot] = changes[change];
+            }
+            slot += 1;
+        }
+        change += 1;
+    }
+    values
+}
+
+const fn same_target(a: PresetValue, b: PresetValue) -> bool {
+    match (a, b) {
+        (C(a, _), C(b, _)) => a as usize == b as usize,
+        (K(a, _), K(b, _)) => a as usize == b as usize,
+        _ => false,
+    }
+}
 
 /// Every preset, in menu order.
 pub const PRESETS: [Preset; 7] = [
-    PAPER_BOTTLE,
+    Preset {
+        name: "Water",
+        id: "water",
+        description: "c = 0.33 in the paper's 300 ml bottle",
+        values: &PAPER_BOTTLE,
+    },
     Preset {
         name: "Thin (c 0.29)",
         id: "thin",
         description: "a liquid felt as thinner than water: the paper's 25 % threshold, c = 0.29",
-        viscosity: 0.29,
-        ..PAPER_BOTTLE
+        values: &paper_bottle_with([C(Control::Viscosity, 0.29)]),
     },
     Preset {
         name: "Sake",
         id: "sake",
         description: "a little more viscous than water (c = 0.36), poured a little slower",
-        viscosity: 0.36,
-        pour_time_s: 5.5,
-        ..PAPER_BOTTLE
+        values: &paper_bottle_with([C(Control::Viscosity, 0.36), C(Control::PourTime, 5.5)]),
     },
     Preset {
         name: "Thick (c 0.42)",
         id: "thick",
         description: "a liquid felt as thicker than water: the paper's 75 % threshold, c = 0.42",
-        viscosity: 0.42,
-        pour_time_s: 7.0,
-        ..PAPER_BOTTLE
+        values: &paper_bottle_with([C(Control::Viscosity, 0.42), C(Control::PourTime, 7.0)]),
     },
     Preset {
         name: "Syrup (c 0.6)",
         id: "syrup",
         description: "well past the 75 % threshold (c = 0.6): slow, low, heavy glugs",
-        viscosity: 0.6,
-        pour_time_s: 12.0,
-        decay_per_s: [38.0, 34.0],
-        ..PAPER_BOTTLE
+        values: &paper_bottle_with([
+            C(Control::Viscosity, 0.6),
+            C(Control::PourTime, 12.0),
+            K(Constant::B1, 38.0),
+            K(Constant::B2, 34.0),
+        ]),
     },
     Preset {
         name: "Small bottle",
         id: "small-bottle",
         description: "a one-gō (180 ml) tokkuri of water: higher, quicker, smaller glugs",
-        capacity_ml: 180.0,
-        pocket_ml: 3.0,
-        pour_time_s: 3.5,
-        frequency_hz: [100.0, 380.0],
-        decay_per_s: [55.0, 50.0],
-        ..PAPER_BOTTLE
+        values: &paper_bottle_with([
+            K(Constant::Capacity, 180.0),
+            K(Constant::Pocket, 3.0),
+            C(Control::PourTime, 3.5),
+            K(Constant::F1, 100.0),
+            K(Constant::F2, 380.0),
+            K(Constant::B1, 55.0),
+            K(Constant::B2, 50.0),
+        ]),
     },
     Preset {
         name: "Large bottle",
         id: "large-bottle",
         description: "a four-gō (720 ml) bottle of water: lower, slower, bigger glugs",
-        capacity_ml: 720.0,
-        pocket_ml: 9.0,
-        pour_time_s: 10.0,
-        frequency_hz: [62.0, 230.0],
-        decay_per_s: [36.0, 32.0],
-        ..PAPER_BOTTLE
+        values: &paper_bottle_with([
+            K(Constant::Capacity, 720.0),
+            K(Constant::Pocket, 9.0),
+            C(Control::PourTime, 10.0),
+            K(Constant::F1, 62.0),
+            K(Constant::F2, 230.0),
+            K(Constant::B1, 36.0),
+            K(Constant::B2, 32.0),
+        ]),
     },
 ];
 
@@ -110,23 +145,29 @@ impl Preset {
         PRESETS.iter().find(|preset| preset.id == id)
     }
 
-    /// The model's constants: the preset's, the rest (seed, spreads, drain) as `base` has them.
-    pub fn config(&self, base: ModelConfig) -> ModelConfig {
-        ModelConfig {
-            capacity_ml: self.capacity_ml,
-            pocket_ml: self.pocket_ml,
-            frequency_hz: self.frequency_hz,
-            decay_per_s: self.decay_per_s,
-            ..base
-        }
+    /// Every preset's identifier, for help texts and messages.
+    pub fn ids() -> String {
+        let ids: Vec<&str> = PRESETS.iter().map(|preset| preset.id).collect();
+        ids.join(", ")
     }
 
-    /// The inputs it sets (the tilt and fill level stay as `base` has them).
-    pub fn controls(&self, base: ControlValues) -> ControlValues {
-        ControlValues {
-            viscosity: self.viscosity,
-            pour_time_s: self.pour_time_s,
-            ..base
+    /// The model's constants: the preset's, the rest (seed, spreads, drain) as `base` has them.
+    pub fn config(&self, mut base: ModelConfig) -> ModelConfig {
+        for value in self.values {
+            if let K(constant, value) = *value {
+                constant.set(&mut base, value);
+            }
         }
+        base
+    }
+
+    /// The inputs it sets; the others stay as `base` has them.
+    pub fn controls(&self, mut base: ControlValues) -> ControlValues {
+        for value in self.values {
+            if let C(control, value) = *value {
+                base[control] = value;
+            }
+        }
+        base
     }
 }

@@ -261,7 +261,7 @@ pub fn render_to_files(
             .collect();
         let tilt_deg: Vec<(f64, f64)> = volume_ml
             .iter()
-            .map(|&(t, _)| (t, scene.tilt_deg.value_at(t)))
+            .map(|&(t, _)| (t, scene.lanes.tilt_deg.value_at(t)))
             .collect();
         let data = super::plot::PlotData {
             sample_rate: fs,
@@ -321,7 +321,7 @@ impl<P> Observer<P> {
     #[cfg(feature = "plot")]
     /// The volume at the start: the fill level, as a reset fills the bottle (MODEL.md §8).
     fn first_volume(&self, scene: &Scene) -> f64 {
-        scene.config.capacity_ml * scene.fill_percent.value_at(0.0) / 100.0
+        scene.config.capacity_ml * scene.lanes.fill_percent.value_at(0.0) / 100.0
     }
 }
 

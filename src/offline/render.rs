@@ -3,10 +3,10 @@
 use std::time::{Duration, Instant};
 
 use super::scene::{LaneBuffers, Scene, MAX_DURATION_S};
-use crate::device::midi::{CcDecoder, DeviceAction, Target};
+use crate::device::midi::{CcDecoder, DeviceAction};
 use crate::device::midi_take::TimedInput;
 use crate::engine::synthesis::SILENT_DECAY_EXPONENT;
-use crate::engine::{Controls, DrainMode, Engine, Lane, UnitOnset};
+use crate::engine::{Controls, DrainMode, Engine, Lane, PerControl, UnitOnset};
 
 /// Samples per engine call offline; any size gives the same samples.
 pub const BLOCK_SIZE: usize = 4096;
@@ -178,7 +178,7 @@ struct TakePlayer<'a> {
     map: crate::device::midi::MidiMap,
     /// Tilt, viscosity and fill as the take last set them: from then on they replace the
     /// scene's lanes, as a CC overrides its parameter in the plugin.
-    held: [Option<f64>; 3],
+    held: PerControl<Option<f64>>,
 }
 
 impl<'a> TakePlayer<'a> {
@@ -188,7 +188,7 @@ impl<'a> TakePlayer<'a> {
             next: 0,
             decoder: CcDecoder::default(),
             map: scene.midi,
-            held: [None; 3],
+            held: PerControl::splat(None),
         }
     }
 
@@ -197,7 +197,7 @@ impl<'a> TakePlayer<'a> {
         while let Some(event) = self.events.get(self.next).filter(|e| e.sample <= position) {
             match self.decoder.decode(&self.map, event.input) {
                 Some(DeviceAction::Refill) => engine.refill(),
-                Some(DeviceAction::Set(target, value)) => self.held[target as usize] = Some(value),
+                Some(DeviceAction::Set(control, value)) => self.held[control] = Some(value),
                 None => {}
             }
             self.next += 1;
@@ -211,14 +211,9 @@ impl<'a> TakePlayer<'a> {
     }
 
     fn override_lanes(&self, controls: &mut Controls) {
-        let lanes = [
-            (Target::Tilt, &mut controls.tilt_deg),
-            (Target::Viscosity, &mut controls.viscosity),
-            (Target::Fill, &mut controls.fill_percent),
-        ];
-        for (target, lane) in lanes {
-            if let Some(value) = self.held[target as usize] {
-                *lane = Lane::Constant(value);
+        for (control, held) in self.held.iter() {
+            if let Some(value) = held {
+                controls[control] = Lane::Constant(value);
             }
         }
     }
@@ -231,7 +226,7 @@ impl<'a> TakePlayer<'a> {
 fn refuse_endless_decays(scene: &Scene) -> Result<(), RenderError> {
     let config = &scene.config;
     let nyquist_hz = scene.sample_rate as f64 / 2.0;
-    let viscosities: Vec<f64> = scene.viscosity.values().collect();
+    let viscosities: Vec<f64> = scene.lanes.viscosity.values().collect();
     let share_can_sound = [
         viscosities.iter().any(|&c| c > 0.0),
         viscosities.iter().any(|&c| c < 1.0),

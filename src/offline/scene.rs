@@ -3,15 +3,16 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::Deserialize;
-
 use super::automation::{Automation, CsvLaneRef, LaneSpec};
 use crate::device::axis::Axis;
 use crate::device::csv_lane::{read_csv_lane, CsvLaneError, CsvLaneSpec};
-use crate::device::midi::MidiMap;
+use crate::device::midi::{MidiMap, MidiSetting};
 use crate::device::midi_take::{read_midi_take, TakeError, TimedInput};
-use crate::engine::config::{self, ControlValues, Range};
-use crate::engine::{ControlSource, Controls, DrainMode, ModelConfig, Preset};
+use crate::engine::config::{self, Range};
+use crate::engine::{
+    Constant, Control, ControlSource, ControlValues, Controls, DrainMode, ModelConfig, PerControl,
+    Preset, PresetValue, Quantity,
+};
 
 /// The built-in default scene: a full 300 ml bottle of water tilted from 90° to 135° over half a
 /// second and held until it stops pouring.
@@ -102,16 +103,8 @@ pub struct Scene {
     pub sample_rate: u32,
     /// `None`: until pouring stops and every unit has decayed.
     pub duration_s: Option<f64>,
-    /// Tilt θ (degrees) over time.
-    pub tilt_deg: Automation,
-    /// Viscosity ratio c over time.
-    pub viscosity: Automation,
-    /// Fill level φ (percent of capacity) over time.
-    pub fill_percent: Automation,
-    /// Pour time T (s) over time.
-    pub pour_time_s: Automation,
-    /// Output gain (dB) over time.
-    pub gain_db: Automation,
+    /// Every control over time.
+    pub lanes: PerControl<Automation>,
     /// Seed, spreads (zero if `deterministic`), drain mode and the other constants.
     pub config: ModelConfig,
     /// A recorded MIDI take from the tilt device, if the scene names one.
@@ -179,9 +172,7 @@ impl Scene {
 
     /// Parses and validates a scene from TOML `text` whose files are relative to `folder`.
     pub fn parse_in(text: &str, folder: &Path) -> Result<Self, SceneError> {
-        let file: SceneFile =
-            toml::from_str(text).map_err(|error| SceneError::Syntax(error.to_string()))?;
-        file.validate(folder)
+        SceneFile::parse(text)?.validate(folder)
     }
 
     /// The same scene at another sample rate, refused as a scene's `sample_rate` would be: out
@@ -199,26 +190,34 @@ impl Scene {
         })
     }
 
-    /// The scene file of a preset: the default pour (tilted from 90° to 135° over half a
-    /// second) with the preset's liquid and bottle. `cargo xtask docs` writes these to
-    /// `presets/<id>.toml`.
+    /// The scene file of a preset: the default pour ([`DEFAULT_SCENE`]) with the preset's
+    /// values, each at its scene key. `cargo xtask docs` writes these to `presets/<id>.toml`.
     pub fn preset_toml(preset: &Preset) -> String {
-        let [f1, f2] = preset.frequency_hz;
-        let [b1, b2] = preset.decay_per_s;
+        let mut table: toml::Table =
+            toml::from_str(DEFAULT_SCENE).expect("the built-in scene is valid TOML");
+        for value in preset.values {
+            let (quantity, value) = match *value {
+                PresetValue::Control(control, value) => (control.quantity(), value),
+                PresetValue::Constant(constant, value) => (constant.quantity(), value),
+            };
+            let (section, name) = match quantity.scene_key.split_once('.') {
+                Some((section, name)) => {
+                    let section = table
+                        .entry(section)
+                        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+                    let section = section.as_table_mut().expect("a section is a table");
+                    (section, name)
+                }
+                None => (&mut table, quantity.scene_key),
+            };
+            section.insert(name.to_owned(), toml::Value::Float(value));
+        }
         format!(
-            "# {name}: {description}.\n\
-             # Written by `cargo xtask docs` from src/engine/presets.rs: edit the preset there.\n\
-             tilt_deg = [[0.0, 90.0], [0.5, 135.0]]\n\
-             viscosity_c = {viscosity:?}\n\
-             pour_time_s = {pour_time:?}\n\
-             \n[bottle]\ncapacity_ml = {capacity:?}\npocket_ml = {pocket:?}\n\
-             \n[glug]\nf1_hz = {f1:?}\nf2_hz = {f2:?}\nb1_per_s = {b1:?}\nb2_per_s = {b2:?}\n",
-            name = preset.name,
-            description = preset.description,
-            viscosity = preset.viscosity,
-            pour_time = preset.pour_time_s,
-            capacity = preset.capacity_ml,
-            pocket = preset.pocket_ml,
+            "# {}: {}.\n# Written by `cargo xtask docs` from src/engine/presets.rs: edit the preset \
+             there.\n{}",
+            preset.name,
+            preset.description,
+            toml::to_string(&table).expect("a table of numbers is valid TOML")
         )
     }
 
@@ -241,22 +240,16 @@ impl Scene {
             .as_ref()
             .and_then(|take| take.events.last())
             .map_or(0.0, |event| event.sample as f64 / self.sample_rate as f64);
-        self.lanes()
+        Control::ALL
             .iter()
-            .map(|lane| lane.last_time_s())
+            .map(|&control| self.lanes[control].last_time_s())
             .fold(last_message_s, f64::max)
     }
 
     /// The inputs at one sample.
-    pub fn values_at(&self, sample: u64) -> (ControlValues, f64) {
+    pub fn values_at(&self, sample: u64) -> ControlValues {
         let time_s = sample as f64 / self.sample_rate as f64;
-        let values = ControlValues {
-            tilt_deg: self.tilt_deg.value_at(time_s),
-            viscosity: self.viscosity.value_at(time_s),
-            fill_percent: self.fill_percent.value_at(time_s),
-            pour_time_s: self.pour_time_s.value_at(time_s),
-        };
-        (values, self.gain_db.value_at(time_s))
+        ControlValues::from_fn(|control| self.lanes[control].value_at(time_s))
     }
 
     /// The engine's controls for `len` samples from `first_sample`, using `buffers` as storage.
@@ -267,211 +260,206 @@ impl Scene {
         len: usize,
     ) -> Controls<'a> {
         let fs = self.sample_rate as f64;
-        let [tilt, viscosity, fill, pour_time, gain] = &mut buffers.0;
-        for buffer in [
-            &mut *tilt,
-            &mut *viscosity,
-            &mut *fill,
-            &mut *pour_time,
-            &mut *gain,
-        ] {
+        buffers.0.each_mut().into_map(|control, buffer| {
             buffer.resize(len, 0.0);
-        }
-        Controls {
-            tilt_deg: self.tilt_deg.lane(first_sample, fs, tilt),
-            viscosity: self.viscosity.lane(first_sample, fs, viscosity),
-            fill_percent: self.fill_percent.lane(first_sample, fs, fill),
-            pour_time_s: self.pour_time_s.lane(first_sample, fs, pour_time),
-            gain_db: self.gain_db.lane(first_sample, fs, gain),
-        }
-    }
-
-    fn lanes(&self) -> [&Automation; 5] {
-        [
-            &self.tilt_deg,
-            &self.viscosity,
-            &self.fill_percent,
-            &self.pour_time_s,
-            &self.gain_db,
-        ]
+            self.lanes[control].lane(first_sample, fs, buffer)
+        })
     }
 }
 
 impl ControlSource for Scene {
-    fn at(&self, sample: u64) -> (ControlValues, f64) {
+    fn at(&self, sample: u64) -> ControlValues {
         self.values_at(sample)
     }
 }
 
 /// Storage for the per-sample lanes of one block, reused from block to block.
-#[derive(Debug, Default)]
-pub struct LaneBuffers([Vec<f64>; 5]);
+#[derive(Debug)]
+pub struct LaneBuffers(PerControl<Vec<f64>>);
 
-// ---- The file as written: every key optional, nothing unknown. ----
-
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct SceneFile {
-    /// Read as a number of either type, so that a fraction is refused by [`check_sample_rate`]
-    /// with the same message as the command line's `--sample-rate`.
-    sample_rate: Option<f64>,
-    duration_s: Option<f64>,
-    seed: Option<u64>,
-    deterministic: Option<bool>,
-    tilt_deg: Option<LaneSpec>,
-    viscosity_c: Option<LaneSpec>,
-    fill_percent: Option<LaneSpec>,
-    pour_time_s: Option<LaneSpec>,
-    midi_take: Option<PathBuf>,
-    #[serde(default)]
-    midi: MidiSection,
-    #[serde(default)]
-    bottle: BottleSection,
-    #[serde(default)]
-    glug: GlugSection,
-    #[serde(default)]
-    output: OutputSection,
-}
-
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct BottleSection {
-    capacity_ml: Option<f64>,
-    pocket_ml: Option<f64>,
-}
-
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct GlugSection {
-    f1_hz: Option<f64>,
-    f2_hz: Option<f64>,
-    b1_per_s: Option<f64>,
-    b2_per_s: Option<f64>,
-    timing_jitter: Option<f64>,
-    freq_jitter: Option<f64>,
-    decay_sigma: Option<f64>,
-}
-
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct OutputSection {
-    gain_db: Option<LaneSpec>,
-    drain: Option<DrainMode>,
-}
-
-/// The `[midi]` table: the plugin's saved MIDI settings, by the same names and values (0–127,
-/// a channel 0–15; 255 for "not mapped" or "any channel").
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct MidiSection {
-    midi_channel: Option<u8>,
-    midi_cc_tilt: Option<u8>,
-    midi_cc_tilt_lsb: Option<u8>,
-    midi_cc_viscosity: Option<u8>,
-    midi_cc_fill: Option<u8>,
-}
-
-impl MidiSection {
-    /// The map, each field checked: a CC above 127 or a channel above 15 that is not 255 is
-    /// refused rather than silently unmapped.
-    fn map(&self) -> Result<MidiMap, SceneError> {
-        let defaults = MidiMap::default().to_raw();
-        let field = |key: &'static str, value: Option<u8>, default: u8, max: u8| {
-            let value = value.unwrap_or(default);
-            if value <= max || value == crate::device::midi::OFF {
-                Ok(value)
-            } else {
-                Err(SceneError::OutOfRange {
-                    key,
-                    value: value as f64,
-                    min: 0.0,
-                    max: max as f64,
-                })
-            }
-        };
-        Ok(MidiMap::from_raw([
-            field("midi.midi_channel", self.midi_channel, defaults[0], 15)?,
-            field("midi.midi_cc_tilt", self.midi_cc_tilt, defaults[1], 127)?,
-            field(
-                "midi.midi_cc_tilt_lsb",
-                self.midi_cc_tilt_lsb,
-                defaults[2],
-                127,
-            )?,
-            field(
-                "midi.midi_cc_viscosity",
-                self.midi_cc_viscosity,
-                defaults[3],
-                127,
-            )?,
-            field("midi.midi_cc_fill", self.midi_cc_fill, defaults[4], 127)?,
-        ]))
+impl Default for LaneBuffers {
+    fn default() -> Self {
+        Self(PerControl::from_fn(|_| Vec::new()))
     }
 }
 
+// ---- The file as written: every key optional, nothing unknown. ----
+
+/// The keys a scene has besides the controls' and the constants' (theirs come from their tables).
+const SAMPLE_RATE: &str = "sample_rate";
+const DURATION: &str = "duration_s";
+const SEED: &str = "seed";
+const DETERMINISTIC: &str = "deterministic";
+const MIDI_TAKE: &str = "midi_take";
+const DRAIN: &str = "output.drain";
+/// The table of the plugin's saved MIDI settings, by their names in the state.
+const MIDI_SECTION: &str = "midi";
+
+/// A scene file's TOML, from which each key is taken as it is read: what is left at the end is
+/// unknown, and refused.
+struct SceneFile {
+    table: toml::Table,
+    /// Every key read or asked for, for the message that refuses an unknown one.
+    known: Vec<String>,
+}
+
 impl SceneFile {
-    fn validate(self, folder: &Path) -> Result<Scene, SceneError> {
-        let sample_rate = match self.sample_rate {
+    fn parse(text: &str) -> Result<Self, SceneError> {
+        let table = toml::from_str(text).map_err(|error| SceneError::Syntax(error.to_string()))?;
+        Ok(Self {
+            table,
+            known: Vec::new(),
+        })
+    }
+
+    /// The value at `key` (`section.name` inside a table), taken out of the file.
+    fn take<T: serde::de::DeserializeOwned>(&mut self, key: &str) -> Result<Option<T>, SceneError> {
+        self.known.push(key.to_owned());
+        let (section, name) = match key.split_once('.') {
+            Some((section, name)) => (Some(section), name),
+            None => (None, key),
+        };
+        let table = match section {
+            None => &mut self.table,
+            Some(section) => match self.table.get_mut(section) {
+                None => return Ok(None),
+                Some(toml::Value::Table(table)) => table,
+                Some(other) => {
+                    return Err(SceneError::Syntax(format!(
+                        "`{section}`: invalid type: {}, expected a table",
+                        other.type_str()
+                    )))
+                }
+            },
+        };
+        match table.remove(name) {
+            None => Ok(None),
+            Some(value) => value
+                .try_into()
+                .map(Some)
+                .map_err(|error| SceneError::Syntax(format!("`{key}`: {error}"))),
+        }
+    }
+
+    /// Refuses whatever key is left: none of the scene's.
+    fn refuse_unknown(self) -> Result<(), SceneError> {
+        // The names known inside `section` (`None`: at the top, sections included).
+        let names_in = |section: Option<&str>| {
+            let mut names: Vec<&str> = Vec::new();
+            for key in &self.known {
+                let name = match (key.split_once('.'), section) {
+                    (Some((outer, name)), Some(wanted)) if outer == wanted => name,
+                    (Some((outer, _)), None) => outer,
+                    (None, None) => key.as_str(),
+                    _ => continue,
+                };
+                if !names.contains(&name) {
+                    names.push(name);
+                }
+            }
+            names
+        };
+        let unknown = |name: &str, place: String, known: Vec<&str>| {
+            let known: Vec<String> = known.iter().map(|name| format!("`{name}`")).collect();
+            SceneError::Syntax(format!(
+                "unknown field `{name}`{place}, expected one of {}",
+                known.join(", ")
+            ))
+        };
+        for (name, value) in &self.table {
+            let inside = names_in(Some(name));
+            if inside.is_empty() {
+                if !self.known.contains(name) {
+                    return Err(unknown(name, String::new(), names_in(None)));
+                }
+            } else if let Some(key) = value.as_table().and_then(|table| table.keys().next()) {
+                return Err(unknown(key, format!(" in [{name}]"), inside));
+            }
+        }
+        Ok(())
+    }
+
+    /// The `[midi]` table, each setting checked: a CC above 127 or a channel above 15 that is
+    /// not [`OFF`](crate::device::midi::OFF) is refused rather than silently unmapped.
+    fn midi_map(&mut self) -> Result<MidiMap, SceneError> {
+        let mut map = MidiMap::default();
+        for setting in MidiSetting::all() {
+            let key = format!("{MIDI_SECTION}.{}", setting.key());
+            let Some(byte) = self.take::<u8>(&key)? else {
+                continue;
+            };
+            if byte > setting.max() && byte != crate::device::midi::OFF {
+                return Err(SceneError::OutOfRange {
+                    key: setting.key(),
+                    value: byte as f64,
+                    min: 0.0,
+                    max: setting.max() as f64,
+                });
+            }
+            map.set_raw(setting, byte);
+        }
+        Ok(map)
+    }
+
+    fn validate(mut self, folder: &Path) -> Result<Scene, SceneError> {
+        let sample_rate = match self.take::<f64>(SAMPLE_RATE)? {
             Some(rate) => check_sample_rate(rate)?,
             None => config::SAMPLE_RATE_HZ.default as u32,
         };
         let duration_s = self
-            .duration_s
+            .take::<f64>(DURATION)?
             .map(|seconds| {
                 let allowed = Range {
                     min: 1.0 / sample_rate as f64,
                     max: MAX_DURATION_S,
                     default: 0.0,
                 };
-                check("duration_s", seconds, allowed)
+                check(DURATION, seconds, allowed)
             })
             .transpose()?;
-        let glug = &self.glug;
         let mut config = ModelConfig {
-            capacity_ml: constant(
-                "bottle.capacity_ml",
-                self.bottle.capacity_ml,
-                config::CAPACITY_ML,
-            )?,
-            pocket_ml: constant("bottle.pocket_ml", self.bottle.pocket_ml, config::POCKET_ML)?,
-            frequency_hz: [
-                constant("glug.f1_hz", glug.f1_hz, config::F1_HZ)?,
-                constant("glug.f2_hz", glug.f2_hz, config::F2_HZ)?,
-            ],
-            decay_per_s: [
-                constant("glug.b1_per_s", glug.b1_per_s, config::B1_PER_S)?,
-                constant("glug.b2_per_s", glug.b2_per_s, config::B2_PER_S)?,
-            ],
-            timing_jitter: constant(
-                "glug.timing_jitter",
-                glug.timing_jitter,
-                config::TIMING_JITTER,
-            )?,
-            freq_jitter: constant("glug.freq_jitter", glug.freq_jitter, config::FREQ_JITTER)?,
-            decay_sigma: constant("glug.decay_sigma", glug.decay_sigma, config::DECAY_SIGMA)?,
-            seed: self.seed.unwrap_or(ModelConfig::default().seed),
-            drain: self.output.drain.unwrap_or_default(),
-            ceiling: config::CEILING.default,
+            seed: self
+                .take::<u64>(SEED)?
+                .unwrap_or(ModelConfig::default().seed),
+            ..ModelConfig::default()
         };
-        if self.deterministic.unwrap_or(false) {
+        let mut lanes = PerControl::from_fn(|_| None);
+        for &control in Control::ALL {
+            let key = control.quantity().scene_key;
+            let spec = self.take::<LaneSpec>(key)?;
+            lanes[control] = Some(automation(
+                key,
+                resolve(key, spec, folder)?,
+                control.range(),
+            )?);
+        }
+        for &constant in Constant::ALL {
+            let Quantity {
+                scene_key, range, ..
+            } = *constant.quantity();
+            let value = self.take::<f64>(scene_key)?;
+            constant.set(
+                &mut config,
+                check(scene_key, value.unwrap_or(range.default), range)?,
+            );
+        }
+        config.drain = self.take::<DrainMode>(DRAIN)?.unwrap_or_default();
+        if self.take::<bool>(DETERMINISTIC)?.unwrap_or(false) {
             config = config.deterministic();
         }
-        let lane = |key, spec, range| automation(key, resolve(key, spec, folder)?, range);
         let take = self
-            .midi_take
+            .take::<PathBuf>(MIDI_TAKE)?
             .map(|path| MidiTake::load(&folder.join(path), sample_rate))
             .transpose()?;
+        let midi = self.midi_map()?;
+        self.refuse_unknown()?;
         Ok(Scene {
             sample_rate,
             duration_s,
-            tilt_deg: lane("tilt_deg", self.tilt_deg, config::TILT_DEG)?,
-            viscosity: lane("viscosity_c", self.viscosity_c, config::VISCOSITY)?,
-            fill_percent: lane("fill_percent", self.fill_percent, config::FILL_PERCENT)?,
-            pour_time_s: lane("pour_time_s", self.pour_time_s, config::POUR_TIME_S)?,
-            gain_db: lane("output.gain_db", self.output.gain_db, config::GAIN_DB)?,
+            lanes: lanes.into_map(|_, lane| lane.expect("every control was read above")),
             config,
             take,
-            midi: self.midi.map()?,
+            midi,
         })
     }
 }
@@ -548,10 +536,6 @@ fn check_sample_rate(sample_rate: f64) -> Result<u32, SceneError> {
         });
     }
     Ok(sample_rate as u32)
-}
-
-fn constant(key: &'static str, value: Option<f64>, range: Range) -> Result<f64, SceneError> {
-    check(key, value.unwrap_or(range.default), range)
 }
 
 fn automation(

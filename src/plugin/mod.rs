@@ -15,17 +15,12 @@ mod editor;
 
 pub use feed::{Feed, UnitView, Visible, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
 pub use osc_input::{OscInput, OscSettings, OscStatus, DEFAULT_AXIS};
-pub use params::{migrate_state, parse_number, GlugParams, Knob, ModelParams, STATE_VERSION};
+pub use params::{
+    exact, float_param, format, migrate_state, parse_number, GlugParams, ModelParams, CEILING_DB,
+    STATE_VERSION,
+};
 pub use realtime::{RealtimeEngine, Settings, FADE_S};
 pub use transport::TransportWatch;
-
-/// Every float knob, for tests and docs that walk the parameters.
-pub mod knobs {
-    pub use super::params::{
-        B1, B2, CAPACITY, CEILING_DB, DECAY_SIGMA, F1, F2, FILL, FREQ_JITTER, GAIN, POCKET,
-        POUR_TIME, SEED_MAX, TILT, TIMING_JITTER, VISCOSITY,
-    };
-}
 
 use std::num::NonZeroU32;
 use std::sync::Arc;
@@ -254,11 +249,9 @@ impl ClapPlugin for SakeGlug {
         let params = &self.params;
         context.add_section("Pour", |section| {
             section.add_page("Pour", |page| {
-                page.add_param(&params.tilt);
-                page.add_param(&params.viscosity);
-                page.add_param(&params.fill);
-                page.add_param(&params.pour_time);
-                page.add_param(&params.gain);
+                for &control in crate::engine::Control::ALL {
+                    page.add_param(&params.controls[control]);
+                }
             });
         });
     }

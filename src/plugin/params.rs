@@ -6,107 +6,55 @@
 //! f64, not the nearest f32). So typing `4.2` in a host and writing `4.2` in a scene file give
 //! the engine the same number, and the same samples.
 
+use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::Arc;
 
+use nice_plug::params::persist::{self, PersistentField};
 use nice_plug::prelude::*;
 
-use crate::device::midi::MidiMap;
-use crate::engine::config::{self, Range};
-use crate::engine::{ControlValues, DrainMode, ModelConfig};
+use crate::device::midi::{MidiMap, MidiSetting};
+use crate::engine::config::{self, Knob, Quantity};
+use crate::engine::{Constant, Control, ControlValues, DrainMode, ModelConfig, PerControl, Range};
 use crate::plugin::osc_input::OscSettings;
 
-/// How one float parameter is ranged, shown and handed to the engine.
-#[derive(Debug, Clone, Copy)]
-pub struct Knob {
-    /// Parameter name shown by the host.
-    pub name: &'static str,
-    /// Unit text shown after the value (with its leading space, if any).
-    pub unit: &'static str,
-    /// Lowest value on the knob.
-    pub min: f64,
-    /// Highest value on the knob.
-    pub max: f64,
-    /// Default value.
-    pub default: f64,
-    /// Decimals shown; the value snaps to steps of 10^−decimals.
-    pub decimals: i32,
-    /// `None` for a linear knob, else nice-plug's skew exponent (negative: finer at the bottom).
-    pub skew: Option<f32>,
+/// The decimal number that `value` shows as on a knob with `decimals` decimals: what the engine
+/// receives.
+pub fn exact(knob: &Knob, value: f32) -> f64 {
+    let scale = 10f64.powi(knob.decimals);
+    let rounded = (value as f64 * scale).round() / scale;
+    // -0.00 would not round-trip through text.
+    if rounded == 0.0 {
+        0.0
+    } else {
+        rounded
+    }
 }
 
-impl Knob {
-    /// A knob over the engine's whole range.
-    const fn from_range(
-        name: &'static str,
-        unit: &'static str,
-        range: Range,
-        decimals: i32,
-    ) -> Self {
-        Self {
-            name,
-            unit,
-            min: range.min,
-            max: range.max,
-            default: range.default,
-            decimals,
-            skew: None,
-        }
-    }
+/// The text for `value`: exactly the knob's decimals, without the unit.
+pub fn format(knob: &Knob, value: f32) -> String {
+    format!("{:.*}", knob.decimals as usize, exact(knob, value))
+}
 
-    /// A knob narrower than the engine's range, where the full range is absurd on a knob.
-    const fn within(self, min: f64, max: f64) -> Self {
-        Self { min, max, ..self }
-    }
-
-    const fn skewed(self, factor: f32) -> Self {
-        Self {
-            skew: Some(factor),
-            ..self
-        }
-    }
-
-    fn scale(&self) -> f64 {
-        10f64.powi(self.decimals)
-    }
-
-    /// The decimal number that `value` shows as: what the engine receives.
-    pub fn exact(&self, value: f32) -> f64 {
-        let rounded = (value as f64 * self.scale()).round() / self.scale();
-        // -0.00 would not round-trip through text.
-        if rounded == 0.0 {
-            0.0
-        } else {
-            rounded
-        }
-    }
-
-    /// The text for `value`: exactly `decimals` decimals, without the unit.
-    pub fn format(&self, value: f32) -> String {
-        format!("{:.*}", self.decimals as usize, self.exact(value))
-    }
-
-    fn range(&self) -> FloatRange {
-        let (min, max) = (self.min as f32, self.max as f32);
-        match self.skew {
-            None => FloatRange::Linear { min, max },
-            Some(factor) => FloatRange::Skewed {
-                min,
-                max,
-                factor: FloatRange::skew_factor(factor),
-            },
-        }
-    }
-
-    /// The nice-plug parameter for this knob.
-    pub fn param(&self) -> FloatParam {
-        let knob = *self;
-        FloatParam::new(self.name, self.default as f32, self.range())
-            .with_unit(self.unit)
-            .with_step_size((1.0 / self.scale()) as f32)
-            .with_value_to_string(Arc::new(move |value| knob.format(value)))
-            .with_string_to_value(Arc::new(parse_number))
-    }
+/// The nice-plug parameter of a quantity: its knob's range, step and skew, its name, unit and
+/// default, text that round-trips.
+pub fn float_param(quantity: &Quantity) -> FloatParam {
+    let knob = quantity.knob;
+    let (min, max) = quantity.knob_bounds();
+    let (min, max) = (min as f32, max as f32);
+    let range = match knob.skew {
+        None => FloatRange::Linear { min, max },
+        Some(factor) => FloatRange::Skewed {
+            min,
+            max,
+            factor: FloatRange::skew_factor(factor),
+        },
+    };
+    FloatParam::new(quantity.name, quantity.range.default as f32, range)
+        .with_unit(quantity.unit)
+        .with_step_size(10f64.powi(-knob.decimals) as f32)
+        .with_value_to_string(Arc::new(move |value| format(&knob, value)))
+        .with_string_to_value(Arc::new(parse_number))
 }
 
 /// Reads what a person types into a parameter: a number, with an exponent (`1e3`) or a decimal
@@ -136,65 +84,23 @@ pub fn parse_number(text: &str) -> Option<f32> {
     value.is_finite().then_some(value)
 }
 
-// The main group. Tilt, viscosity and fill use the engine's full ranges.
-/// Tilt θ (degrees), 0–180.
-pub const TILT: Knob = Knob::from_range("Tilt", "°", config::TILT_DEG, 2);
-/// Viscosity ratio c, 0–1.
-pub const VISCOSITY: Knob = Knob::from_range("Viscosity", "", config::VISCOSITY, 3);
-/// Fill level φ (percent of capacity), 0–100.
-pub const FILL: Knob = Knob::from_range("Fill level", " %", config::FILL_PERCENT, 1);
-/// Narrower than the engine's 0.01–3600 s: below 0.1 s or above 2 minutes is no pour.
-pub const POUR_TIME: Knob = Knob::from_range("Pour time", " s", config::POUR_TIME_S, 2)
-    .within(0.1, 120.0)
-    .skewed(-1.5);
-/// Narrower than the engine's −120…+24 dB, which would make the knob coarse.
-pub const GAIN: Knob =
-    Knob::from_range("Output gain", " dB", config::GAIN_DB, 2).within(-60.0, 12.0);
-
-// The model group (MODEL.md §5, §7). Frequencies, decays, volumes: narrower than the engine's
-// ranges (which only guard against nonsense) but wide enough to reach past Nyquist at 44.1 kHz.
-/// Frequency f1 of the first component (Hz).
-pub const F1: Knob = Knob::from_range("f1", " Hz", config::F1_HZ, 1)
-    .within(10.0, 24_000.0)
-    .skewed(-2.0);
-/// Frequency f2 of the second component (Hz).
-pub const F2: Knob = Knob::from_range("f2", " Hz", config::F2_HZ, 1)
-    .within(10.0, 24_000.0)
-    .skewed(-2.0);
-/// Amplitude decay rate B1 of the first component (1/s).
-pub const B1: Knob = Knob::from_range("B1", " /s", config::B1_PER_S, 1)
-    .within(1.0, 1_000.0)
-    .skewed(-1.5);
-/// Amplitude decay rate B2 of the second component (1/s).
-pub const B2: Knob = Knob::from_range("B2", " /s", config::B2_PER_S, 1)
-    .within(1.0, 1_000.0)
-    .skewed(-1.5);
-/// Mean air-pocket volume b per glug (ml).
-pub const POCKET: Knob = Knob::from_range("Pocket volume", " ml", config::POCKET_ML, 2)
-    .within(0.1, 100.0)
-    .skewed(-1.5);
-/// Bottle capacity C (ml).
-pub const CAPACITY: Knob = Knob::from_range("Capacity", " ml", config::CAPACITY_ML, 0)
-    .within(10.0, 5_000.0)
-    .skewed(-1.5);
-/// Relative spread j_t of each unit's pocket volume, 0–0.95.
-pub const TIMING_JITTER: Knob = Knob::from_range("Timing spread", "", config::TIMING_JITTER, 3);
-/// Relative spread j_f of each unit's f1, f2, 0–1.
-pub const FREQ_JITTER: Knob = Knob::from_range("Frequency spread", "", config::FREQ_JITTER, 3);
-/// Log-normal spread σ of each unit's B1, B2, 0–3.
-pub const DECAY_SIGMA: Knob = Knob::from_range("Decay spread", "", config::DECAY_SIGMA, 3);
-/// The output ceiling in dB (0 dB = the engine's default ±1.0); −60 dB is the engine's 0.001.
-pub const CEILING_DB: Knob = Knob {
+/// The output ceiling in dB (0 dB = the engine's default ±1.0; −60 dB is the engine's 0.001):
+/// the plugin shows the engine's linear [`config::CEILING`] in dB. Scenes have no ceiling.
+pub const CEILING_DB: Quantity = Quantity {
     name: "Output ceiling",
     unit: " dB",
-    min: -60.0,
-    max: 0.0,
-    default: 0.0,
-    decimals: 1,
-    skew: None,
+    scene_key: "",
+    param_id: "ceil",
+    range: Range::new(-60.0, 0.0, 0.0),
+    knob: Knob::full(1),
 };
-/// Largest value of the Seed parameter.
-pub const SEED_MAX: i32 = 999_999;
+
+/// The Seed parameter's id.
+const SEED_ID: &str = "seed";
+/// The Drain mode parameter's id.
+const DRAIN_ID: &str = "drain";
+/// The parameter group of the model's constants and settings.
+const MODEL_GROUP: &str = "Model";
 
 /// The Drain mode parameter is the engine's own [`DrainMode`]; its IDs are the names scenes use.
 impl Enum for DrainMode {
@@ -221,64 +127,36 @@ impl Enum for DrainMode {
     }
 }
 
-/// Every parameter of the plugin, and its saved MIDI settings.
-#[derive(Params)]
+/// Every parameter of the plugin, and its saved MIDI and OSC settings. The parameters come from
+/// the engine's tables of controls and constants: their ids, names, units, ranges and knobs are
+/// declared there once.
 pub struct GlugParams {
-    /// Tilt θ (degrees), see [`TILT`].
-    #[id = "tilt"]
-    pub tilt: FloatParam,
-    /// Viscosity ratio c, see [`VISCOSITY`].
-    #[id = "visc"]
-    pub viscosity: FloatParam,
-    /// Fill level φ (percent of capacity), see [`FILL`].
-    #[id = "fill"]
-    pub fill: FloatParam,
-    /// Pour time T (s), see [`POUR_TIME`].
-    #[id = "pour"]
-    pub pour_time: FloatParam,
-    /// Output gain (dB), see [`GAIN`].
-    #[id = "gain"]
-    pub gain: FloatParam,
-
+    /// One parameter per control (the main group, "Pour" on a CLAP remote-control page).
+    pub controls: PerControl<FloatParam>,
     /// The Model group: the constants of MODEL.md §5, §7 and §8.
-    #[nested(group = "Model")]
     pub model: ModelParams,
-
-    /// MIDI settings of the tilt device (saved with the state, not automatable).
-    #[persist = "midi_channel"]
-    pub midi_channel: AtomicU8,
-    /// CC number of tilt (its MSB when tilt is 14-bit); 128 or more means unmapped.
-    #[persist = "midi_cc_tilt"]
-    pub midi_cc_tilt: AtomicU8,
-    /// CC number of tilt's LSB; 128 or more means 7-bit tilt.
-    #[persist = "midi_cc_tilt_lsb"]
-    pub midi_cc_tilt_lsb: AtomicU8,
-    /// CC number of viscosity; 128 or more means unmapped.
-    #[persist = "midi_cc_viscosity"]
-    pub midi_cc_viscosity: AtomicU8,
-    /// CC number of the fill level; 128 or more means unmapped.
-    #[persist = "midi_cc_fill"]
-    pub midi_cc_fill: AtomicU8,
+    /// MIDI settings of the tilt device (saved with the state, not automatable), in the order
+    /// of [`MidiSetting::all`].
+    pub midi: Vec<AtomicU8>,
     /// The layout of the saved state ([`STATE_VERSION`]); older states are brought up to date
     /// by [`migrate_state`] before they load.
-    #[persist = "state_version"]
     pub state_version: AtomicU8,
-
     /// OSC settings (saved with the state, not automatable).
-    #[nested]
     pub osc: OscSettings,
 }
 
 /// The saved state's layout. 0: before states carried a version (the parameters and MIDI
 /// fields of 0.1.0). 1: the same with this version field, and the OSC settings (off unless set).
 pub const STATE_VERSION: u8 = 1;
+/// The persisted field that holds [`STATE_VERSION`].
+const STATE_VERSION_KEY: &str = "state_version";
 
 /// Brings a saved state up to [`STATE_VERSION`], one version at a time, before it loads; a
 /// state from a newer version loads as it is (its unknown fields are ignored).
 pub fn migrate_state(state: &mut PluginState) {
     let saved = state
         .fields
-        .get("state_version")
+        .get(STATE_VERSION_KEY)
         .and_then(|text| text.parse::<u8>().ok())
         .unwrap_or(0);
     if saved > STATE_VERSION {
@@ -288,65 +166,37 @@ pub fn migrate_state(state: &mut PluginState) {
     // keep their defaults (off). A later change to an ID, range or unit adds its step here.
     state
         .fields
-        .insert("state_version".into(), STATE_VERSION.to_string());
+        .insert(STATE_VERSION_KEY.into(), STATE_VERSION.to_string());
 }
 
 /// The Model group of parameters (MODEL.md §5, §7, §8).
-#[derive(Params)]
 pub struct ModelParams {
-    /// Frequency f1 (Hz), see [`F1`].
-    #[id = "f1"]
-    pub f1: FloatParam,
-    /// Frequency f2 (Hz), see [`F2`].
-    #[id = "f2"]
-    pub f2: FloatParam,
-    /// Decay rate B1 (1/s), see [`B1`].
-    #[id = "b1"]
-    pub b1: FloatParam,
-    /// Decay rate B2 (1/s), see [`B2`].
-    #[id = "b2"]
-    pub b2: FloatParam,
-    /// Pocket volume b (ml), see [`POCKET`].
-    #[id = "pocket"]
-    pub pocket: FloatParam,
-    /// Capacity C (ml), see [`CAPACITY`].
-    #[id = "cap"]
-    pub capacity: FloatParam,
-    /// Timing spread j_t, see [`TIMING_JITTER`].
-    #[id = "tjit"]
-    pub timing_jitter: FloatParam,
-    /// Frequency spread j_f, see [`FREQ_JITTER`].
-    #[id = "fjit"]
-    pub freq_jitter: FloatParam,
-    /// Decay spread σ, see [`DECAY_SIGMA`].
-    #[id = "dsig"]
-    pub decay_sigma: FloatParam,
-    /// Seed of the random generator, 0 to [`SEED_MAX`].
-    #[id = "seed"]
+    /// One parameter per model constant, in the order of [`Constant::ALL`].
+    pub constants: Vec<FloatParam>,
+    /// Seed of the random generator, 0 to [`config::SEED`]'s maximum.
     pub seed: IntParam,
     /// Drain mode: simulate or follow.
-    #[id = "drain"]
     pub drain: EnumParam<DrainMode>,
     /// Output ceiling (dB), see [`CEILING_DB`].
-    #[id = "ceil"]
     pub ceiling: FloatParam,
+}
+
+impl ModelParams {
+    /// The parameter of `constant`.
+    pub fn constant(&self, constant: Constant) -> &FloatParam {
+        &self.constants[constant as usize]
+    }
 }
 
 impl Default for GlugParams {
     fn default() -> Self {
-        let midi = MidiMap::default().to_raw();
+        let midi = MidiMap::default();
         Self {
-            tilt: TILT.param(),
-            viscosity: VISCOSITY.param(),
-            fill: FILL.param(),
-            pour_time: POUR_TIME.param(),
-            gain: GAIN.param(),
+            controls: PerControl::from_fn(|control| float_param(control.quantity())),
             model: ModelParams::default(),
-            midi_channel: AtomicU8::new(midi[0]),
-            midi_cc_tilt: AtomicU8::new(midi[1]),
-            midi_cc_tilt_lsb: AtomicU8::new(midi[2]),
-            midi_cc_viscosity: AtomicU8::new(midi[3]),
-            midi_cc_fill: AtomicU8::new(midi[4]),
+            midi: MidiSetting::all()
+                .map(|setting| AtomicU8::new(midi.raw(setting)))
+                .collect(),
             state_version: AtomicU8::new(STATE_VERSION),
             osc: OscSettings::default(),
         }
@@ -356,81 +206,142 @@ impl Default for GlugParams {
 impl Default for ModelParams {
     fn default() -> Self {
         Self {
-            f1: F1.param(),
-            f2: F2.param(),
-            b1: B1.param(),
-            b2: B2.param(),
-            pocket: POCKET.param(),
-            capacity: CAPACITY.param(),
-            timing_jitter: TIMING_JITTER.param(),
-            freq_jitter: FREQ_JITTER.param(),
-            decay_sigma: DECAY_SIGMA.param(),
+            constants: Constant::ALL
+                .iter()
+                .map(|constant| float_param(constant.quantity()))
+                .collect(),
             seed: IntParam::new(
                 "Seed",
-                ModelConfig::default().seed as i32,
+                config::SEED.default as i32,
                 IntRange::Linear {
-                    min: 0,
-                    max: SEED_MAX,
+                    min: config::SEED.min as i32,
+                    max: config::SEED.max as i32,
                 },
             ),
             drain: EnumParam::new("Drain mode", DrainMode::Simulate),
-            ceiling: CEILING_DB.param(),
+            ceiling: float_param(&CEILING_DB),
         }
     }
 }
 
-impl GlugParams {
-    /// The per-sample inputs as the parameters set them (before any MIDI override).
-    pub fn control_values(&self) -> ControlValues {
-        ControlValues {
-            tilt_deg: TILT.exact(self.tilt.value()),
-            viscosity: VISCOSITY.exact(self.viscosity.value()),
-            fill_percent: FILL.exact(self.fill.value()),
-            pour_time_s: POUR_TIME.exact(self.pour_time.value()),
-        }
+/// Written by hand rather than derived, so that the parameters and fields come from the engine's
+/// tables; the ids, order, groups and field names are those the derive gave 0.1.0, so saved
+/// states and projects load unchanged.
+// SAFETY: every pointer in `param_map` points into `self`, whose parameters never move (the
+// vectors are never resized).
+unsafe impl Params for GlugParams {
+    fn param_map(&self) -> Vec<(String, ParamPtr, String)> {
+        let mut map: Vec<(String, ParamPtr, String)> = Control::ALL
+            .iter()
+            .map(|&control| {
+                let id = control.quantity().param_id.to_owned();
+                (id, self.controls[control].as_ptr(), String::new())
+            })
+            .collect();
+        map.extend(self.model.param_map().into_iter().map(|(id, ptr, group)| {
+            let group = if group.is_empty() {
+                MODEL_GROUP.to_owned()
+            } else {
+                format!("{MODEL_GROUP}/{group}")
+            };
+            (id, ptr, group)
+        }));
+        map.extend(self.osc.param_map());
+        map
     }
 
-    /// The output gain as the engine receives it (dB).
-    pub fn gain_db(&self) -> f64 {
-        GAIN.exact(self.gain.value())
+    fn serialize_fields(&self) -> BTreeMap<String, String> {
+        let mut fields = BTreeMap::new();
+        let persisted = MidiSetting::all()
+            .map(|setting| setting.key())
+            .zip(&self.midi)
+            .chain([(STATE_VERSION_KEY, &self.state_version)]);
+        for (key, field) in persisted {
+            match field.map(persist::serialize_field) {
+                Ok(data) => {
+                    fields.insert(key.to_owned(), data);
+                }
+                Err(error) => nice_debug_assert_failure!("cannot save '{}': {}", key, error),
+            }
+        }
+        fields.extend(self.osc.serialize_fields());
+        fields
+    }
+
+    fn deserialize_fields(&self, serialized: &BTreeMap<String, String>) {
+        let persisted = MidiSetting::all()
+            .map(|setting| setting.key())
+            .zip(&self.midi)
+            .chain([(STATE_VERSION_KEY, &self.state_version)]);
+        for (key, field) in persisted {
+            let Some(data) = serialized.get(key) else {
+                continue;
+            };
+            match persist::deserialize_field(data) {
+                Ok(value) => field.set(value),
+                Err(error) => nice_debug_assert_failure!("cannot load '{}': {}", key, error),
+            }
+        }
+        self.osc.deserialize_fields(serialized);
+    }
+}
+
+// SAFETY: every pointer in `param_map` points into `self`, whose parameters never move.
+unsafe impl Params for ModelParams {
+    fn param_map(&self) -> Vec<(String, ParamPtr, String)> {
+        let mut map: Vec<(String, ParamPtr, String)> = Constant::ALL
+            .iter()
+            .map(|&constant| {
+                let id = constant.quantity().param_id.to_owned();
+                (id, self.constant(constant).as_ptr(), String::new())
+            })
+            .collect();
+        map.push((SEED_ID.to_owned(), self.seed.as_ptr(), String::new()));
+        map.push((DRAIN_ID.to_owned(), self.drain.as_ptr(), String::new()));
+        map.push((
+            CEILING_DB.param_id.to_owned(),
+            self.ceiling.as_ptr(),
+            String::new(),
+        ));
+        map
+    }
+}
+
+impl GlugParams {
+    /// Every control as the parameters set it (before any MIDI or OSC override), as the
+    /// decimal number its text shows.
+    pub fn control_values(&self) -> ControlValues {
+        ControlValues::from_fn(|control| {
+            exact(&control.quantity().knob, self.controls[control].value())
+        })
     }
 
     /// The model's constants as the parameters set them, the ceiling converted to linear.
     pub fn model_config(&self) -> ModelConfig {
         let model = &self.model;
-        ModelConfig {
-            capacity_ml: CAPACITY.exact(model.capacity.value()),
-            pocket_ml: POCKET.exact(model.pocket.value()),
-            frequency_hz: [F1.exact(model.f1.value()), F2.exact(model.f2.value())],
-            decay_per_s: [B1.exact(model.b1.value()), B2.exact(model.b2.value())],
-            timing_jitter: TIMING_JITTER.exact(model.timing_jitter.value()),
-            freq_jitter: FREQ_JITTER.exact(model.freq_jitter.value()),
-            decay_sigma: DECAY_SIGMA.exact(model.decay_sigma.value()),
+        let mut config = ModelConfig {
             seed: model.seed.value().max(0) as u64,
             drain: model.drain.value(),
-            ceiling: 10f64.powf(CEILING_DB.exact(model.ceiling.value()) / 20.0),
+            ceiling: 10f64.powf(exact(&CEILING_DB.knob, model.ceiling.value()) / 20.0),
+            ..ModelConfig::default()
+        };
+        for &constant in Constant::ALL {
+            let value = exact(&constant.quantity().knob, model.constant(constant).value());
+            constant.set(&mut config, value);
         }
+        config
     }
 
     /// The saved MIDI settings, with anything out of range switched off.
     pub fn midi_map(&self) -> MidiMap {
-        MidiMap::from_raw([
-            self.midi_channel.load(Ordering::Relaxed),
-            self.midi_cc_tilt.load(Ordering::Relaxed),
-            self.midi_cc_tilt_lsb.load(Ordering::Relaxed),
-            self.midi_cc_viscosity.load(Ordering::Relaxed),
-            self.midi_cc_fill.load(Ordering::Relaxed),
-        ])
+        MidiMap::from_raw(self.midi.iter().map(|byte| byte.load(Ordering::Relaxed)))
     }
 
     /// Saves `map` as the MIDI settings.
     pub fn set_midi_map(&self, map: MidiMap) {
-        let raw = map.to_raw();
-        self.midi_channel.store(raw[0], Ordering::Relaxed);
-        self.midi_cc_tilt.store(raw[1], Ordering::Relaxed);
-        self.midi_cc_tilt_lsb.store(raw[2], Ordering::Relaxed);
-        self.midi_cc_viscosity.store(raw[3], Ordering::Relaxed);
-        self.midi_cc_fill.store(raw[4], Ordering::Relaxed);
+        for (setting, byte) in MidiSetting::all().zip(&self.midi) {
+            byte.store(map.raw(setting), Ordering::Relaxed);
+        }
     }
 }
 
@@ -463,16 +374,16 @@ mod tests {
 
     #[test]
     fn exact_gives_the_decimal_the_text_shows() {
-        assert_eq!(POUR_TIME.exact(4.2f32), 4.2f64);
-        assert_eq!(VISCOSITY.exact(0.33f32), 0.33f64);
-        assert_eq!(GAIN.format(-0.001), "0.00");
+        let knob = |control: Control| control.quantity().knob;
+        assert_eq!(exact(&knob(Control::PourTime), 4.2f32), 4.2f64);
+        assert_eq!(exact(&knob(Control::Viscosity), 0.33f32), 0.33f64);
+        assert_eq!(format(&knob(Control::Gain), -0.001), "0.00");
     }
 
     #[test]
     fn defaults_match_the_engine() {
         let params = GlugParams::default();
         assert_eq!(params.control_values(), ControlValues::default());
-        assert_eq!(params.gain_db(), config::GAIN_DB.default);
         assert_eq!(params.model_config(), ModelConfig::default());
     }
 }

@@ -6,24 +6,20 @@ use nice_plug::params::internals::ParamPtr;
 use nice_plug::plugin::ParamValue;
 use nice_plug::prelude::*;
 
-use crate::engine::Preset;
+use crate::engine::{Preset, PresetValue};
 use crate::plugin::params::GlugParams;
 use crate::plugin::SakeGlugVst3;
 
 /// The parameters a preset sets, each with the preset's value for it. Every other parameter
 /// (tilt, fill level, gain, spreads, seed, drain, ceiling) is left as it is.
-pub fn preset_values<'a>(preset: &Preset, params: &'a GlugParams) -> [(&'a FloatParam, f64); 8] {
-    let model = &params.model;
-    [
-        (&params.viscosity, preset.viscosity),
-        (&params.pour_time, preset.pour_time_s),
-        (&model.capacity, preset.capacity_ml),
-        (&model.pocket, preset.pocket_ml),
-        (&model.f1, preset.frequency_hz[0]),
-        (&model.f2, preset.frequency_hz[1]),
-        (&model.b1, preset.decay_per_s[0]),
-        (&model.b2, preset.decay_per_s[1]),
-    ]
+pub fn preset_values<'a>(
+    preset: &Preset,
+    params: &'a GlugParams,
+) -> impl Iterator<Item = (&'a FloatParam, f64)> {
+    preset.values.iter().map(move |value| match *value {
+        PresetValue::Control(control, value) => (&params.controls[control], value),
+        PresetValue::Constant(constant, value) => (params.model.constant(constant), value),
+    })
 }
 
 /// The state nice-plug saves (`IComponent::getState`, the CLAP state's JSON) for a fresh plugin

@@ -19,10 +19,8 @@ pub const FADE_S: f64 = 0.005;
 /// The parameters' values for one `process()` call.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
-    /// Tilt, viscosity, fill level and pour time as the parameters set them (before MIDI).
+    /// Every control as the parameters set it (before MIDI and OSC).
     pub values: ControlValues,
-    /// Output gain (dB).
-    pub gain_db: f64,
     /// The model's constants.
     pub config: ModelConfig,
     /// The tilt device's MIDI mapping.
@@ -34,7 +32,6 @@ impl Settings {
     pub fn from_params(params: &GlugParams) -> Self {
         Self {
             values: params.control_values(),
-            gain_db: params.gain_db(),
             config: params.model_config(),
             midi: params.midi_map(),
         }
@@ -191,26 +188,15 @@ impl RealtimeEngine {
     /// Renders `out.len()` samples under `settings` (constant over the span).
     pub fn process(&mut self, settings: &Settings, out: &mut [f32], feed: &Feed) {
         self.apply_config(settings.config);
-        let params = settings.values;
-        let [tilt_deg, viscosity, fill_percent] =
-            self.overrides
-                .apply([params.tilt_deg, params.viscosity, params.fill_percent]);
-        let values = ControlValues {
-            tilt_deg,
-            viscosity,
-            fill_percent,
-            pour_time_s: params.pour_time_s,
-        };
-        let controls = Controls::constant(values, settings.gain_db);
+        let values = self.overrides.apply(settings.values);
+        let tilt_deg = values.tilt_deg;
+        let controls = Controls::constant(values);
         let sample_rate = self.engine.sample_rate();
         // The tail stands upright: it only rings out, nothing new starts in it.
-        let tail_controls = Controls::constant(
-            ControlValues {
-                tilt_deg: 0.0,
-                ..values
-            },
-            settings.gain_db,
-        );
+        let tail_controls = Controls::constant(ControlValues {
+            tilt_deg: 0.0,
+            ..values
+        });
         for span in out.chunks_mut(FEED_SPAN) {
             self.engine.process(&controls, span);
             if self.fade_left > 0 {

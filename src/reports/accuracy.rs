@@ -25,8 +25,6 @@ pub const LENGTHS_S: [f64; 3] = [1.0, 60.0, 3600.0];
 /// The error budget of MODEL.md §9 for the default path: below this at every render length (the
 /// contract states it for an hour and forbids drift with length, so it holds at any length).
 pub const BUDGET_DB: f64 = -100.0;
-/// The output gain every case renders at (the model's default).
-const GAIN_DB: f64 = -6.0;
 
 /// A case of the accuracy set: constants and inputs as a function of time.
 #[derive(Clone, Copy)]
@@ -42,9 +40,9 @@ pub struct Case {
 }
 
 impl Case {
-    /// The case's inputs at `sample` of a render at `sample_rate`, with the output gain.
+    /// The case's inputs at `sample` of a render at `sample_rate` (the output gain at its default).
     pub fn controls(&self, sample_rate: f64) -> impl ControlSource + '_ {
-        move |sample: u64| ((self.inputs)(sample as f64 / sample_rate), GAIN_DB)
+        move |sample: u64| (self.inputs)(sample as f64 / sample_rate)
     }
 }
 

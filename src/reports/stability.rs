@@ -13,10 +13,11 @@
 
 use super::accuracy;
 use super::timing::{self, RenderSpec, TimedRender};
-use crate::engine::config::{self, ControlValues, OUTPUT_RAMP_S};
+use crate::engine::config::OUTPUT_RAMP_S;
 use crate::engine::synthesis::reference;
 use crate::engine::synthesis::MAX_PARTIALS;
 use crate::engine::ControlSource;
+use crate::engine::{Constant, Control, ControlValues};
 use crate::engine::{DrainMode, Engine, ModelConfig, VoiceBank};
 
 /// How long the cases render.
@@ -355,17 +356,15 @@ impl Outcome {
 }
 
 /// The inputs of a case as a function of the sample index.
-type Inputs = Box<dyn Fn(u64) -> (ControlValues, f64)>;
+type Inputs = Box<dyn Fn(u64) -> ControlValues>;
 
 /// Follow mode held full at 135°: continuous pouring at 12 glugs/s (the normal case).
-fn steady(_sample: u64) -> (ControlValues, f64) {
-    (
-        ControlValues {
-            tilt_deg: 135.0,
-            ..ControlValues::default()
-        },
-        -6.0,
-    )
+fn steady(_sample: u64) -> ControlValues {
+    ControlValues {
+        tilt_deg: 135.0,
+        gain_db: -6.0,
+        ..ControlValues::default()
+    }
 }
 
 /// Pours as [`steady`] for `pour_s`, then stands the bottle upright: nothing starts after.
@@ -377,13 +376,11 @@ fn pour_then_stop(sample_rate: f64, pour_s: f64) -> Inputs {
 fn pour_then_stop_at(sample_rate: f64, pour_s: f64, gain_db: f64) -> Inputs {
     Box::new(move |sample| {
         let pouring = (sample as f64) < pour_s * sample_rate;
-        (
-            ControlValues {
-                tilt_deg: if pouring { 135.0 } else { 0.0 },
-                ..ControlValues::default()
-            },
-            gain_db,
-        )
+        ControlValues {
+            tilt_deg: if pouring { 135.0 } else { 0.0 },
+            gain_db: gain_db,
+            ..ControlValues::default()
+        }
     })
 }
 
@@ -644,7 +641,7 @@ fn frequency_sweep(scale: Scale) -> Vec<Outcome> {
         0.4999 * fs,
         0.5 * fs,
         fs,
-        config::F1_HZ.max,
+        Constant::F1.range().max,
         1e9,
     ]
     .into_iter()
@@ -714,7 +711,7 @@ fn sample_rate_sweep(scale: Scale) -> Vec<Outcome> {
     ]
     .into_iter()
     .map(|requested| {
-        let fs = config::SAMPLE_RATE_HZ.sanitize(requested);
+        let fs = crate::engine::config::SAMPLE_RATE_HZ.sanitize(requested);
         let inputs = pour_then_stop(fs, 1.0);
         let run = run(requested, follow(), seconds, &inputs, scale.repeats());
         let span = (ENERGY_SPAN_S * fs).round() as u64;
@@ -754,15 +751,11 @@ fn flood(scale: Scale) -> Vec<Outcome> {
     };
     let busy = run(fs, busy_config, seconds, &steady, scale.repeats());
     let span = (ENERGY_SPAN_S * fs) as u64;
-    let fastest = |_: u64| {
-        (
-            ControlValues {
-                tilt_deg: 135.0,
-                pour_time_s: config::POUR_TIME_S.min,
-                ..ControlValues::default()
-            },
-            -6.0,
-        )
+    let fastest = |_: u64| ControlValues {
+        tilt_deg: 135.0,
+        pour_time_s: Control::PourTime.range().min,
+        gain_db: -6.0,
+        ..ControlValues::default()
     };
     let mut outcomes = Vec::new();
     for (name, drain) in [
@@ -773,7 +766,7 @@ fn flood(scale: Scale) -> Vec<Outcome> {
         ("flood for the whole render (follow)", DrainMode::Follow),
     ] {
         let config = ModelConfig {
-            pocket_ml: config::POCKET_ML.min,
+            pocket_ml: Constant::Pocket.range().min,
             drain,
             ..ModelConfig::default()
         };
@@ -810,24 +803,16 @@ fn tilt_flip(scale: Scale) -> Vec<Outcome> {
     let fs = 48_000.0;
     let seconds = scale.sweep_s();
     let sweep_samples = seconds * fs;
-    let sweep = move |sample: u64| {
-        (
-            ControlValues {
-                tilt_deg: 100.0 + 70.0 * (sample as f64 / sweep_samples),
-                ..ControlValues::default()
-            },
-            -6.0,
-        )
+    let sweep = move |sample: u64| ControlValues {
+        tilt_deg: 100.0 + 70.0 * (sample as f64 / sweep_samples),
+        gain_db: -6.0,
+        ..ControlValues::default()
     };
     let normal = run(fs, follow(), seconds, &sweep, scale.repeats());
-    let flip = |sample: u64| {
-        (
-            ControlValues {
-                tilt_deg: if sample.is_multiple_of(2) { 0.0 } else { 180.0 },
-                ..ControlValues::default()
-            },
-            -6.0,
-        )
+    let flip = |sample: u64| ControlValues {
+        tilt_deg: if sample.is_multiple_of(2) { 0.0 } else { 180.0 },
+        gain_db: -6.0,
+        ..ControlValues::default()
     };
     [("simulate", ModelConfig::default()), ("follow", follow())]
         .into_iter()
@@ -873,13 +858,12 @@ fn hostile_inputs(scale: Scale) -> Vec<Outcome> {
         Scale::Test => 0.5,
         Scale::Report => 5.0,
     };
-    type SetControl = fn(&mut ControlValues, &mut f64, f64);
-    let controls: [(&str, SetControl); 5] = [
-        ("tilt", |c, _, v| c.tilt_deg = v),
-        ("viscosity", |c, _, v| c.viscosity = v),
-        ("fill", |c, _, v| c.fill_percent = v),
-        ("pour time", |c, _, v| c.pour_time_s = v),
-        ("gain", |_, g, v| *g = v),
+    let controls = [
+        ("tilt", Control::Tilt),
+        ("viscosity", Control::Viscosity),
+        ("fill", Control::Fill),
+        ("pour time", Control::PourTime),
+        ("gain", Control::Gain),
     ];
     type SetConfig = fn(&mut ModelConfig, f64);
     let constants: [(&str, SetConfig); 11] = [
@@ -930,17 +914,17 @@ fn hostile_inputs(scale: Scale) -> Vec<Outcome> {
                 .into(),
         });
     };
-    for (name, set) in controls {
+    for (name, control) in controls {
         let runs = HOSTILE
             .iter()
             .map(|&value| {
                 // The bad value every other sample, so it also arrives mid-pour.
                 let inputs = move |sample: u64| {
-                    let (mut values, mut gain) = steady(sample);
+                    let mut values = steady(sample);
                     if sample % 2 == 1 {
-                        set(&mut values, &mut gain, value);
+                        values[control] = value;
                     }
-                    (values, gain)
+                    values
                 };
                 run(fs, follow(), seconds, &inputs, 1)
             })

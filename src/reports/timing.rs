@@ -5,7 +5,9 @@
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
-use crate::engine::{ControlSource, Controls, Engine, Lane, ModelConfig, Synthesis};
+use crate::engine::{
+    Control, ControlSource, Controls, Engine, Lane, ModelConfig, PerControl, Synthesis,
+};
 
 /// Samples per `process` call: a typical host block.
 pub const BLOCK: usize = 4096;
@@ -63,7 +65,7 @@ pub fn timed_render_on<S: Synthesis>(
     spec: &RenderSpec,
     controls: &impl ControlSource,
 ) -> TimedRender {
-    let mut lanes: [Vec<f64>; 5] = std::array::from_fn(|_| Vec::with_capacity(BLOCK));
+    let mut lanes: PerControl<Vec<f64>> = PerControl::from_fn(|_| Vec::with_capacity(BLOCK));
     let mut out = vec![0.0f32; BLOCK];
     let kept_len: u64 = spec
         .keep
@@ -97,24 +99,16 @@ pub fn timed_render_on<S: Synthesis>(
             let to_span_end = spec.energy_span - start % spec.energy_span;
             len = len.min(to_span_end as usize);
         }
-        for lane in &mut lanes {
-            lane.clear();
+        for &control in Control::ALL {
+            lanes[control].clear();
         }
         for sample in start..start + len as u64 {
-            let (values, gain_db) = controls.at(sample);
-            lanes[0].push(values.tilt_deg);
-            lanes[1].push(values.viscosity);
-            lanes[2].push(values.fill_percent);
-            lanes[3].push(values.pour_time_s);
-            lanes[4].push(gain_db);
+            let values = controls.at(sample);
+            for &control in Control::ALL {
+                lanes[control].push(values[control]);
+            }
         }
-        let block = Controls {
-            tilt_deg: lane(&lanes[0]),
-            viscosity: lane(&lanes[1]),
-            fill_percent: lane(&lanes[2]),
-            pour_time_s: lane(&lanes[3]),
-            gain_db: lane(&lanes[4]),
-        };
+        let block: Controls = PerControl::from_fn(|control| lane(&lanes[control]));
         let out = &mut out[..len];
         let began = Instant::now();
         engine.process(&block, out);

@@ -52,7 +52,10 @@ fn render_moving_at(
         }
         let controls = Controls {
             gain_db: Lane::Samples(&gain_db[done..done + len]),
-            ..Controls::constant(pouring(), 0.0)
+            ..Controls::constant(ControlValues {
+                gain_db: 0.0,
+                ..pouring()
+            })
         };
         engine.process(&controls, &mut out[done..done + len]);
         done += len;
@@ -154,18 +157,36 @@ fn a_reset_starts_at_the_gain_and_ceiling_asked_for() {
     };
     let mut fresh = Engine::new(RATE, early(0.05));
     let mut expected = vec![0.0f32; 4 * ramp_len()];
-    fresh.process(&Controls::constant(fast_pour, -3.0), &mut expected);
+    fresh.process(
+        &Controls::constant(ControlValues {
+            gain_db: -3.0,
+            ..fast_pour
+        }),
+        &mut expected,
+    );
     assert!(expected[..ramp_len()].iter().any(|y| *y != 0.0));
     assert_eq!(fresh.gain_now(), 10f64.powf(-3.0 / 20.0));
     assert_eq!(fresh.ceiling_now(), 0.05);
 
     let mut reused = Engine::new(RATE, early(1.0));
     let mut before = vec![0.0f32; 48_000];
-    reused.process(&Controls::constant(fast_pour, 12.0), &mut before);
+    reused.process(
+        &Controls::constant(ControlValues {
+            gain_db: 12.0,
+            ..fast_pour
+        }),
+        &mut before,
+    );
     reused.set_config(early(0.05));
     reused.reset();
     let mut after = vec![0.0f32; expected.len()];
-    reused.process(&Controls::constant(fast_pour, -3.0), &mut after);
+    reused.process(
+        &Controls::constant(ControlValues {
+            gain_db: -3.0,
+            ..fast_pour
+        }),
+        &mut after,
+    );
     assert_eq!(after, expected);
 }
 

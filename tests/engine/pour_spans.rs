@@ -126,9 +126,7 @@ fn pour_onsets_of(scene: &Scene, len: u64) -> Vec<UnitOnset> {
     pour.reset();
     let mut onsets = Vec::new();
     for sample in 0..len {
-        pour.step(sample, scene.values_at(sample).0, |onset| {
-            onsets.push(*onset)
-        });
+        pour.step(sample, scene.values_at(sample), |onset| onsets.push(*onset));
     }
     onsets
 }

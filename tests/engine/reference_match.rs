@@ -138,7 +138,7 @@ fn assert_controls_match(
         };
         let mut gain_db = -6.0;
         vary(sample as f64 / fs, &mut values, &mut gain_db);
-        (values, gain_db)
+        ControlValues { gain_db, ..values }
     };
     let len = (1.5 * fs) as u64;
     let fast = render_controls(sample_rate, config, &controls, len);

@@ -56,7 +56,10 @@ fn render_with(block: usize, lanes: Lanes) -> (Vec<f32>, Vec<bool>) {
             vec![-6.0; n],
         ];
         let controls = match lanes {
-            Lanes::Constant => Controls::constant(values, -6.0),
+            Lanes::Constant => Controls::constant(ControlValues {
+                gain_db: -6.0,
+                ..values
+            }),
             Lanes::PerSample => Controls {
                 tilt_deg: Lane::Samples(&per_sample[0]),
                 viscosity: Lane::Samples(&per_sample[1]),
@@ -122,7 +125,13 @@ fn lone_component(index: usize) -> (Vec<f32>, f64, f64, f64) {
             viscosity,
             ..ControlValues::default()
         };
-        engine.process(&Controls::constant(values, -6.0), chunk);
+        engine.process(
+            &Controls::constant(ControlValues {
+                gain_db: -6.0,
+                ..values
+            }),
+            chunk,
+        );
     }
     assert_eq!(engine.stats().units_started, 1);
     let unit = *engine.last_unit().unwrap();
@@ -169,8 +178,14 @@ fn a_unit_sounds_until_minus_120_db_and_stops_within_a_period() {
 fn units_stop_being_computed_below_minus_120_db() {
     let mut engine = Engine::new(FS, ModelConfig::default().deterministic());
     let mut out = vec![0.0f32; 4800];
-    let pour = Controls::constant(controls_at(0.0), -6.0);
-    let upright = Controls::constant(controls_at(4.0), -6.0);
+    let pour = Controls::constant(ControlValues {
+        gain_db: -6.0,
+        ..controls_at(0.0)
+    });
+    let upright = Controls::constant(ControlValues {
+        gain_db: -6.0,
+        ..controls_at(4.0)
+    });
     for _ in 0..10 {
         engine.process(&pour, &mut out);
     }

@@ -7,7 +7,7 @@ use proptest::prelude::*;
 
 use crate::support::fuzz::{self, any_number, toml_number};
 use sake_glug::engine::config::{self, Range};
-use sake_glug::engine::Lane;
+use sake_glug::engine::{Constant, Control, Lane};
 use sake_glug::offline::{Automation, Scene};
 
 /// Every key of a scene, the table it sits in, and the range of its numbers.
@@ -22,20 +22,20 @@ const KEYS: [(&str, &str, Range); 17] = [
             default: 1.0,
         },
     ),
-    ("", "tilt_deg", config::TILT_DEG),
-    ("", "viscosity_c", config::VISCOSITY),
-    ("", "fill_percent", config::FILL_PERCENT),
-    ("", "pour_time_s", config::POUR_TIME_S),
-    ("bottle", "capacity_ml", config::CAPACITY_ML),
-    ("bottle", "pocket_ml", config::POCKET_ML),
-    ("glug", "f1_hz", config::F1_HZ),
-    ("glug", "f2_hz", config::F2_HZ),
-    ("glug", "b1_per_s", config::B1_PER_S),
-    ("glug", "b2_per_s", config::B2_PER_S),
-    ("glug", "timing_jitter", config::TIMING_JITTER),
-    ("glug", "freq_jitter", config::FREQ_JITTER),
-    ("glug", "decay_sigma", config::DECAY_SIGMA),
-    ("output", "gain_db", config::GAIN_DB),
+    ("", "tilt_deg", Control::Tilt.range()),
+    ("", "viscosity_c", Control::Viscosity.range()),
+    ("", "fill_percent", Control::Fill.range()),
+    ("", "pour_time_s", Control::PourTime.range()),
+    ("bottle", "capacity_ml", Constant::Capacity.range()),
+    ("bottle", "pocket_ml", Constant::Pocket.range()),
+    ("glug", "f1_hz", Constant::F1.range()),
+    ("glug", "f2_hz", Constant::F2.range()),
+    ("glug", "b1_per_s", Constant::B1.range()),
+    ("glug", "b2_per_s", Constant::B2.range()),
+    ("glug", "timing_jitter", Constant::TimingJitter.range()),
+    ("glug", "freq_jitter", Constant::FreqJitter.range()),
+    ("glug", "decay_sigma", Constant::DecaySigma.range()),
+    ("output", "gain_db", Control::Gain.range()),
     (
         "",
         "seed",
@@ -139,11 +139,14 @@ fn assert_valid(scene: &Scene) -> Result<(), TestCaseError> {
     prop_assert!(scene
         .duration_s
         .is_none_or(|d| d > 0.0 && d <= sake_glug::offline::MAX_DURATION_S));
-    prop_assert!(in_range(&scene.tilt_deg, config::TILT_DEG));
-    prop_assert!(in_range(&scene.viscosity, config::VISCOSITY));
-    prop_assert!(in_range(&scene.fill_percent, config::FILL_PERCENT));
-    prop_assert!(in_range(&scene.pour_time_s, config::POUR_TIME_S));
-    prop_assert!(in_range(&scene.gain_db, config::GAIN_DB));
+    prop_assert!(in_range(&scene.lanes.tilt_deg, Control::Tilt.range()));
+    prop_assert!(in_range(&scene.lanes.viscosity, Control::Viscosity.range()));
+    prop_assert!(in_range(&scene.lanes.fill_percent, Control::Fill.range()));
+    prop_assert!(in_range(
+        &scene.lanes.pour_time_s,
+        Control::PourTime.range()
+    ));
+    prop_assert!(in_range(&scene.lanes.gain_db, Control::Gain.range()));
     prop_assert_eq!(scene.config, scene.config.sanitized());
     Ok(())
 }
@@ -189,7 +192,7 @@ fn fuzz_scene_toml() {
 
 #[test]
 fn fuzz_automation_lanes() {
-    let points = prop::collection::vec((any_number(), number_near(config::TILT_DEG)), 0..8);
+    let points = prop::collection::vec((any_number(), number_near(Control::Tilt.range())), 0..8);
     let cut = (
         0u64..20_000,
         1usize..600,
@@ -225,12 +228,15 @@ fn fuzz_automation_lanes() {
             let (first, len) = (cut.0, cut.1);
             let fs = scene.sample_rate as f64;
             let mut buffer = vec![0.0; len];
-            let lane = scene.tilt_deg.lane(first, fs, &mut buffer);
+            let lane = scene.lanes.tilt_deg.lane(first, fs, &mut buffer);
             for index in 0..len {
-                let expected = scene.tilt_deg.value_at((first + index as u64) as f64 / fs);
+                let expected = scene
+                    .lanes
+                    .tilt_deg
+                    .value_at((first + index as u64) as f64 / fs);
                 let got = lane.at(index);
                 prop_assert!(
-                    config::TILT_DEG.contains(got) && got == expected,
+                    Control::Tilt.range().contains(got) && got == expected,
                     "sample {}: lane {} against {}",
                     first + index as u64,
                     got,

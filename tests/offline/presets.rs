@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use sake_glug::engine::{ControlValues, ModelConfig, PRESETS};
+use sake_glug::engine::{ControlValues, ModelConfig, Preset, PRESETS};
 use sake_glug::offline::Scene;
 
 #[test]
@@ -21,7 +21,7 @@ fn every_preset_file_is_the_presets_own_scene() {
         );
         let scene = Scene::load(&path).unwrap();
         assert_eq!(scene.config, preset.config(ModelConfig::default()));
-        let (values, _) = scene.values_at(48_000);
+        let values = scene.values_at(48_000);
         let tilted = ControlValues {
             tilt_deg: 135.0,
             ..ControlValues::default()
@@ -41,11 +41,14 @@ fn every_preset_file_is_the_presets_own_scene() {
 
 #[test]
 fn presets_differ_where_they_should() {
-    let viscosity = |id: &str| PRESETS.iter().find(|p| p.id == id).unwrap().viscosity;
+    let default = ControlValues::default();
+    let config = ModelConfig::default();
+    let preset = |id: &str| Preset::find(id).unwrap();
+    let viscosity = |id: &str| preset(id).controls(default).viscosity;
     assert_eq!(viscosity("water"), 0.33);
     assert_eq!(viscosity("thin"), 0.29);
     assert_eq!(viscosity("thick"), 0.42);
-    let capacity = |id: &str| PRESETS.iter().find(|p| p.id == id).unwrap().capacity_ml;
+    let capacity = |id: &str| preset(id).config(config).capacity_ml;
     assert!(capacity("small-bottle") < 300.0 && capacity("large-bottle") > 300.0);
 }
 

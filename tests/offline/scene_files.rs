@@ -71,11 +71,11 @@ fn the_full_fixture_reads_every_key_with_its_own_value() {
     assert_eq!(scene.sample_rate, 44_100);
     assert_eq!(scene.duration_s, Some(7.25));
     let points = |pairs: &[(f64, f64)]| Automation::Points(pairs.to_vec());
-    assert_eq!(scene.tilt_deg, points(&[(0.0, 91.0), (0.75, 133.0)]));
-    assert_eq!(scene.viscosity, points(&[(0.0, 0.61), (2.0, 0.47)]));
-    assert_eq!(scene.fill_percent, Automation::Constant(88.5));
-    assert_eq!(scene.pour_time_s, points(&[(0.0, 6.5), (1.0, 4.25)]));
-    assert_eq!(scene.gain_db, points(&[(0.0, -9.5), (3.0, -3.0)]));
+    assert_eq!(scene.lanes.tilt_deg, points(&[(0.0, 91.0), (0.75, 133.0)]));
+    assert_eq!(scene.lanes.viscosity, points(&[(0.0, 0.61), (2.0, 0.47)]));
+    assert_eq!(scene.lanes.fill_percent, Automation::Constant(88.5));
+    assert_eq!(scene.lanes.pour_time_s, points(&[(0.0, 6.5), (1.0, 4.25)]));
+    assert_eq!(scene.lanes.gain_db, points(&[(0.0, -9.5), (3.0, -3.0)]));
     assert_eq!(
         scene.config,
         ModelConfig {

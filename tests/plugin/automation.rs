@@ -5,7 +5,7 @@
 
 use crate::clap_host::{ClapInstance, ParamChange};
 use crate::host::TestHost;
-use sake_glug::engine::{Controls, Engine, Lane};
+use sake_glug::engine::{ControlValues, Controls, Engine, Lane};
 
 const RATE: f64 = 48_000.0;
 const TOTAL: usize = 96_000;
@@ -55,7 +55,10 @@ fn engine_render() -> Vec<f32> {
         engine.set_config(config);
         let controls = Controls {
             gain_db: Lane::Samples(&gain_db[span.clone()]),
-            ..Controls::constant(params.control_values(), 0.0)
+            ..Controls::constant(ControlValues {
+                gain_db: 0.0,
+                ..params.control_values()
+            })
         };
         engine.process(&controls, &mut out[span]);
     }

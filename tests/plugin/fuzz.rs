@@ -8,8 +8,8 @@ use proptest::prelude::*;
 
 use crate::clap_host::ClapInstance;
 use crate::support::fuzz::{self, any_number};
-use sake_glug::device::midi::{CcDecoder, MidiMap, Target};
-use sake_glug::engine::config::{FILL_PERCENT, TILT_DEG, VISCOSITY};
+use sake_glug::device::midi::{CcDecoder, MidiMap};
+use sake_glug::engine::Control;
 
 /// A JSON value of any kind, numbers from every corner.
 fn json_value() -> impl Strategy<Value = serde_json::Value> {
@@ -171,21 +171,21 @@ fn fuzz_midi_cc_decoder() {
             let value = value.min(127);
             let expected = if !listening {
                 None
-            } else if Some(cc) == map.tilt_msb {
+            } else if Some(cc) == map.cc[Control::Tilt] {
                 match map.tilt_lsb {
                     Some(_) => {
                         msb = Some(value);
-                        Some((Target::Tilt, tilt_of(value, lsb)))
+                        Some((Control::Tilt, tilt_of(value, lsb)))
                     }
-                    None => Some((Target::Tilt, value as f64 / 127.0 * 180.0)),
+                    None => Some((Control::Tilt, value as f64 / 127.0 * 180.0)),
                 }
             } else if map.tilt_lsb.is_some() && Some(cc) == map.tilt_lsb {
                 lsb = value;
-                msb.map(|msb| (Target::Tilt, tilt_of(msb, value)))
-            } else if Some(cc) == map.viscosity {
-                Some((Target::Viscosity, value as f64 / 127.0))
-            } else if Some(cc) == map.fill {
-                Some((Target::Fill, value as f64 / 127.0 * 100.0))
+                msb.map(|msb| (Control::Tilt, tilt_of(msb, value)))
+            } else if Some(cc) == map.cc[Control::Viscosity] {
+                Some((Control::Viscosity, value as f64 / 127.0))
+            } else if Some(cc) == map.cc[Control::Fill] {
+                Some((Control::Fill, value as f64 / 127.0 * 100.0))
             } else {
                 None
             };
@@ -193,11 +193,7 @@ fn fuzz_midi_cc_decoder() {
                 (None, None) => {}
                 (Some((target, got)), Some((want_target, want))) => {
                     prop_assert_eq!(target, want_target);
-                    let range = match target {
-                        Target::Tilt => TILT_DEG,
-                        Target::Viscosity => VISCOSITY,
-                        Target::Fill => FILL_PERCENT,
-                    };
+                    let range = target.range();
                     prop_assert!(range.contains(got), "{:?} = {} out of range", target, got);
                     prop_assert!(
                         (got - want).abs() <= 1e-9 * range.max,

@@ -4,7 +4,33 @@
 use std::sync::atomic::Ordering::Relaxed;
 
 use crate::host::{cc, note_on, Playhead, TestHost};
-use sake_glug::device::midi::{CcDecoder, MidiMap, Overrides, Target};
+use sake_glug::device::midi::{CcDecoder, MidiMap, Overrides};
+use sake_glug::engine::{Control, ControlValues, PerControl};
+
+/// A map with these CCs for tilt (MSB, LSB), viscosity and fill.
+fn map_of(channel: Option<u8>, [tilt, tilt_lsb, viscosity, fill]: [Option<u8>; 4]) -> MidiMap {
+    MidiMap {
+        channel,
+        cc: PerControl {
+            tilt_deg: tilt,
+            viscosity,
+            fill_percent: fill,
+            pour_time_s: None,
+            gain_db: None,
+        },
+        tilt_lsb,
+    }
+}
+
+/// Tilt, viscosity and fill as given, the rest at their defaults.
+fn values(tilt_deg: f64, viscosity: f64, fill_percent: f64) -> ControlValues {
+    ControlValues {
+        tilt_deg,
+        viscosity,
+        fill_percent,
+        ..ControlValues::default()
+    }
+}
 
 #[test]
 fn fourteen_bit_tilt_assembles_msb_and_lsb() {
@@ -17,7 +43,7 @@ fn fourteen_bit_tilt_assembles_msb_and_lsb() {
         "an LSB before any MSB only waits"
     );
     let (target, coarse) = decoder.feed(&map, 0, 16, 96).expect("tilt MSB");
-    assert_eq!(target, Target::Tilt);
+    assert_eq!(target, Control::Tilt);
     assert_eq!(
         coarse,
         ((96 << 7) + 5) as f64 / 16383.0 * 180.0,
@@ -52,9 +78,12 @@ fn seven_bit_ccs_and_channel_filter() {
         ..MidiMap::default()
     };
     let mut decoder = CcDecoder::default();
-    assert_eq!(decoder.feed(&map, 2, 16, 127), Some((Target::Tilt, 180.0)));
-    assert_eq!(decoder.feed(&map, 2, 17, 0), Some((Target::Viscosity, 0.0)));
-    assert_eq!(decoder.feed(&map, 2, 18, 127), Some((Target::Fill, 100.0)));
+    assert_eq!(decoder.feed(&map, 2, 16, 127), Some((Control::Tilt, 180.0)));
+    assert_eq!(
+        decoder.feed(&map, 2, 17, 0),
+        Some((Control::Viscosity, 0.0))
+    );
+    assert_eq!(decoder.feed(&map, 2, 18, 127), Some((Control::Fill, 100.0)));
     assert_eq!(
         decoder.feed(&map, 3, 16, 64),
         None,
@@ -74,45 +103,33 @@ fn seven_bit_ccs_and_channel_filter() {
 
 #[test]
 fn saved_settings_round_trip_and_out_of_range_bytes_switch_off() {
-    let map = MidiMap {
-        channel: Some(15),
-        tilt_msb: Some(1),
-        tilt_lsb: Some(33),
-        viscosity: None,
-        fill: Some(0),
-    };
+    let map = map_of(Some(15), [Some(1), Some(33), None, Some(0)]);
     assert_eq!(MidiMap::from_raw(map.to_raw()), map);
     let garbage = MidiMap::from_raw([16, 128, 200, 127, 255]);
-    assert_eq!(
-        garbage,
-        MidiMap {
-            channel: None,
-            tilt_msb: None,
-            tilt_lsb: None,
-            viscosity: Some(127),
-            fill: None
-        }
-    );
+    assert_eq!(garbage, map_of(None, [None, None, Some(127), None]));
 }
 
 #[test]
 fn whichever_moved_last_wins() {
     let mut overrides = Overrides::default();
-    assert_eq!(overrides.apply([90.0, 0.33, 100.0]), [90.0, 0.33, 100.0]);
-    overrides.set(Target::Tilt, 135.0);
     assert_eq!(
-        overrides.apply([90.0, 0.33, 100.0]),
-        [135.0, 0.33, 100.0],
+        overrides.apply(values(90.0, 0.33, 100.0)),
+        values(90.0, 0.33, 100.0)
+    );
+    overrides.set(Control::Tilt, 135.0);
+    assert_eq!(
+        overrides.apply(values(90.0, 0.33, 100.0)),
+        values(135.0, 0.33, 100.0),
         "the device moved last"
     );
     assert_eq!(
-        overrides.apply([90.0, 0.33, 100.0]),
-        [135.0, 0.33, 100.0],
+        overrides.apply(values(90.0, 0.33, 100.0)),
+        values(135.0, 0.33, 100.0),
         "and stays in charge"
     );
     assert_eq!(
-        overrides.apply([100.0, 0.33, 100.0]),
-        [100.0, 0.33, 100.0],
+        overrides.apply(values(100.0, 0.33, 100.0)),
+        values(100.0, 0.33, 100.0),
         "the host moved the parameter"
     );
 }
@@ -138,11 +155,10 @@ fn ccs_drive_the_plugin_and_a_note_on_refills() {
         "note-on refills: {drained} -> {refilled}"
     );
     // Settings changed in the saved state take effect: the device on CC 1, 7-bit.
-    host.plugin.glug_params().set_midi_map(MidiMap {
-        tilt_msb: Some(1),
-        tilt_lsb: None,
-        ..MidiMap::default()
-    });
+    let mut map = MidiMap::default();
+    map.cc[Control::Tilt] = Some(1);
+    map.tilt_lsb = None;
+    host.plugin.glug_params().set_midi_map(map);
     host.process(64, vec![cc(0, 9, 1, 0)], Playhead::default());
     assert_eq!(host.plugin.feed().tilt_deg.load(Relaxed), 0.0);
 }

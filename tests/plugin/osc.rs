@@ -8,8 +8,8 @@ use std::time::{Duration, Instant};
 use rosc::{OscMessage, OscPacket, OscType};
 
 use crate::host::{peak, TestHost};
-use sake_glug::device::midi::Target;
 use sake_glug::device::{Axis, LiveControls, LiveReader};
+use sake_glug::engine::Control;
 use sake_glug::plugin::OscStatus;
 use sake_glug::SakeGlug;
 
@@ -203,8 +203,8 @@ fn fill_viscosity_and_refill_over_osc() {
     assert_eq!(volume_ml(&host), 150.0, "refilled to 50 % of 300 ml");
     assert_eq!(host.plugin.feed().tilt_deg.load(Relaxed), 0.0);
     let live = host.plugin.osc().live();
-    assert_eq!(live.value(Target::Viscosity), Some(1.0));
-    assert_eq!(live.value(Target::Tilt), Some(0.0));
+    assert_eq!(live.value(Control::Viscosity), Some(1.0));
+    assert_eq!(live.value(Control::Tilt), Some(0.0));
     // Poured, then refilled by /sakeglug/refill alone.
     send(
         &host,
@@ -252,19 +252,21 @@ fn the_live_reader_sees_every_new_value_once() {
     let live = LiveControls::default();
     let mut reader = LiveReader::default();
     assert_eq!(reader.poll(&live), Default::default());
-    live.set(Target::Tilt, 100.0);
-    live.set(Target::Tilt, 120.0);
+    live.set(Control::Tilt, 100.0);
+    live.set(Control::Tilt, 120.0);
     live.refill();
     live.refill();
     let changes = reader.poll(&live);
-    assert_eq!(changes.values, [Some(120.0), None, None]);
+    let set: Vec<_> = changes.set_values().collect();
+    assert_eq!(set, [(Control::Tilt, 120.0)]);
     assert!(changes.refill);
     assert_eq!(reader.poll(&live), Default::default(), "nothing new");
     // The same value again is news: it takes the control back from the parameter.
-    live.set(Target::Tilt, 120.0);
-    live.set(Target::Fill, f64::NAN);
-    live.set(Target::Fill, 250.0);
+    live.set(Control::Tilt, 120.0);
+    live.set(Control::Fill, f64::NAN);
+    live.set(Control::Fill, 250.0);
     let changes = reader.poll(&live);
-    assert_eq!(changes.values, [Some(120.0), None, Some(100.0)]);
+    let set: Vec<_> = changes.set_values().collect();
+    assert_eq!(set, [(Control::Tilt, 120.0), (Control::Fill, 100.0)]);
     assert!(!changes.refill);
 }

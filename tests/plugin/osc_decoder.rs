@@ -8,6 +8,7 @@ use sake_glug::device::axis::Axis;
 use sake_glug::device::osc::{
     decode_osc, OscControl, OscError, Pointing, GRAVITY_SOURCES, MAX_BUNDLE_DEPTH,
 };
+use sake_glug::engine::Control;
 
 fn message(address: &str, args: Vec<OscType>) -> OscPacket {
     OscPacket::Message(OscMessage {
@@ -40,7 +41,7 @@ fn error_of(packet: &OscPacket) -> OscError {
 /// The tilt, rounded to a nanodegree so that rounding in acos does not matter.
 fn tilt(controls: &[OscControl]) -> f64 {
     match controls {
-        [OscControl::Tilt(tilt)] => (tilt * 1e9).round() / 1e9,
+        [OscControl::Set(Control::Tilt, tilt)] => (tilt * 1e9).round() / 1e9,
         other => panic!("expected one tilt, got {other:?}"),
     }
 }
@@ -51,23 +52,23 @@ fn sake_glug_addresses_take_any_numeric_type() {
     let cases = [
         (
             message("/sakeglug/tilt", vec![Float(30.5)]),
-            OscControl::Tilt(30.5),
+            OscControl::Set(Control::Tilt, 30.5),
         ),
         (
             message("/sakeglug/tilt", vec![Double(12.25)]),
-            OscControl::Tilt(12.25),
+            OscControl::Set(Control::Tilt, 12.25),
         ),
         (
             message("/sakeglug/tilt", vec![Long(90)]),
-            OscControl::Tilt(90.0),
+            OscControl::Set(Control::Tilt, 90.0),
         ),
         (
             message("/sakeglug/viscosity", vec![Double(2.5)]),
-            OscControl::Viscosity(2.5),
+            OscControl::Set(Control::Viscosity, 2.5),
         ),
         (
             message("/sakeglug/fill", vec![Int(80)]),
-            OscControl::Fill(80.0),
+            OscControl::Set(Control::Fill, 80.0),
         ),
         (message("/sakeglug/refill", vec![]), OscControl::Refill),
         (
@@ -182,10 +183,10 @@ fn bundles_apply_in_order_and_nest() {
     assert_eq!(
         controls_of(&packet, Axis::PlusZ),
         [
-            OscControl::Tilt(10.0),
-            OscControl::Fill(50.0),
+            OscControl::Set(Control::Tilt, 10.0),
+            OscControl::Set(Control::Fill, 50.0),
             OscControl::Refill,
-            OscControl::Viscosity(3.0),
+            OscControl::Set(Control::Viscosity, 3.0),
         ]
     );
 }
@@ -202,7 +203,7 @@ fn nested(depth: usize) -> OscPacket {
 fn bundle_depth_is_bounded() {
     assert_eq!(
         controls_of(&nested(MAX_BUNDLE_DEPTH), Axis::PlusZ),
-        [OscControl::Tilt(5.0)]
+        [OscControl::Set(Control::Tilt, 5.0)]
     );
     assert_eq!(
         error_of(&nested(MAX_BUNDLE_DEPTH + 1)),

@@ -53,9 +53,7 @@ fn check_osc(packet: &[u8]) -> Result<(), TestCaseError> {
         match decode_osc(packet, axis, &mut |control| controls.push(control)) {
             Ok(()) => {
                 let finite = controls.iter().all(|control| match control {
-                    OscControl::Tilt(value)
-                    | OscControl::Viscosity(value)
-                    | OscControl::Fill(value) => value.is_finite(),
+                    OscControl::Set(_, value) => value.is_finite(),
                     OscControl::Refill => true,
                 });
                 prop_assert!(finite, "{controls:?}");

@@ -6,7 +6,8 @@ use std::sync::Arc;
 use crate::host::TestHost;
 use nice_plug::prelude::*;
 use sake_glug::engine::config;
-use sake_glug::plugin::{knobs as params, GlugParams};
+use sake_glug::engine::{Constant, Control};
+use sake_glug::plugin::{GlugParams, CEILING_DB};
 
 const MAIN_IDS: [&str; 5] = ["tilt", "visc", "fill", "pour", "gain"];
 const MODEL_IDS: [&str; 12] = [
@@ -71,32 +72,21 @@ fn every_value_text_value_round_trips() {
 
 #[test]
 fn ranges_lie_within_the_engine_ranges() {
-    use params::*;
-    let pairs = [
-        (TILT, config::TILT_DEG),
-        (VISCOSITY, config::VISCOSITY),
-        (FILL, config::FILL_PERCENT),
-        (POUR_TIME, config::POUR_TIME_S),
-        (GAIN, config::GAIN_DB),
-        (F1, config::F1_HZ),
-        (F2, config::F2_HZ),
-        (B1, config::B1_PER_S),
-        (B2, config::B2_PER_S),
-        (POCKET, config::POCKET_ML),
-        (CAPACITY, config::CAPACITY_ML),
-        (TIMING_JITTER, config::TIMING_JITTER),
-        (FREQ_JITTER, config::FREQ_JITTER),
-        (DECAY_SIGMA, config::DECAY_SIGMA),
-    ];
-    for (knob, range) in pairs {
+    let quantities = Control::ALL
+        .iter()
+        .map(|control| control.quantity())
+        .chain(Constant::ALL.iter().map(|constant| constant.quantity()));
+    for quantity in quantities {
+        let (min, max) = quantity.knob_bounds();
+        let range = quantity.range;
         assert!(
-            range.contains(knob.min) && range.contains(knob.max),
+            range.contains(min) && range.contains(max),
             "{}",
-            knob.name
+            quantity.name
         );
-        assert_eq!(knob.default, range.default, "{}", knob.name);
+        assert!(range.contains(range.default), "{}", quantity.name);
     }
-    let ceiling_min = 10f64.powf(CEILING_DB.min / 20.0);
+    let ceiling_min = 10f64.powf(CEILING_DB.range.min / 20.0);
     assert!(config::CEILING.contains(ceiling_min) && config::CEILING.contains(1.0));
 }
 
@@ -128,7 +118,7 @@ fn the_engine_gets_the_decimal_the_host_typed() {
         ),
         (4.2, 97.35, 0.29, 87.3)
     );
-    assert_eq!(params.gain_db(), -6.1);
+    assert_eq!(params.control_values().gain_db, -6.1);
     let model = params.model_config();
     assert_eq!(model.frequency_hz[0], 81.7);
     assert_eq!(model.decay_per_s[1], 38.9);

@@ -23,10 +23,7 @@ fn engine_render(host: &TestHost, total: usize) -> Vec<f32> {
     let params = host.plugin.glug_params();
     let mut engine = Engine::new(RATE as f64, params.model_config());
     let mut out = vec![0.0; total];
-    engine.process(
-        &Controls::constant(params.control_values(), params.gain_db()),
-        &mut out,
-    );
+    engine.process(&Controls::constant(params.control_values()), &mut out);
     out
 }
 

@@ -6,9 +6,9 @@
 use std::path::{Path, PathBuf};
 
 use nice_plug::prelude::Vst3Plugin;
+use sake_glug::engine::{Knob, PresetValue};
 use sake_glug::engine::{Preset, PRESETS};
-use sake_glug::plugin::knobs::{B1, B2, CAPACITY, F1, F2, POCKET, POUR_TIME, VISCOSITY};
-use sake_glug::plugin::{vstpreset, Knob};
+use sake_glug::plugin::{exact, vstpreset};
 use sake_glug::SakeGlugVst3;
 
 use crate::clap_host::ClapInstance;
@@ -112,17 +112,18 @@ fn clap_stream(component_state: &[u8]) -> Vec<u8> {
 }
 
 /// Each parameter a preset sets, by the name a host lists, with its knob and the preset's value.
-fn preset_parameters(preset: &Preset) -> [(&'static str, Knob, f64); 8] {
-    [
-        ("Viscosity", VISCOSITY, preset.viscosity),
-        ("Pour time", POUR_TIME, preset.pour_time_s),
-        ("Capacity", CAPACITY, preset.capacity_ml),
-        ("Pocket volume", POCKET, preset.pocket_ml),
-        ("f1", F1, preset.frequency_hz[0]),
-        ("f2", F2, preset.frequency_hz[1]),
-        ("B1", B1, preset.decay_per_s[0]),
-        ("B2", B2, preset.decay_per_s[1]),
-    ]
+fn preset_parameters(preset: &Preset) -> Vec<(&'static str, Knob, f64)> {
+    preset
+        .values
+        .iter()
+        .map(|value| {
+            let (quantity, value) = match *value {
+                PresetValue::Control(control, value) => (control.quantity(), value),
+                PresetValue::Constant(constant, value) => (constant.quantity(), value),
+            };
+            (quantity.name, quantity.knob, value)
+        })
+        .collect()
 }
 
 #[test]
@@ -190,7 +191,7 @@ fn each_files_state_loads_in_the_plugin_as_the_preset() {
                 Some((_, knob, value)) => {
                     let number: f32 = shown.split_whitespace().next().unwrap().parse().unwrap();
                     assert_eq!(
-                        knob.exact(number),
+                        exact(knob, number),
                         *value,
                         "{}: {name} shows {shown}",
                         preset.name

@@ -89,11 +89,10 @@ fn the_peak_voice_count_is_counted_where_it_happens() {
     let fs = 1_000.0;
     let controls = |sample: u64| {
         let tilt_deg = if sample < 1_000 { 135.0 } else { 0.0 };
-        let values = ControlValues {
+        ControlValues {
             tilt_deg,
             ..ControlValues::default()
-        };
-        (values, -6.0)
+        }
     };
     let len = 3_000;
     let spec = RenderSpec {
@@ -108,8 +107,7 @@ fn the_peak_voice_count_is_counted_where_it_happens() {
     let mut engine = Engine::new(fs, ModelConfig::default());
     let mut truth = 0;
     for sample in 0..len {
-        let (values, gain_db) = controls(sample);
-        engine.process(&Controls::constant(values, gain_db), &mut [0.0]);
+        engine.process(&Controls::constant(controls(sample)), &mut [0.0]);
         truth = truth.max(engine.sounding_components());
     }
     assert!(truth > 0);

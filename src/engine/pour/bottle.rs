@@ -1,7 +1,8 @@
 //! The bottle's residual volume and its tilt-dependent drain (MODEL.md §2, §3, §8).
 
 use super::curves::{CurveSegment, FLOW, REST, SUBMERGED};
-use crate::engine::config::{ControlValues, DrainMode, ModelConfig};
+use crate::engine::config::{DrainMode, ModelConfig};
+use crate::engine::controls::ControlValues;
 
 /// What one sample of pouring did.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -14,50 +14,26 @@ pub use onsets::MAX_ONSETS_PER_SAMPLE;
 pub use randomness::UnitShape;
 
 use crate::engine::amplitude::unit_amplitude;
-use crate::engine::config::{
-    ControlValues, DrainMode, ModelConfig, Range, FILL_PERCENT, POUR_TIME_S, TILT_DEG, VISCOSITY,
-};
-use crate::engine::controls::{Controls, Lane};
+use crate::engine::config::{DrainMode, ModelConfig, Range};
+use crate::engine::controls::{Control, ControlValues, Controls, Lane, PerControl};
 use bottle::{Bottle, SpanLevels, SPAN};
 use exact::Direction;
 use onsets::OnsetDetector;
 use randomness::UnitDraws;
 use span::{PlainRun, PourState};
 
-/// The inputs of up to a grid period of samples, brought into range.
-struct SpanInputs {
-    tilt_deg: [f64; SPAN],
-    viscosity: [f64; SPAN],
-    fill_percent: [f64; SPAN],
-    pour_time_s: [f64; SPAN],
-}
+/// The inputs of up to a grid period of samples, brought into range (the output gain's row
+/// unused: it does not drive the pour).
+type SpanInputs = PerControl<[f64; SPAN]>;
 
-impl Default for SpanInputs {
-    fn default() -> Self {
-        Self {
-            tilt_deg: [0.0; SPAN],
-            viscosity: [0.0; SPAN],
-            fill_percent: [0.0; SPAN],
-            pour_time_s: [0.0; SPAN],
-        }
-    }
-}
-
-impl SpanInputs {
-    /// The first `len` ≤ [`SPAN`] samples of `controls`, each as
-    /// [`ControlValues::sanitized`] would give it.
-    fn read(&mut self, controls: &Controls, len: usize) {
-        read_lane(&controls.tilt_deg, &mut self.tilt_deg[..len], TILT_DEG);
-        read_lane(&controls.viscosity, &mut self.viscosity[..len], VISCOSITY);
+/// The first `len` ≤ [`SPAN`] samples of the controls that drive the pour, each as
+/// [`ControlValues::sanitized`] would give it.
+fn read_span(inputs: &mut SpanInputs, controls: &Controls, len: usize) {
+    for control in Control::pour() {
         read_lane(
-            &controls.fill_percent,
-            &mut self.fill_percent[..len],
-            FILL_PERCENT,
-        );
-        read_lane(
-            &controls.pour_time_s,
-            &mut self.pour_time_s[..len],
-            POUR_TIME_S,
+            &controls[control],
+            &mut inputs[control][..len],
+            control.range(),
         );
     }
 }
@@ -327,13 +303,13 @@ impl Pour {
         self.plain = None;
         let mut advanced = Advanced::nothing_yet(self.bottle.volume_ml());
         let capacity_ml = self.config.capacity_ml;
-        let mut inputs = SpanInputs::default();
+        let mut inputs = SpanInputs::splat([0.0; SPAN]);
         let mut levels = SpanLevels::default();
         let mut start = 0;
         while start < count {
             let len = (count - start).min(SPAN);
             let controls = controls.offset(start);
-            inputs.read(&controls, len);
+            read_span(&mut inputs, &controls, len);
             self.bottle.levels_of_span(
                 &inputs.tilt_deg[..len],
                 &inputs.pour_time_s[..len],

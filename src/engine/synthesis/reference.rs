@@ -154,7 +154,8 @@ pub fn evaluate(
     let mut gains = Vec::with_capacity((window.end - window.start) as usize);
     let mut gain = Ramped::new(sample_rate);
     for sample in 0..window.end {
-        let (values, gain_db) = controls.at(sample);
+        let values = controls.at(sample);
+        let gain_db = values.gain_db;
         // §5: c is taken at the onset's sample, brought into [0, 1].
         let viscosity = VISCOSITY.bring_in(values.viscosity);
         let mut this_sample = 0;

@@ -3,6 +3,7 @@
 use nice_plug::prelude::*;
 use nice_plug_egui::widgets::ParamSlider;
 
+use crate::engine::Control;
 use crate::plugin::params::GlugParams;
 
 /// The main group's sliders.
@@ -16,11 +17,9 @@ pub fn show(ui: &mut egui::Ui, params: &GlugParams, setter: &ParamSetter) {
         .num_columns(2)
         .spacing([8.0, 6.0])
         .show(ui, |ui| {
-            row(ui, &params.tilt, setter, MAIN_SLIDER_WIDTH);
-            row(ui, &params.viscosity, setter, MAIN_SLIDER_WIDTH);
-            row(ui, &params.fill, setter, MAIN_SLIDER_WIDTH);
-            row(ui, &params.pour_time, setter, MAIN_SLIDER_WIDTH);
-            row(ui, &params.gain, setter, MAIN_SLIDER_WIDTH);
+            for &control in Control::ALL {
+                row(ui, &params.controls[control], setter, MAIN_SLIDER_WIDTH);
+            }
         });
     egui::CollapsingHeader::new("Model").show(ui, |ui| {
         let model = &params.model;
@@ -28,22 +27,7 @@ pub fn show(ui: &mut egui::Ui, params: &GlugParams, setter: &ParamSetter) {
             .num_columns(2)
             .spacing([8.0, 4.0])
             .show(ui, |ui| {
-                for param in [
-                    &model.f1,
-                    &model.f2,
-                    &model.b1,
-                    &model.b2,
-                    &model.pocket,
-                    &model.capacity,
-                ] {
-                    row(ui, param, setter, MODEL_SLIDER_WIDTH);
-                }
-                for param in [
-                    &model.timing_jitter,
-                    &model.freq_jitter,
-                    &model.decay_sigma,
-                    &model.ceiling,
-                ] {
+                for param in model.constants.iter().chain([&model.ceiling]) {
                     row(ui, param, setter, MODEL_SLIDER_WIDTH);
                 }
                 row(ui, &model.seed, setter, MODEL_SLIDER_WIDTH);

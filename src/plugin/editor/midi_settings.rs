@@ -2,6 +2,7 @@
 
 use nice_plug::context::gui::GuiContext;
 
+use crate::device::midi::{MidiSetting, OFF};
 use crate::plugin::params::GlugParams;
 
 /// Shows the panel; returns whether the user changed a setting in this frame.
@@ -28,10 +29,12 @@ pub fn show(ui: &mut egui::Ui, params: &GlugParams) -> bool {
             );
             map.channel = (channel > 0).then(|| channel - 1);
             ui.end_row();
-            cc_row(ui, "Tilt CC (MSB)", &mut map.tilt_msb);
-            cc_row(ui, "Tilt LSB CC", &mut map.tilt_lsb);
-            cc_row(ui, "Viscosity CC", &mut map.viscosity);
-            cc_row(ui, "Fill CC", &mut map.fill);
+            for setting in MidiSetting::all().filter(|&setting| setting != MidiSetting::Channel) {
+                let raw = map.raw(setting);
+                let mut cc = (raw <= setting.max()).then_some(raw);
+                cc_row(ui, &setting.label(), &mut cc);
+                map.set_raw(setting, cc.unwrap_or(OFF));
+            }
         });
     if map != before {
         params.set_midi_map(map);
