@@ -17,10 +17,9 @@ pub struct Outflow {
     pub refilled: bool,
 }
 
-/// Levels that depend only on tilt, pour time and capacity, kept until one of those changes.
+/// The levels of one sample, set by its tilt, pour time and capacity (MODEL.md §2, §3).
 #[derive(Debug, Clone, Copy)]
 pub struct Levels {
-    key: [f64; 3],
     /// r(θ)·C: the liquid above it pours.
     pub rest_ml: f64,
     /// s(θ)·C: above it the mouth is submerged and the pour glugs.
@@ -30,12 +29,52 @@ pub struct Levels {
 }
 
 impl Levels {
-    /// The outflow of a sample that starts at `volume_ml` (MODEL.md §3).
-    #[inline]
-    pub fn outflow_ml(&self, volume_ml: f64) -> f64 {
-        self.max_outflow_per_sample_ml
-            .min((volume_ml - self.rest_ml).max(0.0))
+    /// One sample of the drain (MODEL.md §3, §8), the only statement of it: every way of stepping
+    /// the pour takes its samples with this, the closed forms of `super::span` included. V starts
+    /// at `volume_ml`, or at the fill level `fill_ml()` after a refill and at every sample of
+    /// follow mode; the outflow is min(k/fs, max(V − r·C, 0)); the mouth is submerged while
+    /// V > s·C; in simulate mode V falls by the outflow. Returns the outflow and V after it.
+    #[inline(always)]
+    pub fn drain(
+        &self,
+        volume_ml: f64,
+        fill_ml: impl FnOnce() -> f64,
+        refilled: bool,
+        drain: DrainMode,
+    ) -> (Outflow, f64) {
+        let volume_before_ml = if refilled || drain == DrainMode::Follow {
+            fill_ml()
+        } else {
+            volume_ml
+        };
+        let amount_ml = self
+            .max_outflow_per_sample_ml
+            .min((volume_before_ml - self.rest_ml).max(0.0));
+        let volume_after_ml = match drain {
+            DrainMode::Simulate => volume_before_ml - amount_ml,
+            DrainMode::Follow => volume_before_ml,
+        };
+        let outflow = Outflow {
+            volume_before_ml,
+            amount_ml,
+            submerged: volume_before_ml > self.submerged_ml,
+            refilled,
+        };
+        (outflow, volume_after_ml)
     }
+
+    /// [`Levels::drain`] of a sample that refills nothing, from a V that is the fill level
+    /// already in follow mode.
+    #[inline(always)]
+    pub fn drain_on(&self, volume_ml: f64, drain: DrainMode) -> (Outflow, f64) {
+        self.drain(volume_ml, || volume_ml, false, drain)
+    }
+}
+
+/// V at fill level `fill_percent` (MODEL.md §8).
+#[inline(always)]
+pub fn fill_ml(fill_percent: f64, capacity_ml: f64) -> f64 {
+    fill_percent / 100.0 * capacity_ml
 }
 
 /// The levels of each sample of a span (see [`Bottle::levels_of_span`]).
@@ -59,21 +98,10 @@ impl Default for SpanLevels {
 }
 
 impl SpanLevels {
-    /// r·C, s·C and k/fs of sample `index`.
+    /// The levels of sample `index`.
     #[inline]
-    pub fn of(&self, index: usize) -> (f64, f64, f64) {
-        (
-            self.rest_ml[index],
-            self.submerged_ml[index],
-            self.max_outflow_ml[index],
-        )
-    }
-
-    /// The levels of sample `index`, whose controls give `key`.
-    #[inline]
-    pub fn at(&self, index: usize, key: [f64; 3]) -> Levels {
+    pub fn at(&self, index: usize) -> Levels {
         Levels {
-            key,
             rest_ml: self.rest_ml[index],
             submerged_ml: self.submerged_ml[index],
             max_outflow_per_sample_ml: self.max_outflow_ml[index],
@@ -87,6 +115,8 @@ pub struct Bottle {
     refill_pending: bool,
     last_fill_percent: f64,
     levels: Levels,
+    /// The tilt, pour time and capacity that `levels` are of.
+    levels_key: [f64; 3],
     /// The segments of r, s and h that the last tilt fell in: a tilt that moves a little from
     /// sample to sample rarely leaves them.
     segments: [CurveSegment; 3],
@@ -100,11 +130,11 @@ impl Bottle {
             refill_pending: true,
             last_fill_percent: f64::NAN,
             levels: Levels {
-                key: [f64::NAN; 3],
                 rest_ml: 0.0,
                 submerged_ml: 0.0,
                 max_outflow_per_sample_ml: 0.0,
             },
+            levels_key: [f64::NAN; 3],
             segments: [CurveSegment::default(); 3],
         }
     }
@@ -130,7 +160,7 @@ impl Bottle {
     pub fn is_steady_under(&self, controls: &ControlValues, capacity_ml: f64) -> bool {
         !self.refill_pending
             && controls.fill_percent == self.last_fill_percent
-            && [controls.tilt_deg, controls.pour_time_s, capacity_ml] == self.levels.key
+            && [controls.tilt_deg, controls.pour_time_s, capacity_ml] == self.levels_key
     }
 
     /// Whether no sample of a span with these fill levels refills the bottle: no refill is
@@ -171,26 +201,14 @@ impl Bottle {
         levels: &Levels,
         config: &ModelConfig,
     ) -> Outflow {
-        let fill_ml = fill_percent / 100.0 * config.capacity_ml;
         let fill_changed = fill_percent != self.last_fill_percent;
         self.last_fill_percent = fill_percent;
         let refilled = self.refill_pending || (config.drain == DrainMode::Simulate && fill_changed);
         self.refill_pending = false;
-        if refilled || config.drain == DrainMode::Follow {
-            self.volume_ml = fill_ml;
-        }
-
-        let volume_before_ml = self.volume_ml;
-        let amount_ml = levels.outflow_ml(volume_before_ml);
-        if config.drain == DrainMode::Simulate {
-            self.volume_ml = volume_before_ml - amount_ml;
-        }
-        Outflow {
-            volume_before_ml,
-            amount_ml,
-            submerged: volume_before_ml > levels.submerged_ml,
-            refilled,
-        }
+        let fill = || fill_ml(fill_percent, config.capacity_ml);
+        let (outflow, volume_ml) = levels.drain(self.volume_ml, fill, refilled, config.drain);
+        self.volume_ml = volume_ml;
+        outflow
     }
 
     /// The levels of every sample of a span whose tilt (and perhaps pour time) changes from
@@ -231,41 +249,33 @@ impl Bottle {
             }
         }
         if let Some(last) = len.checked_sub(1) {
-            self.levels = levels.at(last, [tilts[last], pour_times[last], capacity_ml]);
+            self.levels = levels.at(last);
+            self.levels_key = [tilts[last], pour_times[last], capacity_ml];
         }
     }
 
     /// [`Bottle::step`] again under the controls of the previous step: no refill can be pending
-    /// and no level can have changed, so only the volume moves. Same arithmetic, same result.
+    /// and no level can have changed, so only the volume moves.
     #[inline]
     pub fn step_steady(&mut self, drain: DrainMode) -> Outflow {
-        let levels = &self.levels;
-        let volume_before_ml = self.volume_ml;
-        let amount_ml = levels.outflow_ml(volume_before_ml);
-        if drain == DrainMode::Simulate {
-            self.volume_ml = volume_before_ml - amount_ml;
-        }
-        Outflow {
-            volume_before_ml,
-            amount_ml,
-            submerged: volume_before_ml > levels.submerged_ml,
-            refilled: false,
-        }
+        let (outflow, volume_ml) = self.levels.drain_on(self.volume_ml, drain);
+        self.volume_ml = volume_ml;
+        outflow
     }
 
     #[inline]
     fn levels(&mut self, controls: &ControlValues, capacity_ml: f64) -> Levels {
         let key = [controls.tilt_deg, controls.pour_time_s, capacity_ml];
-        if key != self.levels.key {
+        if key != self.levels_key {
             let tilt = controls.tilt_deg;
             let [rest, submerged, flow] = &mut self.segments;
             let rate_ml_per_s = capacity_ml / controls.pour_time_s * FLOW.at_in(tilt, flow);
             self.levels = Levels {
-                key,
                 rest_ml: REST.at_in(tilt, rest) * capacity_ml,
                 submerged_ml: SUBMERGED.at_in(tilt, submerged) * capacity_ml,
                 max_outflow_per_sample_ml: rate_ml_per_s / self.sample_rate,
             };
+            self.levels_key = key;
         }
         self.levels
     }
@@ -280,6 +290,36 @@ mod tests {
             tilt_deg,
             ..ControlValues::default()
         }
+    }
+
+    #[test]
+    fn one_sample_of_drain_keeps_the_models_boundaries() {
+        let levels = Levels {
+            rest_ml: 100.0,
+            submerged_ml: 150.0,
+            max_outflow_per_sample_ml: 2.0,
+        };
+        let fill_ml = 250.0;
+        let sample = |volume_ml, refilled, drain| {
+            let (outflow, after) = levels.drain(volume_ml, || fill_ml, refilled, drain);
+            (
+                outflow.volume_before_ml,
+                outflow.amount_ml,
+                outflow.submerged,
+                after,
+            )
+        };
+        use DrainMode::{Follow, Simulate};
+        // Nothing flows at the rest level; above it, what lies above it, at most k/fs.
+        assert_eq!(sample(100.0, false, Simulate), (100.0, 0.0, false, 100.0));
+        assert_eq!(sample(101.0, false, Simulate), (101.0, 1.0, false, 100.0));
+        // At the submerged level the mouth is clear; only above it is it under the liquid.
+        assert_eq!(sample(150.0, false, Simulate), (150.0, 2.0, false, 148.0));
+        assert_eq!(sample(150.5, false, Simulate), (150.5, 2.0, true, 148.5));
+        // A refill starts from the fill level; follow mode starts there at every sample and
+        // does not lower V.
+        assert_eq!(sample(120.0, true, Simulate), (250.0, 2.0, true, 248.0));
+        assert_eq!(sample(120.0, false, Follow), (250.0, 2.0, true, 250.0));
     }
 
     #[test]

@@ -14,9 +14,9 @@ pub use onsets::MAX_ONSETS_PER_SAMPLE;
 pub use randomness::UnitShape;
 
 use crate::engine::amplitude::unit_amplitude;
-use crate::engine::config::{DrainMode, ModelConfig, Range};
+use crate::engine::config::{ModelConfig, Range};
 use crate::engine::controls::{Control, ControlValues, Controls, Lane, PerControl};
-use bottle::{Bottle, SpanLevels, SPAN};
+use bottle::{fill_ml, Bottle, SpanLevels, SPAN};
 use exact::Direction;
 use onsets::OnsetDetector;
 use randomness::UnitDraws;
@@ -270,7 +270,7 @@ impl Pour {
                         self.plain = None;
                     }
                     advanced.last = self.take_plain(&run, taken);
-                    if run.amount_ml > 0.0 {
+                    if run.outflow.amount_ml > 0.0 {
                         advanced.flowed_until = Some(sample + taken);
                     }
                     done += taken;
@@ -331,14 +331,7 @@ impl Pour {
             } else {
                 for (index, &fill) in fills.iter().enumerate() {
                     let sample = first + index as u64;
-                    let key = [
-                        inputs.tilt_deg[index],
-                        inputs.pour_time_s[index],
-                        capacity_ml,
-                    ];
-                    let outflow = self
-                        .bottle
-                        .step_with(fill, &levels.at(index, key), &self.config);
+                    let outflow = self.bottle.step_with(fill, &levels.at(index), &self.config);
                     if outflow.refilled {
                         self.onsets.clear();
                     }
@@ -355,9 +348,9 @@ impl Pour {
         advanced
     }
 
-    /// The samples of a span that refills nothing, with the arithmetic of [`Bottle::step_with`]
-    /// and of the onset detector, but V and g kept in registers: a sample that starts a unit
-    /// goes through the detector itself, from the state before it.
+    /// The samples of a span that refills nothing, each drained as [`Bottle::step_with`] drains
+    /// it and counted with the arithmetic of the onset detector, but V and g kept in registers: a
+    /// sample that starts a unit goes through the detector itself, from the state before it.
     fn step_span_without_refill(
         &mut self,
         first_sample: u64,
@@ -367,33 +360,20 @@ impl Pour {
         advanced: &mut Advanced,
         emit: &mut impl FnMut(&UnitOnset),
     ) {
-        let simulate = self.config.drain == DrainMode::Simulate;
+        let drain = self.config.drain;
         let capacity_ml = self.config.capacity_ml;
         let mut volume = self.bottle.volume_ml();
         let mut accumulated = self.onsets.accumulated_ml();
         let mut pocket = self.draws.next_pocket_ml(&self.config);
         for index in 0..len {
-            if !simulate {
-                volume = inputs.fill_percent[index] / 100.0 * capacity_ml;
-            }
-            let (rest_ml, submerged_ml, max_outflow_ml) = levels.of(index);
-            let volume_before_ml = volume;
-            let amount_ml = max_outflow_ml.min((volume - rest_ml).max(0.0));
-            let submerged = volume > submerged_ml;
-            if simulate {
-                volume = volume_before_ml - amount_ml;
-            }
-            let outflow = Outflow {
-                volume_before_ml,
-                amount_ml,
-                submerged,
-                refilled: false,
-            };
+            let fill = || fill_ml(inputs.fill_percent[index], capacity_ml);
+            let (outflow, volume_after) = levels.at(index).drain(volume, fill, false, drain);
+            volume = volume_after;
             let sample = first_sample + index as u64;
-            if amount_ml > 0.0 {
+            if outflow.amount_ml > 0.0 {
                 advanced.flowed_until = Some(sample + 1);
-                if submerged {
-                    let sum = accumulated + amount_ml;
+                if outflow.submerged {
+                    let sum = accumulated + outflow.amount_ml;
                     if sum >= pocket {
                         self.onsets.set_accumulated_ml(accumulated);
                         self.count_onsets(sample, inputs.viscosity[index], outflow, &mut *emit);
@@ -420,7 +400,8 @@ impl Pour {
         }
     }
 
-    /// `count` plain samples of `run`; returns the last one's outflow.
+    /// `count` plain samples of `run`; returns the last one's outflow: the run's, from the V
+    /// before that sample.
     fn take_plain(&mut self, run: &PlainRun, count: u64) -> Outflow {
         let volume = self.bottle.volume_ml();
         let step = run.volume_step;
@@ -442,9 +423,7 @@ impl Pour {
         }
         Outflow {
             volume_before_ml,
-            amount_ml: run.amount_ml,
-            submerged: run.submerged,
-            refilled: false,
+            ..run.outflow
         }
     }
 

@@ -8,7 +8,7 @@
 //! (the outflow shrinks) or the submerged level (the glugs stop), V or g leaving its binade. That
 //! sample is then stepped on its own, and a new run is planned from there.
 
-use super::bottle::Levels;
+use super::bottle::{Levels, Outflow};
 use super::exact::{BinadeSteps, Direction};
 use crate::engine::config::DrainMode;
 
@@ -17,10 +17,9 @@ use crate::engine::config::DrainMode;
 pub struct PlainRun {
     /// Plain samples left in the stretch.
     pub samples_left: u64,
-    /// The outflow of every one of them.
-    pub amount_ml: f64,
-    /// Whether the mouth is submerged at every one of them.
-    pub submerged: bool,
+    /// Each of them as the per-sample drain takes the first: the same outflow and mouth, only V
+    /// at the start differs.
+    pub outflow: Outflow,
     /// What V falls by in each (0 if it does not move).
     pub volume_step: f64,
     /// What g rises by in each (0 if it does not move).
@@ -43,14 +42,17 @@ impl PlainRun {
     pub fn plan(state: &PourState) -> Option<Self> {
         let levels = state.levels;
         let volume = state.volume_ml;
-        let amount_ml = levels.outflow_ml(volume);
-        let submerged = volume > levels.submerged_ml;
+        let (outflow, _) = levels.drain_on(volume, state.drain);
+        let Outflow {
+            amount_ml,
+            submerged,
+            ..
+        } = outflow;
         if amount_ml == 0.0 {
             // Nothing flows, so nothing moves, for as long as the controls hold.
             return Some(Self {
                 samples_left: u64::MAX,
-                amount_ml,
-                submerged,
+                outflow,
                 volume_step: 0.0,
                 accumulated_step: 0.0,
             });
@@ -58,22 +60,27 @@ impl PlainRun {
         let mut samples = u64::MAX;
         let mut volume_step = 0.0;
         if state.drain == DrainMode::Simulate {
-            // The outflow is the full k only while V − r·C ≥ k; below that each sample differs.
+            // Only the full outflow k is the same from sample to sample; below it each differs.
             let max_outflow = levels.max_outflow_per_sample_ml;
-            if volume - levels.rest_ml < max_outflow {
+            if amount_ml < max_outflow {
                 return None;
             }
-            let steps = BinadeSteps::of(volume, max_outflow, Direction::Down)?;
+            let steps = BinadeSteps::of(volume, amount_ml, Direction::Down)?;
             volume_step = steps.step;
             samples = steps.max_steps;
             if volume_step > 0.0 {
-                let volume_at = |j: u64| steps.after(volume, j, Direction::Down);
-                // Sample j is plain while V_j − r·C ≥ k, and glugs alike while V_j > s·C.
-                let full_outflow = |j: u64| volume_at(j) - levels.rest_ml >= max_outflow;
+                // Sample j as the per-sample step takes it, from V_j.
+                let sample = |j: u64| {
+                    let volume_j = steps.after(volume, j, Direction::Down);
+                    levels.drain_on(volume_j, state.drain).0
+                };
+                // Sample j is plain while its outflow is the full k, and glugs alike while the
+                // mouth stays submerged.
+                let full_outflow = |j: u64| sample(j).amount_ml == max_outflow;
                 let estimate = (volume - levels.rest_ml - max_outflow) / volume_step + 1.0;
                 samples = samples.min(count_while(estimate, samples, full_outflow));
                 if submerged {
-                    let above = |j: u64| volume_at(j) > levels.submerged_ml;
+                    let above = |j: u64| sample(j).submerged;
                     let estimate = (volume - levels.submerged_ml) / volume_step + 1.0;
                     samples = samples.min(count_while(estimate, samples, above));
                 }
@@ -97,8 +104,7 @@ impl PlainRun {
         }
         (samples > 0).then_some(Self {
             samples_left: samples,
-            amount_ml,
-            submerged,
+            outflow,
             volume_step,
             accumulated_step,
         })
