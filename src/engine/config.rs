@@ -40,8 +40,38 @@ impl Range {
 pub const SAMPLE_RATE_HZ: Range = Range::new(1_000.0, 768_000.0, 48_000.0);
 /// Hard output ceiling (linear amplitude): every output sample stays within ±ceiling.
 pub const CEILING: Range = Range::new(0.001, 1.0, 1.0);
-/// The seed of the random generator of §7 (the plugin's Seed parameter spans it).
-pub const SEED: Range = Range::new(0.0, 999_999.0, 1.0);
+/// The seed of the random generator of §7 (the plugin's Seed parameter spans it). A scene may
+/// give any u64 (`seed`); it takes effect at the next reset.
+pub const SEED: Quantity = Quantity {
+    name: "Seed",
+    unit: "",
+    scene_key: "seed",
+    param_id: "seed",
+    note: "of the random draws of MODEL.md §7; takes effect at the next reset",
+    range: Range::new(0.0, 999_999.0, 1.0),
+    knob: Knob::full(0),
+};
+/// The drain mode (§8), a choice rather than a number: its range is its variants' indices.
+pub const DRAIN: Quantity = Quantity {
+    name: "Drain mode",
+    unit: "",
+    scene_key: "output.drain",
+    param_id: "drain",
+    note: "Simulate or Follow (the fill level is the residual volume), MODEL.md §8",
+    range: Range::new(0.0, 1.0, 0.0),
+    knob: Knob::full(0),
+};
+/// The output ceiling in dB as the plugin shows the linear [`CEILING`] (0 dB = ±1.0; −60 dB is
+/// 0.001). Scenes have no ceiling key.
+pub const CEILING_DB: Quantity = Quantity {
+    name: "Output ceiling",
+    unit: " dB",
+    scene_key: "",
+    param_id: "ceil",
+    note: "hard output limit (0 dB = ±1.0), ramped over 10 ms (MODEL.md §6)",
+    range: Range::new(-60.0, 0.0, 0.0),
+    knob: Knob::full(1),
+};
 /// How long the output gain and the ceiling take to reach a new value (s), MODEL.md §6: long
 /// enough that a jump does not click (the 80 Hz component turns by a quarter of its period in it),
 /// short enough to follow a fader.
@@ -102,6 +132,8 @@ pub struct Quantity {
     pub scene_key: &'static str,
     /// The plugin parameter's stable id (saved states and automation depend on it).
     pub param_id: &'static str,
+    /// What it is, in a few words (the README's table of parameters).
+    pub note: &'static str,
     /// The allowed range and the default.
     pub range: Range,
     /// How the plugin shows it.
@@ -158,6 +190,7 @@ declare_constants! {
             unit: " Hz",
             scene_key: "glug.f1_hz",
             param_id: "f1",
+            note: "the pocket bouncing in the neck; omitted at or above Nyquist",
             range: Range::new(0.0, 400_000.0, 80.0),
             // Narrower than the engine's range (which only guards against nonsense) but wide
             // enough to reach past Nyquist at 44.1 kHz.
@@ -173,6 +206,7 @@ declare_constants! {
             unit: " Hz",
             scene_key: "glug.f2_hz",
             param_id: "f2",
+            note: "the free pocket's ring; omitted at or above Nyquist",
             range: Range::new(0.0, 400_000.0, 300.0),
             knob: Knob::full(1).within(10.0, 24_000.0).skewed(-2.0),
         },
@@ -186,6 +220,7 @@ declare_constants! {
             unit: " /s",
             scene_key: "glug.b1_per_s",
             param_id: "b1",
+            note: "amplitude decay rate of the f1 component",
             range: Range::new(0.0, 1e9, 45.0),
             knob: Knob::full(1).within(1.0, 1_000.0).skewed(-1.5),
         },
@@ -199,6 +234,7 @@ declare_constants! {
             unit: " /s",
             scene_key: "glug.b2_per_s",
             param_id: "b2",
+            note: "amplitude decay rate of the f2 component",
             range: Range::new(0.0, 1e9, 40.0),
             knob: Knob::full(1).within(1.0, 1_000.0).skewed(-1.5),
         },
@@ -212,6 +248,7 @@ declare_constants! {
             unit: " ml",
             scene_key: "bottle.pocket_ml",
             param_id: "pocket",
+            note: "air let in per glug",
             range: Range::new(0.001, 1_000.0, 5.0),
             knob: Knob::full(2).within(0.1, 100.0).skewed(-1.5),
         },
@@ -225,6 +262,7 @@ declare_constants! {
             unit: " ml",
             scene_key: "bottle.capacity_ml",
             param_id: "cap",
+            note: "bottle capacity C",
             range: Range::new(1.0, 100_000.0, 300.0),
             knob: Knob::full(0).within(10.0, 5_000.0).skewed(-1.5),
         },
@@ -239,6 +277,7 @@ declare_constants! {
             unit: "",
             scene_key: "glug.timing_jitter",
             param_id: "tjit",
+            note: "j_t of MODEL.md §7: spread of each pocket",
             range: Range::new(0.0, 0.95, 0.15),
             knob: Knob::full(3),
         },
@@ -252,6 +291,7 @@ declare_constants! {
             unit: "",
             scene_key: "glug.freq_jitter",
             param_id: "fjit",
+            note: "j_f of MODEL.md §7: spread of each unit's f1, f2",
             range: Range::new(0.0, 1.0, 0.05),
             knob: Knob::full(3),
         },
@@ -265,6 +305,7 @@ declare_constants! {
             unit: "",
             scene_key: "glug.decay_sigma",
             param_id: "dsig",
+            note: "σ of MODEL.md §7: log-normal spread of each unit's B1, B2",
             range: Range::new(0.0, 3.0, 0.35),
             knob: Knob::full(3),
         },
@@ -342,7 +383,7 @@ impl Default for ModelConfig {
             timing_jitter: 0.0,
             freq_jitter: 0.0,
             decay_sigma: 0.0,
-            seed: SEED.default as u64,
+            seed: SEED.range.default as u64,
             drain: DrainMode::Simulate,
             ceiling: CEILING.default,
         };

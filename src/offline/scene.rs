@@ -288,10 +288,10 @@ impl Default for LaneBuffers {
 /// The keys a scene has besides the controls' and the constants' (theirs come from their tables).
 const SAMPLE_RATE: &str = "sample_rate";
 const DURATION: &str = "duration_s";
-const SEED: &str = "seed";
+const SEED: &str = config::SEED.scene_key;
 const DETERMINISTIC: &str = "deterministic";
 const MIDI_TAKE: &str = "midi_take";
-const DRAIN: &str = "output.drain";
+const DRAIN: &str = config::DRAIN.scene_key;
 /// The table of the plugin's saved MIDI settings, by their names in the state.
 const MIDI_SECTION: &str = "midi";
 

@@ -16,8 +16,7 @@ mod editor;
 pub use feed::{Feed, UnitView, Visible, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
 pub use osc_input::{OscInput, OscSettings, OscStatus, DEFAULT_AXIS};
 pub use params::{
-    exact, float_param, format, migrate_state, parse_number, GlugParams, ModelParams, CEILING_DB,
-    STATE_VERSION,
+    exact, float_param, format, migrate_state, parse_number, GlugParams, ModelParams, STATE_VERSION,
 };
 pub use realtime::{RealtimeEngine, Settings, FADE_S};
 pub use transport::TransportWatch;

@@ -14,8 +14,8 @@ use nice_plug::params::persist::{self, PersistentField};
 use nice_plug::prelude::*;
 
 use crate::device::midi::{MidiMap, MidiSetting};
-use crate::engine::config::{self, Knob, Quantity};
-use crate::engine::{Constant, Control, ControlValues, DrainMode, ModelConfig, PerControl, Range};
+use crate::engine::config::{self, Knob, Quantity, CEILING_DB};
+use crate::engine::{Constant, Control, ControlValues, DrainMode, ModelConfig, PerControl};
 use crate::plugin::osc_input::OscSettings;
 
 /// The decimal number that `value` shows as on a knob with `decimals` decimals: what the engine
@@ -84,21 +84,6 @@ pub fn parse_number(text: &str) -> Option<f32> {
     value.is_finite().then_some(value)
 }
 
-/// The output ceiling in dB (0 dB = the engine's default ±1.0; −60 dB is the engine's 0.001):
-/// the plugin shows the engine's linear [`config::CEILING`] in dB. Scenes have no ceiling.
-pub const CEILING_DB: Quantity = Quantity {
-    name: "Output ceiling",
-    unit: " dB",
-    scene_key: "",
-    param_id: "ceil",
-    range: Range::new(-60.0, 0.0, 0.0),
-    knob: Knob::full(1),
-};
-
-/// The Seed parameter's id.
-const SEED_ID: &str = "seed";
-/// The Drain mode parameter's id.
-const DRAIN_ID: &str = "drain";
 /// The parameter group of the model's constants and settings.
 const MODEL_GROUP: &str = "Model";
 
@@ -173,7 +158,7 @@ pub fn migrate_state(state: &mut PluginState) {
 pub struct ModelParams {
     /// One parameter per model constant, in the order of [`Constant::ALL`].
     pub constants: Vec<FloatParam>,
-    /// Seed of the random generator, 0 to [`config::SEED`]'s maximum.
+    /// Seed of the random generator, see [`config::SEED`].
     pub seed: IntParam,
     /// Drain mode: simulate or follow.
     pub drain: EnumParam<DrainMode>,
@@ -211,14 +196,14 @@ impl Default for ModelParams {
                 .map(|constant| float_param(constant.quantity()))
                 .collect(),
             seed: IntParam::new(
-                "Seed",
-                config::SEED.default as i32,
+                config::SEED.name,
+                config::SEED.range.default as i32,
                 IntRange::Linear {
-                    min: config::SEED.min as i32,
-                    max: config::SEED.max as i32,
+                    min: config::SEED.range.min as i32,
+                    max: config::SEED.range.max as i32,
                 },
             ),
-            drain: EnumParam::new("Drain mode", DrainMode::Simulate),
+            drain: EnumParam::new(config::DRAIN.name, DrainMode::Simulate),
             ceiling: float_param(&CEILING_DB),
         }
     }
@@ -296,8 +281,16 @@ unsafe impl Params for ModelParams {
                 (id, self.constant(constant).as_ptr(), String::new())
             })
             .collect();
-        map.push((SEED_ID.to_owned(), self.seed.as_ptr(), String::new()));
-        map.push((DRAIN_ID.to_owned(), self.drain.as_ptr(), String::new()));
+        map.push((
+            config::SEED.param_id.to_owned(),
+            self.seed.as_ptr(),
+            String::new(),
+        ));
+        map.push((
+            config::DRAIN.param_id.to_owned(),
+            self.drain.as_ptr(),
+            String::new(),
+        ));
         map.push((
             CEILING_DB.param_id.to_owned(),
             self.ceiling.as_ptr(),

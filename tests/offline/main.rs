@@ -11,5 +11,6 @@ mod command;
 mod determinism;
 mod fuzz;
 mod presets;
+mod readme;
 mod scene_files;
 mod takes;

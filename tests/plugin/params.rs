@@ -6,8 +6,9 @@ use std::sync::Arc;
 use crate::host::TestHost;
 use nice_plug::prelude::*;
 use sake_glug::engine::config;
+use sake_glug::engine::config::CEILING_DB;
 use sake_glug::engine::{Constant, Control};
-use sake_glug::plugin::{GlugParams, CEILING_DB};
+use sake_glug::plugin::GlugParams;
 
 const MAIN_IDS: [&str; 5] = ["tilt", "visc", "fill", "pour", "gain"];
 const MODEL_IDS: [&str; 12] = [

@@ -2,6 +2,7 @@
 //! subcommand; the work is in the library, which knows nothing of `clap`.
 
 mod accuracy;
+mod parameters;
 mod presets;
 mod render;
 mod stability;
@@ -31,6 +32,8 @@ enum Command {
     Stability(stability::StabilityArgs),
     /// Lists the presets, or prints one as a scene file.
     Presets(presets::PresetsArgs),
+    /// Every control and model constant: parameter id, scene key, range and default.
+    Parameters(parameters::ParametersArgs),
 }
 
 fn main() -> ExitCode {
@@ -39,5 +42,6 @@ fn main() -> ExitCode {
         Command::Accuracy(args) => accuracy::run(args),
         Command::Stability(args) => stability::run(args),
         Command::Presets(args) => presets::run(args),
+        Command::Parameters(args) => parameters::run(args),
     }
 }
