@@ -378,7 +378,7 @@ fn pour_then_stop_at(sample_rate: f64, pour_s: f64, gain_db: f64) -> Inputs {
         let pouring = (sample as f64) < pour_s * sample_rate;
         ControlValues {
             tilt_deg: if pouring { 135.0 } else { 0.0 },
-            gain_db: gain_db,
+            gain_db,
             ..ControlValues::default()
         }
     })
