@@ -9,7 +9,7 @@ use crate::engine::synthesis::SILENT_DECAY_EXPONENT;
 use crate::engine::{Controls, DrainMode, Engine, Lane, PerControl, UnitOnset};
 
 /// Samples per engine call offline; any size gives the same samples.
-pub const BLOCK_SIZE: usize = 4096;
+const BLOCK_SIZE: usize = 4096;
 
 /// Why a scene could not be rendered.
 #[derive(Debug, thiserror::Error)]

@@ -53,7 +53,7 @@ fn integer_formats_and_sample_rate_override_are_written_as_asked() {
             "render",
             "-o",
             &name,
-            "--format",
+            "--sample-format",
             format,
             "--sample-rate",
             "96000",
@@ -73,6 +73,22 @@ fn integer_formats_and_sample_rate_override_are_written_as_asked() {
             peak > full_scale / 4 && peak < full_scale / 2,
             "{format}: peak {peak}"
         );
+    }
+}
+
+#[test]
+fn the_old_format_flag_is_refused_by_the_name_of_the_new_one() {
+    let directory = tempfile::tempdir().unwrap();
+    for args in [
+        &["render", "-o", "pour.wav", "--format", "s24"][..],
+        &["render", "--format=s16"],
+        &["render", "--format"],
+    ] {
+        let output = sake_glug(directory.path(), args);
+        assert_eq!(output.status.code(), Some(2), "{args:?}");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.contains("--sample-format"), "{args:?}: {stderr}");
+        assert!(files_in(directory.path()).is_empty(), "{args:?}");
     }
 }
 

@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use sake_glug::engine::{Preset, PRESETS};
+use sake_glug::engine::Preset;
 use sake_glug::offline::clips::HapticBand;
 use sake_glug::offline::{
     render_to_files, OutputError, OutputFormat, OutputOptions, RenderReport, SampleFormat, Scene,
@@ -19,19 +19,21 @@ use sake_glug::offline::{
 pub struct RenderArgs {
     /// Scene files (TOML, see MODEL.md §10); without any, the built-in default pour.
     scenes: Vec<PathBuf>,
-    /// A file to write; its extension picks the format: .wav, .haptic, .ahap, .csv or .png (the
-    /// pour plot). Repeat for several files from the same render. Default: pour.wav.
-    #[arg(short, long = "output", value_name = "FILE")]
+    #[arg(short, long = "output", value_name = "FILE", help = format!(
+        "A file to write; its extension picks the format: {}. Repeat for several files from the \
+         same render. Default: pour.wav",
+        OutputFormat::extensions()
+    ))]
     outputs: Vec<PathBuf>,
     /// Writes DIR/<scene name>.<extension> for every scene and every one of --formats.
     #[arg(long, value_name = "DIR", conflicts_with = "outputs")]
     out_dir: Option<PathBuf>,
-    /// With --out-dir: the formats to write, by extension (wav, haptic, ahap, csv, png).
     #[arg(
         long,
         value_delimiter = ',',
         default_value = "wav",
-        requires = "out_dir"
+        requires = "out_dir",
+        help = format!("With --out-dir: the formats to write ({})", OutputFormat::names())
     )]
     formats: Vec<String>,
     /// Also draws the pour plot (waveform, clip envelope and onsets, V(t), tilt(t)) to this PNG.
@@ -40,9 +42,16 @@ pub struct RenderArgs {
     /// The actuator band (Hz) that .haptic frequencies 0..1 map to, as LOW..HIGH.
     #[arg(long, value_name = "LOW..HIGH", default_value_t = HapticBand::default())]
     haptic_band: HapticBand,
-    /// Renders a preset (water, thin, sake, thick, syrup, small-bottle, large-bottle) instead of
-    /// a scene file: the default pour with that liquid and bottle.
-    #[arg(long, value_name = "NAME", conflicts_with = "scenes")]
+    // The help names the presets from their table.
+    #[arg(
+        long,
+        value_name = "NAME",
+        conflicts_with = "scenes",
+        help = format!(
+            "Renders a preset ({}) instead of a scene file: the default pour with that liquid and bottle",
+            Preset::ids()
+        )
+    )]
     preset: Option<String>,
     /// A recorded take (Standard MIDI File) that drives the scene, read with the plugin's
     /// mapping (or the scene's [midi] table); replaces a take the scene names.
@@ -53,7 +62,10 @@ pub struct RenderArgs {
     sample_rate: Option<f64>,
     /// Sample format of WAV files: f32, s24 or s16.
     #[arg(long, default_value = "f32")]
-    format: SampleFormat,
+    sample_format: SampleFormat,
+    /// The old name of --sample-format, which sat beside --formats: refused, naming the new one.
+    #[arg(long = "format", hide = true, num_args = 0..=1, default_missing_value = "")]
+    renamed_format: Option<String>,
 }
 
 /// One scene to render and the files it becomes.
@@ -89,7 +101,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
         }
     }
     let options = OutputOptions {
-        wav_format: args.format,
+        sample_format: args.sample_format,
         haptic_band: args.haptic_band,
     };
     let progress = BatchProgress::new(jobs.len());
@@ -119,12 +131,18 @@ pub fn run(args: RenderArgs) -> ExitCode {
 /// The jobs the arguments ask for; every output's format is checked here, before anything is
 /// rendered.
 fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
+    if args.renamed_format.is_some() {
+        return Err(
+            "--format is now --sample-format (the sample format of WAV files); \
+                    --formats chooses the kinds of file"
+                .into(),
+        );
+    }
     if let Some(name) = &args.preset {
         if Preset::find(name).is_none() {
-            let names: Vec<&str> = PRESETS.iter().map(|preset| preset.id).collect();
             return Err(format!(
                 "no preset `{name}`: choose one of {}",
-                names.join(", ")
+                Preset::ids()
             ));
         }
     }
@@ -148,9 +166,10 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
             .formats
             .iter()
             .map(|name| {
-                OutputFormat::of_extension(name.trim_start_matches('.')).ok_or_else(|| {
+                OutputFormat::of_name(name.trim_start_matches('.')).ok_or_else(|| {
                     format!(
-                        "unknown format `{name}` in --formats: use wav, haptic, ahap, csv or png"
+                        "unknown format `{name}` in --formats: use {}",
+                        OutputFormat::names()
                     )
                 })
             })
@@ -200,7 +219,7 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
             OutputFormat::of_path(output).map_err(|error| error.to_string())?;
         }
         if let Some(plot) = &args.plot {
-            if !matches!(OutputFormat::of_path(plot), Ok(OutputFormat::Plot)) {
+            if !matches!(OutputFormat::of_path(plot), Ok(format) if format == OutputFormat::PLOT) {
                 return Err(format!(
                     "--plot {}: the plot is a .png file",
                     plot.display()

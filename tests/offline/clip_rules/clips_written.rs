@@ -6,13 +6,12 @@ use std::f64::consts::TAU;
 use std::io::Write;
 
 use super::{ahap, haptic};
-use sake_glug::offline::clips::ahap::ahap_json;
-use sake_glug::offline::clips::csv::write_csv_samples;
-use sake_glug::offline::clips::haptic::haptic_json;
 use sake_glug::offline::clips::{
     envelope_at, envelope_breakpoints, is_audible, BandParseError, ClipSource, Glug, HapticBand,
 };
-use sake_glug::offline::plot::{draw_pour_plot, PlotData, PlotError};
+use sake_glug::offline::sinks::{
+    ahap_json, draw_pour_plot, haptic_json, write_csv_samples, PlotData, PlotError,
+};
 
 const GLUG_COUNT: usize = 50;
 const SPACING_S: f64 = 0.08;

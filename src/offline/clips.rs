@@ -1,17 +1,15 @@
-//! Haptic clips of a render: the glugs of a pour written as a Meta Haptics Studio `.haptic`
-//! clip, an Apple Core Haptics `.ahap` pattern and a Syntacts-style CSV of samples.
+//! What every haptic clip is written from: the glugs of a render and their felt envelope.
 //!
-//! Both haptic formats describe what is *felt*, not the waveform: an amplitude envelope that
-//! jumps at every glug onset and decays like the glug, a felt frequency, and one transient per
-//! audible glug. The shared logic (envelope, breakpoints, frequency mapping) lives here so the
-//! two writers agree on every number.
-
-pub mod ahap;
-pub mod csv;
-pub mod haptic;
+//! The clip formats ([`super::sinks`]: Meta's `.haptic`, Apple's `.ahap`, the pour plot's
+//! envelope) describe what is *felt*, not the waveform: an amplitude envelope that jumps at every
+//! glug onset and decays like the glug, a felt frequency, and one transient per audible glug. The
+//! shared logic (envelope, breakpoints, frequency mapping) lives here so the formats agree on
+//! every number.
 
 use std::fmt;
 use std::str::FromStr;
+
+use crate::engine::UnitOnset;
 
 /// One glug of the render: two decaying sinusoids starting at `onset_s`,
 /// `y(τ) = A1·e^(−B1·τ)·sin(2π·f1·τ) + A2·e^(−B2·τ)·sin(2π·f2·τ)` for `τ = t − onset_s ≥ 0`.
@@ -27,6 +25,21 @@ pub struct Glug {
     pub decay_per_s: [f64; 2],
     /// Viscosity `c` in 0..1 (water 0.33); the share of the low component.
     pub viscosity: f64,
+}
+
+impl Glug {
+    /// A unit of a render at `sample_rate` (Hz) as the clips see it: its onset in seconds and
+    /// its components at the output gain it starts to be heard at.
+    pub fn of_unit(unit: &UnitOnset, output_gain: f64, sample_rate: u32) -> Self {
+        let [a1, a2] = unit.component_amplitudes();
+        Self {
+            onset_s: (unit.sample as f64 + unit.fraction) / sample_rate as f64,
+            amplitudes: [a1 * output_gain, a2 * output_gain],
+            frequency_hz: unit.shape.frequency_hz,
+            decay_per_s: unit.shape.decay_per_s,
+            viscosity: unit.viscosity,
+        }
+    }
 }
 
 /// What a clip is written from: the glugs of one render and where they came from.
@@ -196,25 +209,6 @@ pub fn felt_frequency_hz(glug: &Glug) -> f64 {
     }
 }
 
-/// The felt frequency in Hz of everything ringing at time `t`: the mean of every started
-/// component's frequency weighted by its decayed amplitude. `None` while nothing rings.
-pub fn ringing_frequency_hz(glugs: &[Glug], t: f64) -> Option<f64> {
-    let (weighted, weight) = glugs
-        .iter()
-        .filter(|glug| glug.onset_s <= t)
-        .flat_map(|glug| {
-            (0..2).map(move |k| {
-                let amplitude =
-                    glug.amplitudes[k].abs() * (-glug.decay_per_s[k] * (t - glug.onset_s)).exp();
-                (amplitude * glug.frequency_hz[k], amplitude)
-            })
-        })
-        .fold((0.0, 0.0), |(sum_fa, sum_a), (fa, a)| {
-            (sum_fa + fa, sum_a + a)
-        });
-    (weight > 0.0).then(|| weighted / weight)
-}
-
 /// A glug's own peak on the envelope's 0..1 scale: `min(ceiling, |A1| + |A2|)`, clamped to 0..1.
 pub fn glug_peak(glug: &Glug, ceiling: f64) -> f64 {
     (glug.amplitudes[0].abs() + glug.amplitudes[1].abs())
@@ -259,7 +253,8 @@ pub struct Breakpoint {
     pub time_s: f64,
     /// `envelope_at(time_s)`, clamped to 0..1.
     pub amplitude: f64,
-    /// `ringing_frequency_hz(time_s)`: the felt frequency of what rings here, `None` if silent.
+    /// The felt frequency (Hz) of everything ringing here: every started component's frequency
+    /// weighted by its decayed amplitude; `None` while nothing rings.
     pub felt_frequency_hz: Option<f64>,
     /// The index (into `ClipSource::glugs`) of the audible glug whose onset this is, if any.
     pub onset_of: Option<usize>,
@@ -326,7 +321,8 @@ impl<'a> EnvelopeSum<'a> {
         }
     }
 
-    /// `(envelope_at(t) clamped to 0..1, ringing_frequency_hz(t))` over the audible glugs.
+    /// `envelope_at(t)` clamped to 0..1, and the felt frequency of what rings at `t` (see
+    /// [`Breakpoint::felt_frequency_hz`]), over the audible glugs.
     fn at(&self, t: f64) -> (f64, Option<f64>) {
         let started = self.sorted.partition_point(|&i| self.glugs[i].onset_s <= t);
         let (mut sum, mut weighted_hz) = (0.0, 0.0);

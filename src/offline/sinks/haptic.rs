@@ -3,10 +3,18 @@
 
 use serde::Serialize;
 
-use super::{
+use super::{ClipSink, OutputError, Sink, SinkContext};
+use crate::offline::clips::{
     clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, transient_intensity,
     ClipSource, HapticBand,
 };
+
+/// The sink of a `.haptic` output, its frequencies on the band of the options.
+pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
+    ClipSink::open(context, |source, options| {
+        haptic_json(source, &options.haptic_band)
+    })
+}
 
 #[derive(Serialize)]
 struct HapticFile {
@@ -73,10 +81,10 @@ const SILENT_FREQUENCY: f64 = 0.5;
 
 /// The clip as a `.haptic` JSON document.
 ///
-/// - Amplitude: the felt envelope ([`super::envelope_breakpoints`]), on the sample scale (full
+/// - Amplitude: the felt envelope ([`envelope_breakpoints`]), on the sample scale (full
 ///   scale = 1), so the clip is as strong as the sound.
 /// - Emphasis, one per audible glug at its exact onset: amplitude
-///   `max(envelope there, √peak)` ([`super::transient_intensity`], lifted to the envelope
+///   `max(envelope there, √peak)` ([`transient_intensity`], lifted to the envelope
 ///   because the spec requires the emphasis to be at least the envelope), frequency the band
 ///   position of the glug's felt frequency, which falls as the viscosity rises.
 /// - Frequency: the band position of the felt frequency of everything ringing, at the same

@@ -5,6 +5,88 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
+use super::clip::clip_source;
+use super::{OutputError, PendingFile, Sink, SinkContext};
+use crate::engine::UnitOnset;
+use crate::offline::clips::{clip_onsets, envelope_breakpoints, Glug};
+use crate::offline::RenderSummary;
+
+/// The sink of a `.png` output: it keeps every sample, glug and report of the bottle, and draws
+/// them once the render has ended.
+pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
+    let scene = context.scene;
+    // The volume at the start: the fill level, as a reset fills the bottle (MODEL.md §8).
+    let first_volume_ml = scene.config.capacity_ml * scene.lanes.fill_percent.value_at(0.0) / 100.0;
+    Ok(Box::new(PlotSink {
+        file: PendingFile::beside(context.path, ".png").map_err(OutputError::io(context.path))?,
+        context,
+        samples: Vec::new(),
+        glugs: Vec::new(),
+        volume_ml: vec![(0.0, first_volume_ml)],
+    }))
+}
+
+struct PlotSink<'a> {
+    file: PendingFile,
+    context: SinkContext<'a>,
+    samples: Vec<f32>,
+    glugs: Vec<Glug>,
+    /// `(t, V)`: the volume at the start and after every block.
+    volume_ml: Vec<(f64, f64)>,
+}
+
+impl Sink for PlotSink<'_> {
+    fn samples(&mut self, block: &[f32]) -> Result<(), OutputError> {
+        self.samples.extend_from_slice(block);
+        Ok(())
+    }
+
+    fn unit_started(&mut self, onset: &UnitOnset, output_gain: f64) {
+        let sample_rate = self.context.scene.sample_rate;
+        self.glugs
+            .push(Glug::of_unit(onset, output_gain, sample_rate));
+    }
+
+    /// A point of V(t) every 10 ms at least.
+    fn bottle_every(&self) -> Option<usize> {
+        Some((self.context.scene.sample_rate as usize / 100).max(1))
+    }
+
+    fn bottle(&mut self, position: u64, volume_ml: f64) {
+        let fs = self.context.scene.sample_rate as f64;
+        self.volume_ml.push((position as f64 / fs, volume_ml));
+    }
+
+    fn finish(self: Box<Self>, summary: &RenderSummary) -> Result<PendingFile, OutputError> {
+        let scene = self.context.scene;
+        let source = clip_source(&self.context, &self.glugs, summary);
+        let envelope: Vec<(f64, f64)> = envelope_breakpoints(&source)
+            .iter()
+            .map(|point| (point.time_s, point.amplitude))
+            .collect();
+        let onsets_s: Vec<f64> = clip_onsets(&source)
+            .into_iter()
+            .map(|index| self.glugs[index].onset_s)
+            .collect();
+        let tilt_deg: Vec<(f64, f64)> = self
+            .volume_ml
+            .iter()
+            .map(|&(t, _)| (t, scene.lanes.tilt_deg.value_at(t)))
+            .collect();
+        let data = PlotData {
+            sample_rate: scene.sample_rate as f64,
+            samples: &self.samples,
+            envelope: &envelope,
+            onsets_s: &onsets_s,
+            volume_ml: &self.volume_ml,
+            capacity_ml: scene.config.capacity_ml,
+            tilt_deg: &tilt_deg,
+        };
+        draw_pour_plot(&data, self.file.temp_path())?;
+        Ok(self.file)
+    }
+}
+
 /// What the pour plot shows. Every time is in seconds from the start of the render.
 #[derive(Debug, Clone, Copy)]
 pub struct PlotData<'a> {

@@ -1,15 +1,37 @@
-//! Writing renders to WAV files all or nothing: samples go to a temporary file beside the target,
-//! which replaces the target only once complete, so a failed render never leaves a partial file.
+//! The WAV sink: the mono output streamed to a temporary file beside the target as it is
+//! rendered, refused up front when the render is known to be too long for a WAV file.
 //!
 //! hound writes the header; the samples are converted a block at a time and written as one
-//! buffer (hound takes f32 and 24-bit samples only one by one), and on commit the two sizes of
+//! buffer (hound takes f32 and 24-bit samples only one by one), and once complete the two sizes of
 //! the header are set as hound sets them. The files are byte for byte what hound alone writes.
 
 use std::io::{BufWriter, Cursor, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use hound::{SampleFormat as HoundFormat, WavSpec, WavWriter};
-use tempfile::NamedTempFile;
+
+use super::{OutputError, PendingFile, Sink, SinkContext};
+use crate::offline::RenderSummary;
+
+/// The sink of a `.wav` output.
+pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
+    let (path, scene) = (context.path, context.scene);
+    let format = context.options.sample_format;
+    if let Some(samples) = scene.duration_samples() {
+        WavFile::check_length(path, samples, scene.sample_rate, format)?;
+    }
+    Ok(Box::new(WavFile::create(path, scene.sample_rate, format)?))
+}
+
+impl Sink for WavFile {
+    fn samples(&mut self, block: &[f32]) -> Result<(), OutputError> {
+        Ok(self.write(block)?)
+    }
+
+    fn finish(self: Box<Self>, _: &RenderSummary) -> Result<PendingFile, OutputError> {
+        Ok(self.complete()?)
+    }
+}
 
 /// The sample format of a WAV file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -86,10 +108,9 @@ pub enum WavError {
     },
 }
 
-/// A mono WAV file being written; it appears at its path only on [`WavFile::commit`].
-pub struct WavFile {
-    path: PathBuf,
-    temp: NamedTempFile,
+/// A mono WAV file being written; it replaces its target only once complete and committed.
+pub(crate) struct WavFile {
+    file: PendingFile,
     writer: BufWriter<std::fs::File>,
     format: SampleFormat,
     sample_rate: u32,
@@ -140,14 +161,7 @@ impl WavFile {
             path: path.to_owned(),
             source,
         };
-        let directory = match path.parent() {
-            Some(parent) if !parent.as_os_str().is_empty() => parent,
-            _ => Path::new("."),
-        };
-        let temp = temp_file_builder()
-            .tempfile_in(directory)
-            .map_err(io_error)?;
-        let file = temp.reopen().map_err(io_error)?;
+        let file = PendingFile::beside(path, "").map_err(io_error)?;
         let spec = wav_spec(sample_rate, format);
         let encode_error = |source| WavError::Encode {
             path: path.to_owned(),
@@ -159,11 +173,10 @@ impl WavFile {
             .and_then(WavWriter::finalize)
             .map_err(encode_error)?;
         let header = header.into_inner();
-        let mut writer = BufWriter::new(file);
+        let mut writer = file.writer().map_err(io_error)?;
         writer.write_all(&header).map_err(io_error)?;
         Ok(Self {
-            path: path.to_owned(),
-            temp,
+            file,
             writer,
             format,
             sample_rate,
@@ -177,7 +190,7 @@ impl WavFile {
     /// WAV can hold, as a render whose length was not known up front may.
     pub fn write(&mut self, samples: &[f32]) -> Result<(), WavError> {
         let written = self.written + samples.len() as u64;
-        Self::check_length(&self.path, written, self.sample_rate, self.format)?;
+        Self::check_length(self.file.path(), written, self.sample_rate, self.format)?;
         self.written = written;
         let bytes: &[u8] = match self.format {
             // A little-endian machine holds f32 samples as the file does: no conversion at all.
@@ -193,13 +206,13 @@ impl WavFile {
             }),
         };
         self.writer.write_all(bytes).map_err(|source| WavError::Io {
-            path: self.path.clone(),
+            path: self.file.path().to_owned(),
             source,
         })
     }
 
-    /// Completes the file and moves it into place; returns its path.
-    pub fn commit(self) -> Result<PathBuf, WavError> {
+    /// Completes the file (the sizes in its header), still in its temporary file.
+    pub fn complete(self) -> Result<PendingFile, WavError> {
         let data_bytes = self.written * self.format.bytes_per_sample() as u64;
         // Where hound puts them: the RIFF size (all but its first 8 bytes) at 4, the data's
         // size in the last 4 bytes of the header. Both fit in 32 bits: `write` saw to it.
@@ -208,13 +221,10 @@ impl WavFile {
             (self.header_len - 4, data_bytes),
         ];
         let Self {
-            path,
-            temp,
-            mut writer,
-            ..
+            file, mut writer, ..
         } = self;
         let io_error = |source| WavError::Io {
-            path: path.clone(),
+            path: file.path().to_owned(),
             source,
         };
         for (offset, size) in sizes {
@@ -224,12 +234,7 @@ impl WavFile {
                 .map_err(io_error)?;
         }
         writer.flush().map_err(io_error)?;
-        drop(writer);
-        temp.persist(&path).map_err(|error| WavError::Io {
-            path: path.clone(),
-            source: error.error,
-        })?;
-        Ok(path)
+        Ok(file)
     }
 }
 
@@ -259,7 +264,7 @@ fn wav_spec(sample_rate: u32, format: SampleFormat) -> WavSpec {
     }
 }
 
-/// Temporary files are private by default; the finished WAV should get the permissions any new
+/// Temporary files are private by default; a finished file should get the permissions any new
 /// file gets (0o666 less the umask), as if it had been written in place.
 pub(crate) fn temp_file_builder() -> tempfile::Builder<'static, 'static> {
     let mut builder = tempfile::Builder::new();
@@ -328,7 +333,7 @@ mod tests {
                 for block in samples[..len].chunks(777) {
                     file.write(block).unwrap();
                 }
-                file.commit().unwrap();
+                file.complete().unwrap().commit().unwrap();
                 let theirs = dir.path().join(format!("hound-{name}-{len}.wav"));
                 write_with_hound(&theirs, &samples[..len], format);
                 assert!(

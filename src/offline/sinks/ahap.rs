@@ -7,10 +7,16 @@
 
 use serde::Serialize;
 
-use super::{
+use super::{ClipSink, OutputError, Sink, SinkContext};
+use crate::offline::clips::{
     clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, transient_intensity,
     ClipSource, HapticBand, ENVELOPE_FLOOR,
 };
+
+/// The sink of an `.ahap` output (its sharpness always on the default band).
+pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
+    ClipSink::open(context, |source, _| ahap_json(source))
+}
 
 #[derive(Serialize)]
 #[serde(rename_all = "PascalCase")]
@@ -53,7 +59,7 @@ struct EventParameter {
 }
 
 /// Core Haptics' limit on the length of one continuous event.
-pub const MAX_EVENT_DURATION_S: f64 = 30.0;
+const MAX_EVENT_DURATION_S: f64 = 30.0;
 
 /// Envelope steps shorter than this (the jump just before an onset) get no continuous event:
 /// the transient carries the jump.
@@ -78,15 +84,15 @@ fn parameters(intensity: f64, sharpness: f64) -> [EventParameter; 2] {
 /// The clip as an AHAP JSON document.
 ///
 /// - Transient per audible glug at its exact onset: `HapticIntensity` = `√peak`
-///   ([`super::transient_intensity`]: Core Haptics' intensity is perceptually close to the
+///   ([`transient_intensity`]: Core Haptics' intensity is perceptually close to the
 ///   square root of amplitude, and Meta's converter writes the same), `HapticSharpness` = the
 ///   position of the glug's felt frequency in the default [`HapticBand`] (80..300 Hz), which
 ///   with the default components is exactly `1 − c`: a more viscous glug feels duller.
 /// - Ring: one `HapticContinuous` event per step of the felt envelope
-///   ([`super::envelope_breakpoints`]) that rises above [`ENVELOPE_FLOOR`], intensity the
+///   ([`envelope_breakpoints`]) that rises above [`ENVELOPE_FLOOR`], intensity the
 ///   square root of the step's mean amplitude, sharpness the band position of the felt
 ///   frequency of what rings at the step's start. Steps longer than
-///   [`MAX_EVENT_DURATION_S`] are split.
+///   `MAX_EVENT_DURATION_S` (Core Haptics' limit) are split.
 pub fn ahap_json(source: &ClipSource) -> String {
     let band = HapticBand::default();
     let breakpoints = envelope_breakpoints(source);

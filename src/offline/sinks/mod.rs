@@ -1,0 +1,255 @@
+//! Sinks: one per kind of file a render writes, all fed by the same single pass.
+//!
+//! A `Sink` hears the render as it runs (its samples block by block, each unit as it starts,
+//! the bottle's volume if it asks for it) and, once the render has ended, completes its file in
+//! a temporary file beside the target (a `PendingFile`); [`super::render_to_files`] replaces
+//! the targets only once every sink has finished. What a sink needs to keep it keeps itself: a
+//! WAV or CSV streams its samples to disk and keeps no units; the clips keep the glugs.
+//!
+//! Every format is one entry of [`OutputFormat::ALL`]: adding one is a file here with its sink
+//! and an `open` function, and an entry in that table.
+
+mod ahap;
+mod clip;
+mod csv;
+mod haptic;
+mod pending;
+#[cfg(feature = "plot")]
+mod plot;
+mod wav;
+
+use std::path::{Path, PathBuf};
+
+use super::clips::HapticBand;
+use super::render::{RenderError, RenderSummary};
+use super::scene::Scene;
+use crate::engine::UnitOnset;
+use clip::ClipSink;
+pub(crate) use pending::PendingFile;
+#[cfg(feature = "plot")]
+use plot::open as open_plot;
+
+pub use ahap::ahap_json;
+pub use csv::write_csv_samples;
+pub use haptic::haptic_json;
+#[cfg(feature = "plot")]
+pub use plot::{draw_pour_plot, PlotData, PlotError};
+pub(crate) use wav::temp_file_builder;
+pub use wav::{SampleFormat, WavError};
+
+/// One file of a render, written from the render's single pass. Every method but
+/// [`Sink::finish`] has a default that ignores what it hears.
+pub(crate) trait Sink {
+    /// The next samples of the output: every sample of the render passes here once, in order.
+    fn samples(&mut self, _block: &[f32]) -> Result<(), OutputError> {
+        Ok(())
+    }
+    /// A unit started (at `(onset.sample + onset.fraction) / fs`), heard at the output gain
+    /// `output_gain` (linear, on its ramp: MODEL.md §6).
+    fn unit_started(&mut self, _onset: &UnitOnset, _output_gain: f64) {}
+    /// The most samples this sink lets pass between two [`Sink::bottle`] reports, or `None` for
+    /// none. The render then cuts time at least this finely (which changes no sample), and
+    /// reports after every block: as often as the most demanding sink asked.
+    fn bottle_every(&self) -> Option<usize> {
+        None
+    }
+    /// The residual volume (ml) after `position` samples.
+    fn bottle(&mut self, _position: u64, _volume_ml: f64) {}
+    /// The render has ended (`summary`): completes the file in its temporary file, which
+    /// replaces the target only once every sink of the render has finished.
+    fn finish(self: Box<Self>, summary: &RenderSummary) -> Result<PendingFile, OutputError>;
+}
+
+/// What a sink is opened with: the file it writes and the render it is written from.
+#[derive(Clone, Copy)]
+pub(crate) struct SinkContext<'a> {
+    /// The file asked for.
+    pub path: &'a Path,
+    /// The scene being rendered.
+    pub scene: &'a Scene,
+    /// Its name, for the clips' metadata.
+    pub scene_name: &'a str,
+    /// How the files are written.
+    pub options: &'a OutputOptions,
+}
+
+/// Opens the sink of one format, refusing up front what it knows it cannot write.
+type OpenSink = for<'a> fn(SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError>;
+
+/// A kind of file a render writes: its name in `--formats`, the extension of its files, and how
+/// its sink is opened.
+#[derive(Clone, Copy)]
+pub struct OutputFormat {
+    name: &'static str,
+    extension: &'static str,
+    open: OpenSink,
+}
+
+impl OutputFormat {
+    /// `.wav`: the mono output, for an actuator driven from an audio interface.
+    pub const WAV: Self = Self::new("wav", "wav", wav::open);
+    /// `.haptic`: a Meta Haptics Studio 1.0 clip.
+    pub const HAPTIC: Self = Self::new("haptic", "haptic", haptic::open);
+    /// `.ahap`: an Apple Core Haptics pattern.
+    pub const AHAP: Self = Self::new("ahap", "ahap", ahap::open);
+    /// `.csv`: one sample per line, no header (Syntacts' format).
+    pub const CSV: Self = Self::new("csv", "csv", csv::open);
+    /// `.png`: the pour plot (feature `plot`; a build without it refuses a plot by name).
+    pub const PLOT: Self = Self::new("png", "png", open_plot);
+
+    /// Every format, in the order a file's extension is looked up.
+    pub const ALL: &'static [Self] = &[Self::WAV, Self::HAPTIC, Self::AHAP, Self::CSV, Self::PLOT];
+
+    const fn new(name: &'static str, extension: &'static str, open: OpenSink) -> Self {
+        Self {
+            name,
+            extension,
+            open,
+        }
+    }
+
+    /// The extension (without the dot) its files get.
+    pub fn extension(self) -> &'static str {
+        self.extension
+    }
+
+    /// The format of a name (any case).
+    pub fn of_name(name: &str) -> Option<Self> {
+        Self::ALL
+            .iter()
+            .copied()
+            .find(|format| format.name.eq_ignore_ascii_case(name))
+    }
+
+    /// The first format of [`OutputFormat::ALL`] with an extension (without the dot, any case).
+    fn of_extension(extension: &str) -> Option<Self> {
+        Self::ALL
+            .iter()
+            .copied()
+            .find(|format| format.extension.eq_ignore_ascii_case(extension))
+    }
+
+    /// The format of a file, by its extension; an unknown or missing one is refused.
+    pub fn of_path(path: &Path) -> Result<Self, OutputError> {
+        path.extension()
+            .and_then(|extension| extension.to_str())
+            .and_then(Self::of_extension)
+            .ok_or_else(|| OutputError::UnknownFormat {
+                path: path.to_owned(),
+            })
+    }
+
+    /// Every format's name, as a list a message can end with: "wav, haptic, … or png".
+    pub fn names() -> String {
+        one_of(Self::ALL.iter().map(|format| format.name.to_owned()))
+    }
+
+    /// Every extension, as a list a message can end with: ".wav, .haptic, … or .png".
+    pub fn extensions() -> String {
+        one_of(
+            Self::ALL
+                .iter()
+                .map(|format| format!(".{}", format.extension)),
+        )
+    }
+
+    /// The sink that writes `context.path` in this format.
+    pub(crate) fn open<'a>(
+        self,
+        context: SinkContext<'a>,
+    ) -> Result<Box<dyn Sink + 'a>, OutputError> {
+        (self.open)(context)
+    }
+}
+
+/// Formats are told apart by name (each has its own).
+impl PartialEq for OutputFormat {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name
+    }
+}
+
+impl Eq for OutputFormat {}
+
+impl std::fmt::Debug for OutputFormat {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "OutputFormat({})", self.name)
+    }
+}
+
+/// "a, b or c".
+fn one_of(items: impl Iterator<Item = String>) -> String {
+    let items: Vec<String> = items.collect();
+    match items.split_last() {
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    }
+}
+
+/// Without the `plot` feature a plot is refused by name, not taken for an unknown format.
+#[cfg(not(feature = "plot"))]
+fn open_plot<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
+    Err(OutputError::NoPlot {
+        path: context.path.to_owned(),
+    })
+}
+
+/// How the files of a render are written.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct OutputOptions {
+    /// Sample format of WAV files.
+    pub sample_format: SampleFormat,
+    /// The actuator band the `.haptic` frequencies map to.
+    pub haptic_band: HapticBand,
+}
+
+/// Why the files of a render could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// An output's extension names no format the renderer writes.
+    #[error(
+        "{}: unknown output format; the extension must be {}",
+        path.display(),
+        OutputFormat::extensions()
+    )]
+    UnknownFormat {
+        /// The output asked for.
+        path: PathBuf,
+    },
+    /// The render itself failed.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// A WAV file could not be written.
+    #[error(transparent)]
+    Wav(#[from] WavError),
+    /// Another file could not be written.
+    #[error("cannot write {}: {source}", path.display())]
+    Io {
+        /// The file asked for.
+        path: PathBuf,
+        /// What the file system said.
+        source: std::io::Error,
+    },
+    /// The pour plot could not be drawn.
+    #[cfg(feature = "plot")]
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+    /// A plot was asked for from a build without the `plot` feature.
+    #[cfg(not(feature = "plot"))]
+    #[error("{}: this build draws no plots (feature `plot`)", path.display())]
+    NoPlot {
+        /// The plot asked for.
+        path: PathBuf,
+    },
+}
+
+impl OutputError {
+    /// The file system refused `path`.
+    fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Self + '_ {
+        move |source| Self::Io {
+            path: path.to_owned(),
+            source,
+        }
+    }
+}
