@@ -17,7 +17,4 @@ pub use render::{
     render_scene, render_scene_to_vec, RenderError, RenderObserver, RenderSummary, BLOCK_SIZE,
 };
 pub use scene::{LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S};
-/// Every file the crate writes is first written as one of these, beside its target.
-#[cfg(feature = "plugin")]
-pub(crate) use wav::temp_file_builder;
 pub use wav::{SampleFormat, WavError, WavFile};

@@ -12,8 +12,9 @@ use tempfile::NamedTempFile;
 use super::clips::{self, ClipSource, Glug, HapticBand};
 use super::render::{render_scene, RenderError, RenderObserver, RenderSummary};
 use super::scene::Scene;
-use super::wav::{temp_file_builder, SampleFormat, WavError, WavFile};
+use super::wav::{SampleFormat, WavError, WavFile};
 use crate::engine::UnitOnset;
+use crate::files::temp_file_builder;
 
 /// A kind of file a render writes, chosen by the file's extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -11,6 +11,8 @@ use std::path::{Path, PathBuf};
 use hound::{SampleFormat as HoundFormat, WavSpec, WavWriter};
 use tempfile::NamedTempFile;
 
+use crate::files::temp_file_builder;
+
 /// The sample format of a WAV file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SampleFormat {
@@ -257,18 +259,6 @@ fn wav_spec(sample_rate: u32, format: SampleFormat) -> WavSpec {
         bits_per_sample,
         sample_format,
     }
-}
-
-/// Temporary files are private by default; the finished WAV should get the permissions any new
-/// file gets (0o666 less the umask), as if it had been written in place.
-pub(crate) fn temp_file_builder() -> tempfile::Builder<'static, 'static> {
-    let mut builder = tempfile::Builder::new();
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    builder
 }
 
 /// `samples` in a format of `WIDTH` bytes per sample, in `bytes` (reused from block to block).
