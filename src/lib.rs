@@ -6,19 +6,25 @@
 //! - [`plugin`]: the CLAP/VST3 plugin (feature `plugin`, its egui editor with `editor`), also
 //!   run as the standalone app `sake-glug-standalone` (feature `standalone`);
 //! - [`offline`]: scene files, automation lanes, the offline renderer and its file writers, used
-//!   by the `sake-glug` command line (feature `cli`);
-//! - [`reports`]: the accuracy and stability reports the command line prints.
+//!   by the `sake-glug` command line (feature `offline`, which `cli` brings);
+//! - [`reports`]: the accuracy and stability reports the command line prints (feature `reports`,
+//!   which `cli` brings).
 //!
-//! [`device`] holds what a tilt device sends (the MIDI mapping and decoder, recorded MIDI and
-//! CSV takes, OSC from phones), shared by the plugin and the offline renderer. Data flows one
-//! way: scene, take or host → controls → pour → synthesis → sinks (WAV, clips, plot, audio out).
+//! The plugin compiles neither `offline` nor `reports`. [`device`] holds what a tilt device sends
+//! (the MIDI mapping and decoder, OSC from phones, and with `offline` recorded MIDI and CSV
+//! takes), shared by the plugin and the offline renderer. Data flows one way: scene, take or
+//! host → controls → pour → synthesis → sinks (WAV, clips, plot, audio out).
 #![warn(missing_docs)]
 
 pub mod device;
 pub mod engine;
+#[cfg(any(feature = "plugin", feature = "offline"))]
+mod files;
+#[cfg(feature = "offline")]
 pub mod offline;
 #[cfg(feature = "plugin")]
 pub mod plugin;
+#[cfg(feature = "reports")]
 pub mod reports;
 
 /// The plugin types, at the crate's root for nice-plug's export macros.

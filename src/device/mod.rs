@@ -2,7 +2,8 @@
 //! plugin, the standalone app and the offline renderer decode a device the same way:
 //!
 //! - [`midi`]: the CC mapping of the bottle-shaped controller and the one MIDI decoder;
-//! - [`midi_take`]: a recorded take as a Standard MIDI File, each message at its sample;
+//! - [`midi_take`]: a recorded take as a Standard MIDI File, each message at its sample (feature
+//!   `offline`, like the next);
 //! - [`csv_lane`]: a logged take as CSV, a column or an accelerometer's gravity vector;
 //! - [`axis`]: which sensor axis runs from the bottle's base to its mouth, and the tilt of a
 //!   gravity reading;
@@ -10,9 +11,11 @@
 //!   and reaching the audio thread through [`LiveControls`], read without locks or allocation.
 
 pub mod axis;
+#[cfg(feature = "offline")]
 pub mod csv_lane;
 pub mod live;
 pub mod midi;
+#[cfg(feature = "offline")]
 pub mod midi_take;
 pub mod osc;
 pub mod osc_listener;

@@ -21,13 +21,13 @@ pub use controls::{
 use output::OutputStage;
 pub use pour::{Pour, PourStats, UnitOnset};
 pub use presets::{Preset, PresetValue, PRESETS};
-pub use synthesis::{RecursiveF32, RecursiveF64, Synthesis, VoiceBank, GRID};
+pub use synthesis::{AnchoredF32, RecursiveF32, RecursiveF64, Synthesis, GRID};
 
 /// Renders the model into caller-provided buffers; allocation-free after construction.
 ///
 /// The output of a given sample depends only on the controls up to it, never on how the caller
 /// cuts time into blocks. `S` is the synthesis path; the default is the real-time f32 path.
-pub struct Engine<S: Synthesis = VoiceBank> {
+pub struct Engine<S: Synthesis = AnchoredF32> {
     sample_rate: f64,
     pour: Pour,
     voices: S,
@@ -142,14 +142,6 @@ impl<S: Synthesis> Engine<S> {
     /// itself failed there, even though the output stayed finite.
     pub fn non_finite_before_limiter(&self) -> u64 {
         self.output.limiter.non_finite
-    }
-
-    /// Gives the next component that starts a NaN state, as a broken synthesis would: how the
-    /// tests show that the stability checks see through the limiter. Only with the
-    /// `fault-injection` feature, which no product is built with.
-    #[cfg(feature = "fault-injection")]
-    pub fn inject_nan_into_next_component(&mut self) {
-        self.voices.poison_next_component();
     }
 
     /// The output ceiling at the last sample rendered (linear): the scene's or the parameter's,

@@ -14,7 +14,4 @@ pub use automation::Automation;
 pub use outputs::{render_to_files, RenderReport};
 pub use render::{render_scene, render_scene_to_vec, RenderError, RenderObserver, RenderSummary};
 pub use scene::{LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S};
-/// Every file the crate writes is first written as one of these, beside its target.
-#[cfg(feature = "plugin")]
-pub(crate) use sinks::temp_file_builder;
 pub use sinks::{OutputError, OutputFormat, OutputOptions, SampleFormat, WavError};

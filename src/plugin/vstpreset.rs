@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 use nice_plug::prelude::*;
 
 use crate::engine::{Preset, PRESETS};
-use crate::offline::temp_file_builder;
+use crate::files::temp_file_builder;
 use crate::plugin::presets::{preset_state, state_bytes};
 use crate::plugin::SakeGlugVst3;
 

@@ -14,8 +14,8 @@ use std::time::Instant;
 use super::timing::{self, RenderSpec};
 use crate::engine::synthesis::reference;
 use crate::engine::{
-    ControlSource, ControlValues, DrainMode, ModelConfig, RecursiveF32, RecursiveF64, Synthesis,
-    VoiceBank,
+    AnchoredF32, ControlSource, ControlValues, DrainMode, ModelConfig, RecursiveF32, RecursiveF64,
+    Synthesis,
 };
 
 /// Seconds compared at the start and at the end of a long render.
@@ -225,7 +225,7 @@ pub fn path_windows(
     };
     match path {
         SynthesisPath::Reference => panic!("the reference is the yardstick, not a path under test"),
-        SynthesisPath::Default => run::<VoiceBank>(case, &spec, sample_rate),
+        SynthesisPath::Default => run::<AnchoredF32>(case, &spec, sample_rate),
         SynthesisPath::RecursiveF64 => run::<RecursiveF64>(case, &spec, sample_rate),
         SynthesisPath::RecursiveF32 => run::<RecursiveF32>(case, &spec, sample_rate),
     }

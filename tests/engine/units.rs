@@ -5,14 +5,14 @@ use rustfft::{num_complex::Complex, FftPlanner};
 use sake_glug::engine::pour::UnitShape;
 use sake_glug::engine::GRID;
 use sake_glug::engine::{
-    Controls, DrainMode, Engine, Lane, ModelConfig, Synthesis, UnitOnset, VoiceBank,
+    AnchoredF32, Controls, DrainMode, Engine, Lane, ModelConfig, Synthesis, UnitOnset,
 };
 
 const FS: f64 = 48_000.0;
 
 /// One unit, rendered alone on the default path for `len` samples.
 fn render_unit(onset: UnitOnset, len: usize) -> Vec<f32> {
-    let mut bank = VoiceBank::new(FS);
+    let mut bank = AnchoredF32::new(FS);
     bank.start_unit(&onset);
     let mut out = vec![0.0f32; len];
     for (period, chunk) in out.chunks_mut(GRID).enumerate() {

@@ -207,3 +207,27 @@ fn the_accuracy_command_fails_on_a_nan_row() {
     let message = String::from_utf8_lossy(&output.stderr);
     assert!(message.contains("the error is NaN"), "{message}");
 }
+
+#[test]
+fn the_accuracy_lengths_are_taken_as_the_help_shows_them() {
+    let directory = tempfile::tempdir().unwrap();
+    let help = sake_glug(directory.path(), &["accuracy", "--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(help.contains("[default: 1 60 3600]"), "{help}");
+    // Space-separated as in the help, and comma-separated; at a sample rate of 0 the rows are
+    // NaN (a quick failure), but every length asked for has its rows.
+    for lengths in [&["1", "2"][..], &["1,2"]] {
+        let mut args = vec!["accuracy", "--sample-rate", "0", "--lengths"];
+        args.extend(lengths);
+        let output = sake_glug(directory.path(), &args);
+        let message = String::from_utf8_lossy(&output.stderr);
+        assert!(message.contains("the error is NaN"), "{args:?}: {message}");
+        let table = String::from_utf8_lossy(&output.stdout);
+        for label in ["| 1 s |", "| 2 s |"] {
+            assert!(
+                table.contains(label),
+                "{args:?}: no {label} row in\n{table}"
+            );
+        }
+    }
+}

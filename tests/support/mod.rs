@@ -5,7 +5,7 @@ pub mod fuzz;
 
 use sake_glug::engine::synthesis::reference;
 use sake_glug::engine::{
-    ControlSource, ControlValues, Engine, ModelConfig, Pour, UnitOnset, VoiceBank,
+    AnchoredF32, ControlSource, ControlValues, Engine, ModelConfig, Pour, UnitOnset,
 };
 use sake_glug::offline::{LaneBuffers, Scene};
 use sake_glug::reports::accuracy;
@@ -96,7 +96,7 @@ pub fn render_controls(
         keep: std::slice::from_ref(&whole),
         energy_span: 0,
     };
-    timing::timed_render::<VoiceBank>(&spec, controls).kept
+    timing::timed_render::<AnchoredF32>(&spec, controls).kept
 }
 
 /// The f64 reference of the same controls, asked for at the same `sample_rate`.

@@ -9,8 +9,8 @@ use sake_glug::reports::accuracy;
 
 #[derive(Args, Debug)]
 pub struct AccuracyArgs {
-    /// Render lengths in seconds.
-    #[arg(long, value_delimiter = ',', default_values_t = accuracy::LENGTHS_S)]
+    /// Render lengths in seconds, as the default shows them (commas work too).
+    #[arg(long, num_args = 1.., value_delimiter = ',', default_values_t = accuracy::LENGTHS_S)]
     lengths: Vec<f64>,
     /// Sample rate (Hz).
     #[arg(long, default_value_t = 48_000.0)]

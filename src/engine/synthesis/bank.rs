@@ -1,14 +1,16 @@
 //! The sounding components of a synthesis path, in a bank of fixed capacity allocated once, and
-//! the rules for letting new ones in (the voice caps of MODEL.md §11). Every path admits
-//! components the same way, so they differ only in how a component is rendered.
+//! the rules for letting new ones in (the voice caps of MODEL.md §11). Every path is a [`Bank`]
+//! and admits components the same way, so paths differ only in their [`BankComponent`]: how one
+//! component is rendered.
 
 use super::component::Component;
+use super::Synthesis;
 use crate::engine::pour::UnitOnset;
 
 /// More components than this never sound at once. Past it, a new component replaces the weakest
 /// sounding one if it is louder, and is given up otherwise: a bottle pours a handful of units at
 /// a time, so this only bites in stress cases (B near 0, pocket volumes near zero).
-pub const MAX_PARTIALS: usize = 256;
+pub const MAX_COMPONENTS: usize = 256;
 /// The start budget holds at most this many units: a burst of this many may start at once.
 pub const START_BURST_UNITS: f64 = 8.0;
 /// The start budget refills by this many units per second of (onset) time: 500 times a real
@@ -18,14 +20,17 @@ pub const START_BURST_UNITS: f64 = 8.0;
 /// in time, not in samples, so the voicing does not depend on the sample rate.
 pub const STARTS_PER_SECOND: f64 = 6000.0;
 
-/// What a bank holds: something started from a [`Component`] with a loudness to compare.
-pub trait Sounding {
+/// A component as one synthesis path renders it: what its [`Bank`] holds.
+pub trait BankComponent: Sized {
+    /// The component from its first sample on.
     fn start(component: Component) -> Self;
     /// Any measure that orders components by loudness.
     fn level(&self) -> f64;
-    /// Makes the component's state NaN: the fault the stability suite must catch.
-    #[cfg(feature = "fault-injection")]
-    fn poison(&mut self);
+    /// Moves to the grid period starting at `period_start`; false once the component is silent.
+    fn advance(&mut self, period_start: u64) -> bool;
+    /// Adds every component of a bank into `out`, which starts at absolute sample `span_start`
+    /// and lies within one grid period.
+    fn add_all(components: &mut [Self], span_start: u64, out: &mut [f32]);
 }
 
 /// The start budget of MODEL.md §11: a bucket of at most [`START_BURST_UNITS`] units that refills
@@ -57,51 +62,48 @@ impl StartBudget {
     }
 }
 
-pub struct Bank<T> {
-    sounding: Vec<T>,
+/// A synthesis path: the sounding components of kind `C`, allocation-free after `new()`.
+pub struct Bank<C> {
+    sounding: Vec<C>,
+    sample_rate: f64,
+    /// Components given up because the bank was full or the start budget was spent (both
+    /// components of a unit refused by the budget count).
     given_up: u64,
     budget: StartBudget,
-    /// The most components that sounded at once since [`Bank::take_peak_len`] last read it.
+    /// The most components that sounded at once since [`Synthesis::take_peak_len`] last read it.
     peak_len: usize,
-    #[cfg(feature = "fault-injection")]
-    poison_next: bool,
 }
 
-impl<T: Sounding> Bank<T> {
-    pub fn new() -> Self {
+impl<C: BankComponent> Synthesis for Bank<C> {
+    fn new(sample_rate: f64) -> Self {
         Self {
-            sounding: Vec::with_capacity(MAX_PARTIALS),
+            sounding: Vec::with_capacity(MAX_COMPONENTS),
+            sample_rate,
             given_up: 0,
             budget: StartBudget::FULL,
             peak_len: 0,
-            #[cfg(feature = "fault-injection")]
-            poison_next: false,
         }
     }
 
-    pub fn clear(&mut self) {
+    fn clear(&mut self) {
         self.sounding.clear();
         self.given_up = 0;
         self.budget = StartBudget::FULL;
     }
 
-    pub fn sounding(&self) -> &[T] {
-        &self.sounding
+    fn is_empty(&self) -> bool {
+        self.sounding.is_empty()
     }
 
-    pub fn sounding_mut(&mut self) -> &mut [T] {
-        &mut self.sounding
+    fn len(&self) -> usize {
+        self.sounding.len()
     }
 
-    /// Components given up because the bank was full or the start budget was spent (both
-    /// components of a unit refused by the budget count).
-    pub fn given_up(&self) -> u64 {
+    fn given_up(&self) -> u64 {
         self.given_up
     }
 
-    /// The most components that sounded at once since the last call (or since the bank was
-    /// made); the count starts again from those sounding now.
-    pub fn take_peak_len(&mut self) -> usize {
+    fn take_peak_len(&mut self) -> usize {
         let peak = self.peak_len.max(self.sounding.len());
         self.peak_len = self.sounding.len();
         peak
@@ -109,37 +111,33 @@ impl<T: Sounding> Bank<T> {
 
     /// Starts the audible components of `onset` if the start budget admits the unit; a refused
     /// unit is given up whole.
-    pub fn start_unit(&mut self, onset: &UnitOnset, sample_rate: f64) {
-        let time_s = (onset.sample as f64 + onset.fraction) / sample_rate;
+    fn start_unit(&mut self, onset: &UnitOnset) {
+        let time_s = (onset.sample as f64 + onset.fraction) / self.sample_rate;
         if !self.budget.admit(time_s) {
             self.given_up += 2;
             return;
         }
         for index in 0..2 {
-            if let Some(component) = Component::of(onset, index, sample_rate) {
-                self.insert(T::start(component));
+            if let Some(component) = Component::of(onset, index, self.sample_rate) {
+                self.insert(C::start(component));
             }
         }
     }
 
-    /// A new grid period: `keep` decides which components sound on.
-    pub fn advance(&mut self, keep: impl FnMut(&mut T) -> bool) {
-        self.sounding.retain_mut(keep);
+    #[inline]
+    fn synthesize(&mut self, span_start: u64, out: &mut [f32]) {
+        C::add_all(&mut self.sounding, span_start, out);
     }
 
-    /// The next component to start will have a NaN state.
-    #[cfg(feature = "fault-injection")]
-    pub fn poison_next(&mut self) {
-        self.poison_next = true;
+    fn advance(&mut self, period_start: u64) {
+        self.sounding
+            .retain_mut(|component| component.advance(period_start));
     }
+}
 
-    #[allow(unused_mut)]
-    fn insert(&mut self, mut new: T) {
-        #[cfg(feature = "fault-injection")]
-        if std::mem::take(&mut self.poison_next) {
-            new.poison();
-        }
-        if self.sounding.len() < MAX_PARTIALS {
+impl<C: BankComponent> Bank<C> {
+    fn insert(&mut self, new: C) {
+        if self.sounding.len() < MAX_COMPONENTS {
             self.sounding.push(new);
             self.peak_len = self.peak_len.max(self.sounding.len());
             return;
@@ -153,12 +151,6 @@ impl<T: Sounding> Bank<T> {
         if weakest.level() < new.level() {
             *weakest = new;
         }
-    }
-}
-
-impl<T: Sounding> Default for Bank<T> {
-    fn default() -> Self {
-        Self::new()
     }
 }
 

@@ -1,30 +1,29 @@
-//! Synthesis: the units the pour starts, voiced and summed (MODEL.md §5–6, §9).
+//! Synthesis: the units the pour starts, their components summed (MODEL.md §5–6, §9).
 //!
-//! Three paths implement [`Synthesis`] and share the admission rules of [`bank`]: the default
-//! anchored path ([`VoiceBank`], real time, f32), and the recursive oscillators in f32 and f64
-//! ([`RecursiveF32`], [`RecursiveF64`]) that the accuracy report compares with it. [`reference`]
-//! is no path at all: the f64 closed form summed at every sample, the yardstick of the others.
+//! A unit (one glug) sounds as two components, each a decaying sinusoid ([`component`]). Three
+//! paths implement [`Synthesis`], each a [`bank`] of its own kind of component sharing the
+//! admission rules: the default anchored path ([`AnchoredF32`], real time, f32), and the recursive
+//! oscillators in f32 and f64 ([`RecursiveF32`], [`RecursiveF64`]) that the accuracy report
+//! compares with it. [`reference`] is no path at all: the f64 closed form summed at every sample,
+//! the yardstick of the others.
 
+mod anchored;
 mod bank;
 mod component;
-mod partial;
 mod recursive;
 pub mod reference;
-mod voices;
 
-pub use bank::{MAX_PARTIALS, STARTS_PER_SECOND, START_BURST_UNITS};
+pub use anchored::{AnchoredF32, GRID};
+pub use bank::{MAX_COMPONENTS, STARTS_PER_SECOND, START_BURST_UNITS};
 pub use component::SILENT_DECAY_EXPONENT;
-pub use partial::GRID;
 pub use recursive::{RecursiveF32, RecursiveF64, REANCHOR_SAMPLES};
-pub use voices::VoiceBank;
 
 use crate::engine::pour::UnitOnset;
 
-/// A bank of sounding wave-unit components. The engine renders spans that lie within one grid
-/// period of [`GRID`] samples and calls [`Synthesis::advance`] at each period's
-/// start, counted from the last reset (while the bank is empty and the pour rests, only at the
-/// last period start before it renders again); a path must give the same samples however spans
-/// are cut.
+/// A bank of sounding unit components. The engine renders spans that lie within one grid period
+/// of [`GRID`] samples and calls [`Synthesis::advance`] at each period's start, counted from the
+/// last reset (while the bank is empty and the pour rests, only at the last period start before
+/// it renders again); a path must give the same samples however spans are cut.
 pub trait Synthesis {
     /// An empty bank for output at `sample_rate` (Hz); allocates, once.
     fn new(sample_rate: f64) -> Self;
@@ -39,10 +38,7 @@ pub trait Synthesis {
     /// The most components that sounded at once since the last call; the count then starts
     /// again from those sounding now.
     fn take_peak_len(&mut self) -> usize;
-    /// The next component to start gets a NaN state (a test's deliberate fault).
-    #[cfg(feature = "fault-injection")]
-    fn poison_next_component(&mut self);
-    /// Voices a unit that starts during sample `onset.sample`.
+    /// Starts the components of a unit that starts during sample `onset.sample`.
     fn start_unit(&mut self, onset: &UnitOnset);
     /// Adds every component into `out`, which starts at absolute sample `span_start` and lies
     /// within one grid period.

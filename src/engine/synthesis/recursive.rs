@@ -1,11 +1,12 @@
 //! The recursive synthesis paths: each component is a complex oscillator stepped by one rotation
-//! z = e^(−d + iω) per sample, in f64 ([`RecursiveF64`]) or in f32 ([`RecursiveF32`]).
+//! z = e^(−d + iω) per sample ([`RecursiveComponent`]), in f64 ([`RecursiveF64`]) or in f32
+//! ([`RecursiveF32`]).
 //!
 //! A bare recursion drifts: the rounding of z compounds, so phase and magnitude errors grow
 //! linearly with the samples rung. Both paths therefore re-anchor every component from the closed
 //! form at fixed points of the absolute sample grid ([`REANCHOR_SAMPLES`]), so the error is
 //! bounded by what one anchor interval can accumulate, whatever the render length. In f64 that is
-//! far below the budget; in f32 it is not, which is why the default path ([`super::VoiceBank`])
+//! far below the budget; in f32 it is not, which is why the default path ([`super::AnchoredF32`])
 //! anchors every 64 samples instead of recursing.
 //!
 //! Which components are computed ([`Component::of`]) and admitted ([`Bank`]) is shared with the
@@ -14,22 +15,21 @@
 use num_complex::Complex;
 use num_traits::Float;
 
-use super::bank::{Bank, Sounding};
+use super::anchored::GRID;
+use super::bank::{Bank, BankComponent};
 use super::component::{Component, SILENT_DECAY_EXPONENT};
-use super::partial::GRID;
-use super::Synthesis;
-use crate::engine::pour::UnitOnset;
 
 /// Components are re-evaluated from the closed form on every multiple of this many samples
 /// (1024 grid periods, ≈ 1.4 s at 48 kHz): the longest a recursion runs unchecked.
 pub const REANCHOR_SAMPLES: u64 = 1024 * GRID as u64;
 
 /// The f64 recursive path: the precise one.
-pub type RecursiveF64 = RecursiveBank<f64>;
+pub type RecursiveF64 = Bank<RecursiveComponent<f64>>;
 /// The f32 recursive path: shows what a recursion in the output's precision costs in accuracy.
-pub type RecursiveF32 = RecursiveBank<f32>;
+pub type RecursiveF32 = Bank<RecursiveComponent<f32>>;
 
-struct Oscillator<T> {
+/// One component on a recursive path, in precision `T`.
+pub struct RecursiveComponent<T> {
     /// The complex state A·e^((−B + iω)τ) at `next_sample`; its imaginary part is the output.
     state: Complex<T>,
     /// z, the per-sample rotation.
@@ -40,35 +40,52 @@ struct Oscillator<T> {
     component: Component,
 }
 
-impl<T: Float> Sounding for Oscillator<T> {
+impl<T: Float> BankComponent for RecursiveComponent<T> {
     fn start(component: Component) -> Self {
         // Bτ ≤ ln 10⁶ ⇔ sample ≤ onset + x + ln 10⁶ / d; `as` saturates for d = 0 (rings for ever).
         let audible_until = component.onset_sample as f64
             + component.onset_fraction
             + SILENT_DECAY_EXPONENT / component.decay_per_sample;
         let first_sample = component.first_sample();
-        let mut oscillator = Self {
+        let mut recursive = Self {
             state: Complex::new(T::zero(), T::zero()),
             step: to_complex(component.step()),
             next_sample: first_sample,
             silent_from: (audible_until.floor() as u64).saturating_add(1),
             component,
         };
-        oscillator.anchor_at(first_sample);
-        oscillator
+        recursive.anchor_at(first_sample);
+        recursive
     }
 
     fn level(&self) -> f64 {
         self.state.norm().to_f64().unwrap_or(0.0)
     }
 
-    #[cfg(feature = "fault-injection")]
-    fn poison(&mut self) {
-        self.state = Complex::new(T::nan(), T::nan());
+    fn advance(&mut self, period_start: u64) -> bool {
+        if period_start >= self.silent_from {
+            return false;
+        }
+        if period_start.is_multiple_of(REANCHOR_SAMPLES) && self.next_sample == period_start {
+            self.anchor_at(period_start);
+        }
+        true
+    }
+
+    fn add_all(components: &mut [Self], span_start: u64, out: &mut [f32]) {
+        // The span's sum in the path's own precision, before it meets the f32 output.
+        let mut sum = [T::zero(); GRID];
+        let sum = &mut sum[..out.len()];
+        for component in components {
+            component.synthesize(span_start, sum);
+        }
+        for (y, &value) in out.iter_mut().zip(sum.iter()) {
+            *y += value.to_f32().unwrap_or(0.0);
+        }
     }
 }
 
-impl<T: Float> Oscillator<T> {
+impl<T: Float> RecursiveComponent<T> {
     /// Sets the state from the closed form at `sample`.
     fn anchor_at(&mut self, sample: u64) {
         self.state = to_complex(self.component.state_at(sample));
@@ -97,80 +114,6 @@ impl<T: Float> Oscillator<T> {
         self.state = state;
         self.next_sample = end;
     }
-
-    /// Moves to the period starting at `period_start`; returns false once the component is silent.
-    fn advance(&mut self, period_start: u64) -> bool {
-        if period_start >= self.silent_from {
-            return false;
-        }
-        if period_start.is_multiple_of(REANCHOR_SAMPLES) && self.next_sample == period_start {
-            self.anchor_at(period_start);
-        }
-        true
-    }
-}
-
-/// The sounding components of a recursive path.
-pub struct RecursiveBank<T> {
-    bank: Bank<Oscillator<T>>,
-    /// Sums the components of a span in the path's own precision before it meets the f32 output.
-    scratch: [T; GRID],
-    sample_rate: f64,
-}
-
-impl<T: Float> Synthesis for RecursiveBank<T> {
-    fn new(sample_rate: f64) -> Self {
-        Self {
-            bank: Bank::new(),
-            scratch: [T::zero(); GRID],
-            sample_rate,
-        }
-    }
-
-    fn clear(&mut self) {
-        self.bank.clear();
-    }
-
-    fn is_empty(&self) -> bool {
-        self.bank.sounding().is_empty()
-    }
-
-    fn len(&self) -> usize {
-        self.bank.sounding().len()
-    }
-
-    fn given_up(&self) -> u64 {
-        self.bank.given_up()
-    }
-
-    fn take_peak_len(&mut self) -> usize {
-        self.bank.take_peak_len()
-    }
-
-    #[cfg(feature = "fault-injection")]
-    fn poison_next_component(&mut self) {
-        self.bank.poison_next();
-    }
-
-    fn start_unit(&mut self, onset: &UnitOnset) {
-        self.bank.start_unit(onset, self.sample_rate);
-    }
-
-    fn synthesize(&mut self, span_start: u64, out: &mut [f32]) {
-        let scratch = &mut self.scratch[..out.len()];
-        scratch.fill(T::zero());
-        for oscillator in self.bank.sounding_mut() {
-            oscillator.synthesize(span_start, scratch);
-        }
-        for (y, &sum) in out.iter_mut().zip(scratch.iter()) {
-            *y += sum.to_f32().unwrap_or(0.0);
-        }
-    }
-
-    fn advance(&mut self, period_start: u64) {
-        self.bank
-            .advance(|oscillator| oscillator.advance(period_start));
-    }
 }
 
 fn to_complex<T: Float>([re, im]: [f64; 2]) -> Complex<T> {
@@ -183,7 +126,8 @@ fn to_complex<T: Float>([re, im]: [f64; 2]) -> Complex<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::pour::UnitShape;
+    use crate::engine::pour::{UnitOnset, UnitShape};
+    use crate::engine::Synthesis;
 
     fn onset(decay_per_s: f64) -> UnitOnset {
         UnitOnset {
@@ -215,7 +159,7 @@ mod tests {
 
     /// Renders like the engine does: spans within grid periods, advance at each period start.
     fn render<T: Float>(onset: &UnitOnset, fs: f64, len: u64) -> Vec<f32> {
-        let mut bank = RecursiveBank::<T>::new(fs);
+        let mut bank = Bank::<RecursiveComponent<T>>::new(fs);
         bank.start_unit(onset);
         let mut out = vec![0.0f32; len as usize];
         let mut sample = 0u64;

@@ -34,7 +34,7 @@ pub use csv::write_csv_samples;
 pub use haptic::haptic_json;
 #[cfg(feature = "plot")]
 pub use plot::{draw_pour_plot, PlotData, PlotError};
-pub(crate) use wav::temp_file_builder;
+
 pub use wav::{SampleFormat, WavError};
 
 /// One file of a render, written from the render's single pass. Every method but

@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 
 use tempfile::NamedTempFile;
 
-use super::{temp_file_builder, OutputError};
+use super::OutputError;
+use crate::files::temp_file_builder;
 
 /// A file being written in a temporary file beside its target, which it replaces on
 /// [`PendingFile::commit`]; dropped uncommitted, it leaves nothing behind.

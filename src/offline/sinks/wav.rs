@@ -264,18 +264,6 @@ fn wav_spec(sample_rate: u32, format: SampleFormat) -> WavSpec {
     }
 }
 
-/// Temporary files are private by default; a finished file should get the permissions any new
-/// file gets (0o666 less the umask), as if it had been written in place.
-pub(crate) fn temp_file_builder() -> tempfile::Builder<'static, 'static> {
-    let mut builder = tempfile::Builder::new();
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    builder
-}
-
 /// `samples` in a format of `WIDTH` bytes per sample, in `bytes` (reused from block to block).
 #[inline]
 fn convert<'a, const WIDTH: usize>(
