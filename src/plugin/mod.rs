@@ -8,7 +8,6 @@ pub mod presets;
 mod realtime;
 pub mod standalone;
 mod transport;
-pub mod vstpreset;
 
 #[cfg(feature = "editor")]
 mod editor;

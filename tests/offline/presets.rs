@@ -51,31 +51,3 @@ fn presets_differ_where_they_should() {
     let capacity = |id: &str| preset(id).config(config).capacity_ml;
     assert!(capacity("small-bottle") < 300.0 && capacity("large-bottle") > 300.0);
 }
-
-/// `sake-glug presets --vstpreset DIR`, which `cargo xtask docs` runs, writes the committed
-/// `presets/vst3/` files, byte for byte (`tests/plugin/vstpreset.rs` checks what they hold).
-#[cfg(feature = "plugin")]
-#[test]
-fn the_vstpreset_command_writes_the_committed_files() {
-    use crate::command::{files_in, sake_glug};
-
-    let directory = tempfile::tempdir().unwrap();
-    let output = sake_glug(directory.path(), &["presets", "--vstpreset", "vst3"]);
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/vst3");
-    let written = directory.path().join("vst3");
-    let names = files_in(&written);
-    assert_eq!(names, files_in(&committed));
-    assert_eq!(names.len(), PRESETS.len());
-    for name in names {
-        assert!(
-            std::fs::read(written.join(&name)).unwrap()
-                == std::fs::read(committed.join(&name)).unwrap(),
-            "{name} differs from presets/vst3/{name} (run `cargo xtask docs`)"
-        );
-    }
-}

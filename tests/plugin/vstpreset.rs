@@ -1,17 +1,83 @@
-//! The presets as VST3 preset files: `presets/vst3/<name>.vstpreset` is the code's own file for
-//! each preset (so the files cannot drift from the editor's menu), laid out as Steinberg's
-//! format says, and its component state is one nice-plug's real state path loads as the preset
-//! and saves back byte for byte.
+//! The presets as VST3 preset files (`.vstpreset`), the preset mechanism VST3 hosts offer: a
+//! host lists the files of a plugin's preset folder and loads one by handing its component state
+//! to the plugin's `IComponent::setState`. `presets/vst3/<name>.vstpreset` is, for each preset,
+//! the state the plugin's own wrapper saves once a host has set the preset's parameters on a new
+//! instance (as the editor's menu does), so the files cannot drift from the menu; it is laid out
+//! as Steinberg's format says. With `SAKE_GLUG_WRITE_PRESETS=1` (what `cargo xtask docs` sets)
+//! the test writes the files instead of checking them.
+//!
+//! The layout is Steinberg's (VST3 SDK, "Preset Format"), all integers little-endian:
+//!
+//! ```text
+//! 0   'VST3'                              4 bytes
+//! 4   format version, 1                   int32
+//! 8   the class ID as 32 hex digits       32 bytes ASCII
+//! 40  offset of the chunk list            int64
+//! 48  'Comp' data: the component state    what IComponent::getState writes
+//! …   'List'                              4 bytes
+//!     entry count, 1                      int32
+//!     'Comp', its offset (48), its size   4 bytes, int64, int64
+//! ```
+//!
+//! There is no 'Cont' chunk: nice-plug's edit controller keeps no state of its own. The list comes
+//! last, as Steinberg's own writer puts it. The whole format is a 48-byte header and a 24-byte
+//! table, written here rather than taken from a crate (no well-kept one writes it).
 
 use std::path::{Path, PathBuf};
 
 use nice_plug::prelude::Vst3Plugin;
 use sake_glug::engine::{Knob, PresetValue};
 use sake_glug::engine::{Preset, PRESETS};
-use sake_glug::plugin::{exact, vstpreset};
+use sake_glug::plugin::exact;
 use sake_glug::SakeGlugVst3;
 
 use crate::clap_host::ClapInstance;
+
+/// The format version Steinberg's files carry.
+const FORMAT_VERSION: i32 = 1;
+/// Bytes before the first chunk: id, version, class ID, chunk-list offset.
+const HEADER_SIZE: usize = 4 + 4 + 32 + 8;
+
+/// The class ID as a preset file (and a host's project) spells it: the 16 bytes of
+/// `VST3_CLASS_ID` as 32 upper-case hex digits, on every platform (nice-plug reorders the bytes
+/// on Windows so that the COM GUID spells the same digits).
+fn class_id_text(class_id: &[u8; 16]) -> String {
+    class_id.iter().map(|byte| format!("{byte:02X}")).collect()
+}
+
+/// A preset file for the plugin with `class_id` whose component state is `component_state`.
+fn vstpreset(class_id: &[u8; 16], component_state: &[u8]) -> Vec<u8> {
+    let list_offset = HEADER_SIZE + component_state.len();
+    let mut file = Vec::with_capacity(list_offset + 4 + 4 + 4 + 8 + 8);
+    file.extend_from_slice(b"VST3");
+    file.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    file.extend_from_slice(class_id_text(class_id).as_bytes());
+    file.extend_from_slice(&(list_offset as i64).to_le_bytes());
+    file.extend_from_slice(component_state);
+    file.extend_from_slice(b"List");
+    file.extend_from_slice(&1i32.to_le_bytes());
+    file.extend_from_slice(b"Comp");
+    file.extend_from_slice(&(HEADER_SIZE as i64).to_le_bytes());
+    file.extend_from_slice(&(component_state.len() as i64).to_le_bytes());
+    file
+}
+
+/// The preset file of `preset`: a new instance, through its CLAP entry as a host makes one, the
+/// preset's parameters set as a host sets them (their text, the plugin's own parse), and the
+/// state its wrapper saves.
+fn preset_file(preset: &Preset) -> Vec<u8> {
+    let instance = ClapInstance::new();
+    for (name, _, value) in preset_parameters(preset) {
+        instance.set_text(name, &value.to_string());
+    }
+    // The CLAP stream is the state's length, then the state nice-plug's VST3 wrapper saves too.
+    vstpreset(&SakeGlugVst3::VST3_CLASS_ID, &instance.save()[8..])
+}
+
+/// The file's name: the preset's name, which hosts show as the preset's.
+fn file_name(preset: &Preset) -> String {
+    format!("{}.vstpreset", preset.name)
+}
 
 fn folder() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/vst3")
@@ -128,11 +194,19 @@ fn preset_parameters(preset: &Preset) -> Vec<(&'static str, Knob, f64)> {
 
 #[test]
 fn every_vstpreset_file_is_the_presets_own() {
+    if std::env::var_os("SAKE_GLUG_WRITE_PRESETS").is_some() {
+        std::fs::create_dir_all(folder()).unwrap();
+        for preset in &PRESETS {
+            let path = folder().join(file_name(preset));
+            std::fs::write(&path, preset_file(preset)).unwrap();
+            println!("{} written", path.display());
+        }
+    }
     for preset in &PRESETS {
         assert!(
-            committed(preset) == vstpreset::preset_file(preset),
+            committed(preset) == preset_file(preset),
             "presets/vst3/{} is stale (run `cargo xtask docs`)",
-            vstpreset::file_name(preset)
+            file_name(preset)
         );
     }
     let files = std::fs::read_dir(folder()).unwrap().count();
