@@ -1,5 +1,5 @@
 //! Stability on stiff and extreme cases: the cases, what each checks, and the measurements, shared
-//! by `sake-glug stability` (long renders) and `tests/stability.rs` (short ones).
+//! by `sake-glug stability` (long renders) and `tests/reports/stability.rs` (short ones).
 //!
 //! Every case renders through the engine's public API and checks some of:
 //! - **finite**: no NaN or infinity in any sample, before the output limiter as well as after;
