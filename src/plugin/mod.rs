@@ -39,7 +39,7 @@ pub struct SakeGlugPlugin<const RAW_MIDI: bool> {
     feed: Arc<Feed>,
     /// OSC from phones and sensors: the socket thread and the values it leaves for `process()`.
     osc: Arc<OscInput>,
-    /// Built in `initialize()`, where allocating is allowed.
+    /// Built in `activate()`, where allocating is allowed.
     renderer: Option<RealtimeEngine>,
 }
 

@@ -1,7 +1,7 @@
 //! OSC in the plugin: the saved port and axis, and the socket thread they start.
 //!
 //! Real-time safety: the socket is bound, read and decoded on threads other than the audio
-//! thread (the listener's own thread; [`OscInput::listen`] runs from `initialize()` or the
+//! thread (the listener's own thread; [`OscInput::listen`] runs from `activate()` or the
 //! editor). The audio thread only polls [`LiveControls`], whose `Arc` never changes while the
 //! plugin lives: atomic loads, no lock, no allocation.
 

@@ -65,7 +65,7 @@ pub struct RealtimeEngine {
 }
 
 impl RealtimeEngine {
-    /// Allocates: call from `initialize()`.
+    /// Allocates: call from `activate()`.
     pub fn new(sample_rate: f64, config: ModelConfig) -> Self {
         let engine = Engine::new(sample_rate, config);
         let fade_len = ((engine.sample_rate() * FADE_S).round() as usize).max(1);

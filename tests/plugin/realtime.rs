@@ -2,7 +2,7 @@
 //! built with `--features assert_process_allocs` in the dev profile), under every kind of input a
 //! host sends: odd block sizes, parameter changes, note-ons, CCs, transport starts and jumps.
 //!
-//! Run: `cargo test --features assert_process_allocs --test plugin_realtime`
+//! Run: `cargo test --features assert_process_allocs --test plugin realtime`
 
 use nice_plug::prelude::Plugin;
 

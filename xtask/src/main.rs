@@ -1,8 +1,11 @@
 //! `cargo xtask`: nice-plug's bundler, plus the project's two everyday jobs.
 //!
-//! - `cargo xtask pour`: build the plugin bundles and render the built-in scene to `pour.wav`.
+//! - `cargo xtask pour`: build the plugin bundles, the CLI and the standalone app, and render the
+//!   built-in scene to `pour.wav`. Without the app's libraries (pkg-config's `alsa` and `jack`) it
+//!   skips the app and ends with one line naming the `apt-get install` that adds them.
 //! - `cargo xtask test`: every test: formatting and lints, the Rust suites, then the bundles in a
-//!   real VST3 host and the standalone app under a JACK server.
+//!   real VST3 host and the standalone app under a JACK server. Without the app's libraries it
+//!   stops at once, naming the `apt-get install`.
 //! - `cargo xtask docs [--bench]`: regenerates every table and picture of docs/ from the current
 //!   code (the accuracy table and plot, the stability report, the pour plot, the presets as
 //!   scene files and VST3 preset files), stamped with the commit and the machine, and the cost
@@ -12,7 +15,8 @@
 //!   and while a phone's OSC gravity pours, written to docs/editor-idle.png and
 //!   docs/editor-pouring.png.
 //! - `cargo xtask fuzz`: every fuzz target (tests named `fuzz_…`) with a million cases each
-//!   (`FUZZ_CASES` to change it), summarised in docs/fuzzing.md.
+//!   (`FUZZ_CASES` to change it), summarised in docs/fuzzing.md; built with every feature, or
+//!   every one but `standalone` without the app's libraries.
 //!
 //! Each product is built with only its features: the bundles with `editor` (which brings
 //! `plugin`), the command line with `cli`, the standalone app with `standalone`, so none compiles
@@ -23,7 +27,19 @@ use std::process::Command;
 
 mod screenshots;
 
-fn main() -> nice_plug_xtask::Result<()> {
+/// An error is said in one line, without the backtrace anyhow adds under `RUST_BACKTRACE`: it
+/// tells what is wrong with the machine or the code, not where in the xtask it was noticed.
+fn main() -> std::process::ExitCode {
+    match xtask() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn xtask() -> nice_plug_xtask::Result<()> {
     // Read before nice-plug's bundler runs: it clears cargo's variables for its own builds.
     TARGET_DIR.get_or_init(|| {
         std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| PathBuf::from("target"), PathBuf::from)
@@ -32,11 +48,21 @@ fn main() -> nice_plug_xtask::Result<()> {
     match args.first().map(String::as_str) {
         Some("pour") => {
             nice_plug_xtask::chdir_workspace_root()?;
-            build_release()?;
-            run("target/release/sake-glug", &["render", "-o", "pour.wav"])
+            let missing = standalone_missing();
+            build_bundles_and_cli()?;
+            if missing.is_empty() {
+                build_standalone()?;
+            }
+            run(&cli(), &["render", "-o", "pour.wav"])?;
+            if !missing.is_empty() {
+                println!("{}", standalone_skipped("the standalone app", &missing));
+            }
+            Ok(())
         }
         Some("test") => {
             nice_plug_xtask::chdir_workspace_root()?;
+            // Clippy and the suites build every feature, the standalone app's among them.
+            require_standalone("cargo xtask test")?;
             cargo(&["fmt", "--all", "--check"])?;
             cargo(&[
                 "clippy",
@@ -50,7 +76,8 @@ fn main() -> nice_plug_xtask::Result<()> {
             // All features, assert_process_allocs among them: the dev profile keeps the debug
             // assertions it needs.
             cargo(&["test", "--workspace", "--no-fail-fast", "--all-features"])?;
-            build_release()?;
+            build_bundles_and_cli()?;
+            build_standalone()?;
             host_tests()
         }
         Some("docs") => {
@@ -66,6 +93,7 @@ fn main() -> nice_plug_xtask::Result<()> {
         Some("screenshots") => {
             nice_plug_xtask::chdir_workspace_root()?;
             screenshots::check_tools()?;
+            require_standalone("cargo xtask screenshots")?;
             build_standalone()?;
             let cpu = screenshots::screenshots(
                 &target_dir().join("release/sake-glug-standalone"),
@@ -77,9 +105,8 @@ fn main() -> nice_plug_xtask::Result<()> {
     }
 }
 
-/// The CLAP and VST3 bundles under target/bundled/, and the release CLI and standalone app
-/// beside them.
-fn build_release() -> nice_plug_xtask::Result<()> {
+/// The CLAP and VST3 bundles under target/bundled/, and the release CLI beside them.
+fn build_bundles_and_cli() -> nice_plug_xtask::Result<()> {
     nice_plug_xtask::main_with_args(
         "cargo xtask",
         [
@@ -92,8 +119,55 @@ fn build_release() -> nice_plug_xtask::Result<()> {
         ]
         .map(String::from),
     )?;
-    build_cli()?;
-    build_standalone()
+    build_cli()
+}
+
+/// What the standalone app links against, as pkg-config names each library, and the Debian
+/// package that provides it.
+const STANDALONE_LIBRARIES: [(&str, &str); 2] =
+    [("alsa", "libasound2-dev"), ("jack", "libjack-jackd2-dev")];
+
+/// The Debian packages the standalone app still needs here, asked of pkg-config as the build
+/// scripts of `alsa-sys` and `jack-sys` will ask it (`$PKG_CONFIG`, its search path); without
+/// pkg-config, pkg-config and every library. Empty when the app can be built.
+fn standalone_missing() -> Vec<&'static str> {
+    let pkg_config = std::env::var("PKG_CONFIG").unwrap_or_else(|_| "pkg-config".into());
+    if Command::new(&pkg_config).arg("--version").output().is_err() {
+        return std::iter::once("pkg-config")
+            .chain(STANDALONE_LIBRARIES.map(|(_, package)| package))
+            .collect();
+    }
+    STANDALONE_LIBRARIES
+        .iter()
+        .filter(|(library, _)| {
+            !Command::new(&pkg_config)
+                .args(["--exists", library])
+                .status()
+                .is_ok_and(|status| status.success())
+        })
+        .map(|(_, package)| *package)
+        .collect()
+}
+
+/// The one line a command that went on without the standalone app's libraries ends with.
+fn standalone_skipped(what: &str, missing: &[&str]) -> String {
+    format!(
+        "{what} skipped: its libraries are missing; `sudo apt-get install {}` enables it",
+        missing.join(" ")
+    )
+}
+
+/// Fails at once, in one line naming the packages, if the standalone app cannot be built here
+/// (rather than in a build script's panic minutes later).
+fn require_standalone(command: &str) -> nice_plug_xtask::Result<()> {
+    let missing = standalone_missing();
+    if !missing.is_empty() {
+        anyhow::bail!(
+            "{command} needs the standalone app and its libraries: sudo apt-get install {}",
+            missing.join(" ")
+        );
+    }
+    Ok(())
 }
 
 /// The standalone app (JACK and ALSA: libjack and libasound at build time).
@@ -168,22 +242,18 @@ fn docs() -> nice_plug_xtask::Result<()> {
         std::fs::write(format!("presets/{id}.toml"), scene)?;
         println!("presets/{id}.toml written");
     }
-    // And as VST3 preset files: the plugin's saved state, so a CLI built with the plugin; then
-    // the CLI alone again, which the rest of the docs measure.
-    cargo(&[
-        "run",
-        "--release",
-        "--bin",
-        "sake-glug",
-        "--no-default-features",
-        "--features",
-        "cli,plugin",
-        "--",
-        "presets",
-        "--vstpreset",
-        "presets/vst3",
-    ])?;
-    build_cli()?;
+    // And as VST3 preset files: the state the plugin's own wrapper saves once a host has set a
+    // preset's parameters, which the plugin test that checks the files writes when asked to.
+    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .args(["test", "--all-features", "--test", "plugin", "vstpreset"])
+        .env("SAKE_GLUG_WRITE_PRESETS", "1")
+        .status()?;
+    if !status.success() {
+        anyhow::bail!("writing presets/vst3 through the plugin test failed ({status})");
+    }
+    // The README's table of parameters, from the engine's tables.
+    let parameters = output(&cli(), &["parameters"])?;
+    replace_block("README.md", "parameters", &parameters)?;
     // The README's example of the pour plot: the default scene.
     let clip = target_dir().join("pour-plot.haptic");
     run(
@@ -391,16 +461,16 @@ fn stamp(took: std::time::Duration) -> String {
 /// their summary lines to docs/fuzzing.md.
 fn fuzz() -> nice_plug_xtask::Result<()> {
     let cases = std::env::var("FUZZ_CASES").unwrap_or_else(|_| "1000000".into());
+    // No fuzz target needs the standalone app: without its libraries, every other feature.
+    let missing = standalone_missing();
+    let features = if missing.is_empty() {
+        "--all-features".to_owned()
+    } else {
+        format!("--features={}", features_but_standalone()?)
+    };
     let started = std::time::Instant::now();
     let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .args([
-            "test",
-            "--all-features",
-            "--tests",
-            "fuzz_",
-            "--",
-            "--nocapture",
-        ])
+        .args(["test", &features, "--tests", "fuzz_", "--", "--nocapture"])
         .args(["--test-threads", "1"])
         .env("PROPTEST_CASES", &cases)
         .stderr(std::process::Stdio::inherit())
@@ -432,10 +502,33 @@ fn fuzz() -> nice_plug_xtask::Result<()> {
         "fuzz-results",
         &format!("{fuzz_stamp}\n{table}"),
     )?;
+    if !missing.is_empty() {
+        println!(
+            "{}",
+            standalone_skipped("the `standalone` feature", &missing)
+        );
+    }
     if rows.is_empty() || !out.status.success() {
         anyhow::bail!("the fuzz run failed or found no target");
     }
     Ok(())
+}
+
+/// Every feature of Cargo.toml's `[features]` but `default` and `standalone`, comma-separated.
+fn features_but_standalone() -> nice_plug_xtask::Result<String> {
+    let manifest = std::fs::read_to_string("Cargo.toml")?;
+    let Some((_, table)) = manifest.split_once("\n[features]\n") else {
+        anyhow::bail!("Cargo.toml has no [features]");
+    };
+    let features: Vec<&str> = table
+        .lines()
+        .take_while(|line| !line.starts_with('['))
+        // An entry starts its line; its list's continuation lines and comments do not.
+        .filter(|line| line.starts_with(|c: char| c.is_ascii_alphabetic()))
+        .filter_map(|line| line.split_once('=').map(|(name, _)| name.trim()))
+        .filter(|name| !["default", "standalone"].contains(name))
+        .collect();
+    Ok(features.join(","))
 }
 
 /// Replaces the text between `<!-- generated:NAME:begin -->` and `<!-- generated:NAME:end -->`.

@@ -2,7 +2,7 @@
 //! return is either well-formed or an error with a message.
 //!
 //! The case count is proptest's: 256 unless the `PROPTEST_CASES` environment variable says
-//! otherwise (e.g. `PROPTEST_CASES=100000 cargo test --release --test takes fuzz`).
+//! otherwise (e.g. `PROPTEST_CASES=100000 cargo test --release --test offline takes::fuzz`).
 
 use std::path::Path;
 
