@@ -30,7 +30,7 @@ pub use synthesis::{AnchoredF32, RecursiveF32, RecursiveF64, Synthesis, GRID};
 pub struct Engine<S: Synthesis = AnchoredF32> {
     sample_rate: f64,
     pour: Pour,
-    voices: S,
+    synthesis: S,
     /// Samples since the last reset: the grid periods and onset times are counted from it.
     sample: u64,
     /// The pour's last step changed nothing and would change nothing again under these controls.
@@ -56,7 +56,7 @@ impl<S: Synthesis> Engine<S> {
         let mut engine = Self {
             sample_rate,
             pour: Pour::new(sample_rate, config),
-            voices: S::new(sample_rate),
+            synthesis: S::new(sample_rate),
             sample: 0,
             resting_under: None,
             output: OutputStage::new(sample_rate),
@@ -86,7 +86,7 @@ impl<S: Synthesis> Engine<S> {
     /// MODEL.md §8 reset: refill, silence every unit, re-seed.
     pub fn reset(&mut self) {
         self.pour.reset();
-        self.voices.clear();
+        self.synthesis.clear();
         self.sample = 0;
         self.resting_under = None;
         self.last_unit = None;
@@ -117,18 +117,18 @@ impl<S: Synthesis> Engine<S> {
 
     /// Components currently sounding.
     pub fn sounding_components(&self) -> usize {
-        self.voices.len()
+        self.synthesis.len()
     }
 
-    /// Components given up because more were sounding than the engine voices.
+    /// Components given up because more were sounding than the engine synthesises at once.
     pub fn components_given_up(&self) -> u64 {
-        self.voices.given_up()
+        self.synthesis.given_up()
     }
 
     /// The most components that sounded at once since the last call (at any sample, not only at
     /// the end of a block); the count then starts again from those sounding now.
     pub fn take_peak_sounding(&mut self) -> usize {
-        self.voices.take_peak_len()
+        self.synthesis.take_peak_len()
     }
 
     /// Samples since the last reset that the output stage's limiter changed: a signal over the
@@ -174,7 +174,7 @@ impl<S: Synthesis> Engine<S> {
 
     /// Nothing sounds and, under constant controls, nothing would start: the rest is silence.
     pub fn is_settled(&self) -> bool {
-        self.voices.is_empty() && self.resting_under.is_some()
+        self.synthesis.is_empty() && self.resting_under.is_some()
     }
 
     /// Renders `out.len()` samples; `controls` give the inputs from the block's first sample.
@@ -191,7 +191,7 @@ impl<S: Synthesis> Engine<S> {
         out: &mut [f32],
         on_unit: &mut impl FnMut(&UnitOnset, f64),
     ) {
-        if self.voices.is_empty() && self.rests_under(controls) {
+        if self.synthesis.is_empty() && self.rests_under(controls) {
             // Settled under the same controls: the block is silence, so it costs a fill and not
             // a walk over its grid periods. An empty bank only needs the last period start.
             out.fill(0.0);
@@ -200,7 +200,7 @@ impl<S: Synthesis> Engine<S> {
             let end = self.sample + out.len() as u64;
             let last_period = end / GRID as u64 * GRID as u64;
             if last_period > self.sample {
-                self.voices.advance(last_period);
+                self.synthesis.advance(last_period);
             }
             self.sample = end;
             return;
@@ -224,13 +224,13 @@ impl<S: Synthesis> Engine<S> {
         out.fill(0.0);
         self.step_pour(controls, out.len(), on_unit);
         let ceiling = self.pour.config().ceiling;
-        if self.voices.is_empty() {
+        if self.synthesis.is_empty() {
             self.output
                 .pass_silence(&controls.gain_db, ceiling, out.len());
             self.advance_position(out.len());
             return;
         }
-        self.voices.synthesize(self.sample, out);
+        self.synthesis.synthesize(self.sample, out);
         self.active_until = self.sample + out.len() as u64;
         self.output.apply(&controls.gain_db, ceiling, out);
         self.advance_position(out.len());
@@ -247,7 +247,7 @@ impl<S: Synthesis> Engine<S> {
         }
         let Self {
             pour,
-            voices,
+            synthesis,
             last_unit,
             output,
             sample: span_start,
@@ -255,7 +255,7 @@ impl<S: Synthesis> Engine<S> {
         } = self;
         let span_start = *span_start;
         let mut start_unit = |onset: &UnitOnset| {
-            voices.start_unit(onset);
+            synthesis.start_unit(onset);
             *last_unit = Some(*onset);
             // Heard from the sample after the one it starts in (MODEL.md §6: t_i ≤ t_n).
             let first_heard = (onset.sample + 1 - span_start) as usize;
@@ -301,7 +301,7 @@ impl<S: Synthesis> Engine<S> {
     fn advance_position(&mut self, len: usize) {
         self.sample += len as u64;
         if self.sample.is_multiple_of(GRID as u64) {
-            self.voices.advance(self.sample);
+            self.synthesis.advance(self.sample);
         }
     }
 }

@@ -114,8 +114,8 @@ fn units_carry_the_viscosity_and_volume_at_their_onset() {
 }
 
 #[test]
-fn a_flood_voices_exactly_eight_units_a_sample() {
-    // MODEL.md §11: 625 pockets are due in every sample here, 8 are voiced. The reference takes
+fn a_flood_starts_exactly_eight_units_a_sample() {
+    // MODEL.md §11: 625 pockets are due in every sample here, 8 are started. The reference takes
     // its onsets from the same schedule, so the cap is checked here, against the contract's 8.
     let config = ModelConfig {
         pocket_ml: 0.001,

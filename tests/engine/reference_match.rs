@@ -92,8 +92,8 @@ fn other_capacities_and_viscosities_match_the_reference() {
 }
 
 #[test]
-fn a_short_flood_is_voiced_by_the_contracts_caps() {
-    // 625 pockets are due per sample for 10 ms: 8 a sample are voiced (§11), and of those the
+fn a_short_flood_is_started_by_the_contracts_caps() {
+    // 625 pockets are due per sample for 10 ms: 8 a sample are started (§11), and of those the
     // start budget admits a burst of 8 units and then 6000 per second, about 68 units, whose
     // 136 components stay under the 256 the bank holds (which the reference does not model).
     let scene = Scene::parse(

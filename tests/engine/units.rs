@@ -120,7 +120,7 @@ fn a_unit_is_its_closed_form_from_its_onset_on() {
 }
 
 #[test]
-fn c_of_zero_or_one_voices_one_component_only() {
+fn c_of_zero_or_one_sounds_one_component_only() {
     for (c, present) in [(0.0, 1), (1.0, 0)] {
         let onset = unit(c, [45.0, 40.0]);
         let samples = render_unit(onset, 24_000);
@@ -173,7 +173,7 @@ fn amplitude_follows_the_papers_law_and_vanishes_below_84_ml() {
     assert_eq!(silent, 0.0);
 }
 
-/// The voice caps of MODEL.md §11 in a 10 ms flood (625 pockets due per sample, 8 voiced): the
+/// The caps of MODEL.md §11 in a 10 ms flood (625 pockets due per sample, 8 started): the
 /// start budget admits a burst of 8 units and then 6000 a second, whatever the sample rate, and
 /// admits or refuses whole units.
 #[test]
@@ -195,10 +195,10 @@ fn the_start_budget_is_a_rate_in_time_and_admits_whole_units() {
         let mut out = vec![0.0f32; (0.01 * fs) as usize];
         engine.process(&controls, &mut out);
         let stats = engine.stats();
-        let voiced = stats.units_started - stats.units_skipped;
+        let started = stats.units_started - stats.units_skipped;
         let given_up = engine.components_given_up();
         assert_eq!(given_up % 2, 0, "{fs} Hz: half a unit was given up");
-        let admitted = voiced - given_up / 2;
+        let admitted = started - given_up / 2;
         assert_eq!(
             engine.sounding_components() as u64,
             2 * admitted,

@@ -93,7 +93,7 @@ impl UnitOnset {
 pub struct PourStats {
     /// Units whose onset came since the last reset, the skipped ones included.
     pub units_started: u64,
-    /// Units not voiced because more started within one sample than the engine voices.
+    /// Units not synthesised because more started within one sample than the engine starts.
     pub units_skipped: u64,
 }
 

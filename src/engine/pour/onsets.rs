@@ -6,7 +6,7 @@ use super::randomness::{UnitDraws, UnitShape};
 use crate::engine::config::ModelConfig;
 
 /// More onsets than this in one sample are beyond any bottle (it would glug above fs); the rest of
-/// that sample's outflow is counted as skipped units instead of voiced, so cost stays bounded.
+/// that sample's outflow is counted as skipped units instead of started, so cost stays bounded.
 pub const MAX_ONSETS_PER_SAMPLE: u32 = 8;
 
 /// Where in its sample a unit starts, and the residual volume at that instant.
@@ -127,9 +127,9 @@ mod tests {
         let config = ModelConfig::default().deterministic();
         let mut draws = UnitDraws::new(1);
         let mut detector = OnsetDetector::default();
-        let mut voiced = 0;
-        let skipped = detector.feed(&outflow(100.0), &config, &mut draws, |_, _| voiced += 1);
-        assert_eq!(voiced, MAX_ONSETS_PER_SAMPLE);
-        assert_eq!(skipped + voiced as u64, 20);
+        let mut started = 0;
+        let skipped = detector.feed(&outflow(100.0), &config, &mut draws, |_, _| started += 1);
+        assert_eq!(started, MAX_ONSETS_PER_SAMPLE);
+        assert_eq!(skipped + started as u64, 20);
     }
 }

@@ -1,5 +1,5 @@
 //! The sounding components of a synthesis path, in a bank of fixed capacity allocated once, and
-//! the rules for letting new ones in (the voice caps of MODEL.md §11). Every path is a [`Bank`]
+//! the rules for letting new ones in (the caps of MODEL.md §11). Every path is a [`Bank`]
 //! and admits components the same way, so paths differ only in their [`BankComponent`]: how one
 //! component is rendered.
 

@@ -107,7 +107,7 @@ impl Ramped {
     }
 }
 
-/// MODEL.md §11: units voiced per sample at most.
+/// MODEL.md §11: units started per sample at most.
 const ONSETS_PER_SAMPLE: usize = 8;
 /// MODEL.md §11: the start budget holds at most 8 units and refills at 6000 units per second.
 const BUDGET_UNITS: f64 = 8.0;
@@ -125,7 +125,7 @@ pub struct ReferenceWindow {
     pub onsets: Vec<UnitOnset>,
 }
 
-/// One voiced unit: what §5 needs, computed here.
+/// One started unit: what §5 needs, computed here.
 struct Unit {
     /// t_i in samples: n + x.
     onset: f64,

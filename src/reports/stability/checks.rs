@@ -30,7 +30,7 @@ pub enum Property {
     /// The same number of units at every sample rate.
     SameGlugs,
     /// The bank never holds more than its cap.
-    VoicesCapped,
+    ComponentsCapped,
     /// Units do start.
     Glugs,
     /// A never-decaying unit stays on the reference.
@@ -46,7 +46,7 @@ impl Property {
         Property::Time,
         Property::NotComputed,
         Property::SameGlugs,
-        Property::VoicesCapped,
+        Property::ComponentsCapped,
         Property::Glugs,
         Property::NoDrift,
     ];
@@ -60,7 +60,7 @@ impl Property {
             Property::Time => "time",
             Property::NotComputed => "not computed",
             Property::SameGlugs => "same glugs",
-            Property::VoicesCapped => "voices capped",
+            Property::ComponentsCapped => "components capped",
             Property::Glugs => "glugs",
             Property::NoDrift => "no drift",
         }
@@ -99,7 +99,7 @@ impl Property {
             Property::SameGlugs => "the number of units at any sample rate equals the number \
                                     at 48 kHz (±1): onsets are sub-sample exact"
                 .into(),
-            Property::VoicesCapped => format!(
+            Property::ComponentsCapped => format!(
                 "at most {MAX_COMPONENTS} components sound, and the units beyond the caps are \
                  counted as skipped"
             ),

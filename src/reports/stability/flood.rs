@@ -1,5 +1,5 @@
 //! Pour time down to 10 ms and pockets down to 0.001 ml: hundreds of units due per sample.
-//! The pour voices at most 8 per sample and counts the rest as skipped, the start budget admits
+//! The pour starts at most 8 units per sample and counts the rest as skipped, the start budget admits
 //! a burst of 8 units and then 6000 units per second, and the bank holds at most 256
 //! components (MODEL.md §11); the run time is compared with a busy but ordinary pour whose bank
 //! is also full (0.02 ml pockets).
@@ -62,7 +62,7 @@ impl CaseGroup for Flood {
                 finite(&run),
                 ceiling(&run),
                 check(
-                    Property::VoicesCapped,
+                    Property::ComponentsCapped,
                     run.render.max_sounding <= MAX_COMPONENTS && run.units_skipped > 0,
                     format!(
                         "at most {} sounding (cap {MAX_COMPONENTS}), {} of {} units skipped",

@@ -12,7 +12,7 @@
 //!   only where the limiter did not act (so the output is the signal before the limiter);
 //! - **time**: engine run time per sample within a factor of a normal case measured in the same
 //!   run (catches denormal slow-downs and runaway work); a ratio, never an absolute time;
-//! - case-specific properties (voices capped, nothing computed above Nyquist, no drift...).
+//! - case-specific properties (components capped, nothing computed above Nyquist, no drift...).
 
 mod checks;
 mod harness;
