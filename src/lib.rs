@@ -12,6 +12,8 @@
 //! [`device`] holds what a tilt device sends (the MIDI mapping and decoder, recorded MIDI and
 //! CSV takes, OSC from phones), shared by the plugin and the offline renderer. Data flows one
 //! way: scene, take or host → controls → pour → synthesis → sinks (WAV, clips, plot, audio out).
+//!
+//! [`text::printable`] escapes the control characters of outside text echoed in any message.
 #![warn(missing_docs)]
 
 pub mod device;
@@ -20,6 +22,7 @@ pub mod offline;
 #[cfg(feature = "plugin")]
 pub mod plugin;
 pub mod reports;
+pub mod text;
 
 /// The plugin types, at the crate's root for nice-plug's export macros.
 #[cfg(feature = "plugin")]

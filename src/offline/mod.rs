@@ -16,7 +16,9 @@ pub use outputs::{render_to_files, OutputError, OutputFormat, OutputOptions, Ren
 pub use render::{
     render_scene, render_scene_to_vec, RenderError, RenderObserver, RenderSummary, BLOCK_SIZE,
 };
-pub use scene::{LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S};
+pub use scene::{
+    InputFile, InputFileError, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S,
+};
 /// Every file the crate writes is first written as one of these, beside its target.
 #[cfg(feature = "plugin")]
 pub(crate) use wav::temp_file_builder;
