@@ -651,9 +651,19 @@ fn read_input_file(path: &Path, limit: u64) -> Result<Vec<u8>, InputFileError> {
     let file = File::open(path)?;
     // And again as opened, should the path have been replaced in between.
     let size = check(file.metadata()?)?;
-    let mut bytes = Vec::with_capacity(size as usize);
     // A file may hold more than its size says (/proc) or grow while read.
-    file.take(limit + 1).read_to_end(&mut bytes)?;
+    read_at_most(file, size, limit)
+}
+
+/// Everything `reader` holds (`expected_size` bytes, it says), or an error once more than
+/// `limit` bytes came out of it.
+fn read_at_most(
+    reader: impl Read,
+    expected_size: u64,
+    limit: u64,
+) -> Result<Vec<u8>, InputFileError> {
+    let mut bytes = Vec::with_capacity(expected_size.min(limit) as usize);
+    reader.take(limit + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > limit {
         return Err(InputFileError::OverLimit { limit });
     }
@@ -752,6 +762,16 @@ mod tests {
             read_input_file(&path, 9),
             Err(InputFileError::TooLarge { size: 10, limit: 9 })
         ));
+    }
+
+    #[test]
+    fn reading_stops_past_the_limit() {
+        let endless = std::io::repeat(b'x');
+        assert!(matches!(
+            read_at_most(endless, 0, 1000),
+            Err(InputFileError::OverLimit { limit: 1000 })
+        ));
+        assert_eq!(read_at_most(&b"12345"[..], 5, 5).unwrap(), b"12345");
     }
 
     #[cfg(target_os = "linux")]
