@@ -14,6 +14,8 @@
 //! (the MIDI mapping and decoder, OSC from phones, and with `offline` recorded MIDI and CSV
 //! takes), shared by the plugin and the offline renderer. Data flows one way: scene, take or
 //! host → controls → pour → synthesis → sinks (WAV, clips, plot, audio out).
+//!
+//! [`text::printable`] escapes the control characters of outside text echoed in any message.
 #![warn(missing_docs)]
 
 pub mod device;
@@ -26,6 +28,7 @@ pub mod offline;
 pub mod plugin;
 #[cfg(feature = "reports")]
 pub mod reports;
+pub mod text;
 
 /// The plugin types, at the crate's root for nice-plug's export macros.
 #[cfg(feature = "plugin")]

@@ -7,9 +7,18 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 use super::axis::{tilt_from_gravity, Axis};
+use crate::text::printable;
 
 /// The column of times, in seconds from the start of the take.
 pub const TIME_COLUMN: &str = "time_s";
+
+/// The largest CSV take read (256 MiB): an hour of readings at 1 kHz with a time and three
+/// gravity columns (about 70 bytes a row) fits, and the text, held whole while it is read, stays
+/// a small part of a computer's memory.
+pub const MAX_CSV_LANE_BYTES: u64 = 256 << 20;
+
+/// The most of a field an error quotes: enough to see what it is, never a whole line.
+const QUOTED_FIELD_CHARS: usize = 32;
 
 /// Which values of a CSV take make the lane.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -43,7 +52,8 @@ pub struct CsvLaneError {
 impl fmt::Display for CsvLaneError {
     /// `take.csv, line 7, column "ax": "abc" is not a number`.
     fn fmt(&self, formatter: &mut fmt::Formatter) -> fmt::Result {
-        write!(formatter, "{}, line {}", self.file.display(), self.line)?;
+        let file = self.file.to_string_lossy();
+        write!(formatter, "{}, line {}", printable(&file), self.line)?;
         match self.columns.as_slice() {
             [] => {}
             [column] => write!(formatter, ", column {column:?}")?,
@@ -61,7 +71,8 @@ impl fmt::Display for CsvLaneError {
 
 impl std::error::Error for CsvLaneError {}
 
-/// What is wrong at the place a [`CsvLaneError`] names.
+/// What is wrong at the place a [`CsvLaneError`] names. Nothing of the file is quoted but the
+/// field at fault, cut short: a scene may name any file, and its error must not show it.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum CsvFault {
     /// The file holds nothing, not even a header.
@@ -70,12 +81,10 @@ pub enum CsvFault {
     /// A header and no data.
     #[error("no data rows after the header")]
     NoRows,
-    /// A column the lane needs is not in the header.
-    #[error("no such column in the header, which has {}", list(.header))]
-    MissingColumn {
-        /// The header's columns.
-        header: Vec<String>,
-    },
+    /// A column the lane needs is not in the header (whose names are not quoted: the file may
+    /// be no take at all).
+    #[error("no such column in the header")]
+    MissingColumn,
     /// A column the lane needs is named more than once, so which one is meant is unclear.
     #[error("named more than once in the header")]
     DuplicateColumn,
@@ -95,10 +104,10 @@ pub enum CsvFault {
         /// The header's columns.
         expected: usize,
     },
-    /// A field that does not read as a number.
+    /// A field that does not read as a number (its first characters, with `…` if cut).
     #[error("{0:?} is not a number")]
     NotANumber(String),
-    /// A field that reads as infinity or NaN.
+    /// A field that reads as infinity or NaN (its first characters, with `…` if cut).
     #[error("{0:?} is not a finite number")]
     NotFinite(String),
     /// A time before the start of the take.
@@ -116,13 +125,16 @@ pub enum CsvFault {
     #[error("the gravity vector is zero, so it has no direction")]
     ZeroVector,
     /// Text the CSV reader refuses.
-    #[error("unreadable CSV: {0}")]
+    #[error("unreadable CSV: {}", printable(.0))]
     Unreadable(String),
 }
 
-/// Column names as `a, b, c`.
-fn list(names: &[String]) -> String {
-    names.join(", ")
+/// The start of `field`, for an error to quote.
+fn quoted(field: &str) -> String {
+    match field.char_indices().nth(QUOTED_FIELD_CHARS) {
+        Some((end, _)) => format!("{}…", &field[..end]),
+        None => field.to_owned(),
+    }
 }
 
 /// Reads the lane `spec` picks from the CSV `text` of `file` (named in errors only) as
@@ -166,13 +178,7 @@ pub fn read_csv_lane(
         match (matches.next(), matches.next()) {
             (Some((index, _)), None) => Ok(index),
             (Some(_), Some(_)) => Err(fail(header_line, &[name], CsvFault::DuplicateColumn)),
-            (None, _) => Err(fail(
-                header_line,
-                &[name],
-                CsvFault::MissingColumn {
-                    header: header.iter().map(str::to_owned).collect(),
-                },
-            )),
+            (None, _) => Err(fail(header_line, &[name], CsvFault::MissingColumn)),
         }
     };
     let time_index = column_index(TIME_COLUMN)?;
@@ -220,8 +226,8 @@ pub fn read_csv_lane(
             let name = &header[index];
             match field.parse::<f64>() {
                 Ok(value) if value.is_finite() => Ok(value),
-                Ok(_) => Err(fail(line, &[name], CsvFault::NotFinite(field.to_owned()))),
-                Err(_) => Err(fail(line, &[name], CsvFault::NotANumber(field.to_owned()))),
+                Ok(_) => Err(fail(line, &[name], CsvFault::NotFinite(quoted(field)))),
+                Err(_) => Err(fail(line, &[name], CsvFault::NotANumber(quoted(field)))),
             }
         };
 

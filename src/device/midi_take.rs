@@ -9,9 +9,14 @@ use midly::{Format, MetaMessage, MidiMessage, Timing, TrackEventKind};
 use thiserror::Error;
 
 use super::midi::MidiInput;
+use crate::text::printable;
 
 /// The longest take read, in seconds: anything later is a corrupt delta time, not a pour.
 pub const MAX_TAKE_SECONDS: u64 = 24 * 60 * 60;
+
+/// The largest take file read (16 MiB): four million messages of about four bytes, over an
+/// hour of a control change every millisecond, far more than a tilt device sends.
+pub const MAX_TAKE_BYTES: u64 = 16 << 20;
 
 /// The tempo of a file that sets none: 120 quarter notes per minute.
 const DEFAULT_TEMPO_US: u32 = 500_000;
@@ -340,7 +345,7 @@ fn count_track_chunks(bytes: &[u8]) -> Result<usize, TakeError> {
                 format!(
                     "chunk {} ({})",
                     index + 1,
-                    String::from_utf8_lossy(&head[..4])
+                    printable(&String::from_utf8_lossy(&head[..4]))
                 )
             };
             return Err(TakeError::Truncated {

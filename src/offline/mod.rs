@@ -13,5 +13,7 @@ pub mod sinks;
 pub use automation::Automation;
 pub use outputs::{render_to_files, RenderReport};
 pub use render::{render_scene, render_scene_to_vec, RenderError, RenderObserver, RenderSummary};
-pub use scene::{LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S};
+pub use scene::{
+    InputFile, InputFileError, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S,
+};
 pub use sinks::{OutputError, OutputFormat, OutputOptions, SampleFormat, WavError};

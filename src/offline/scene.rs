@@ -1,18 +1,21 @@
 //! Scene files (MODEL.md §10): TOML in, a validated [`Scene`] out. Every key is optional; an
 //! unknown key, a wrong type or an out-of-range value is refused with an error naming it.
 
+use std::fs::{File, FileType};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use super::automation::{Automation, CsvLaneRef, LaneSpec};
 use crate::device::axis::Axis;
-use crate::device::csv_lane::{read_csv_lane, CsvLaneError, CsvLaneSpec};
+use crate::device::csv_lane::{read_csv_lane, CsvLaneError, CsvLaneSpec, MAX_CSV_LANE_BYTES};
 use crate::device::midi::{MidiMap, MidiSetting};
-use crate::device::midi_take::{read_midi_take, TakeError, TimedInput};
+use crate::device::midi_take::{read_midi_take, TakeError, TimedInput, MAX_TAKE_BYTES};
 use crate::engine::config::{self, Range};
 use crate::engine::{
     Constant, Control, ControlSource, ControlValues, Controls, DrainMode, ModelConfig, PerControl,
     Preset, PresetValue, Quantity,
 };
+use crate::text::printable;
 
 /// The built-in default scene: a full 300 ml bottle of water tilted from 90° to 135° over half a
 /// second and held until it stops pouring.
@@ -23,18 +26,38 @@ tilt_deg = [[0.0, 90.0], [0.5, 135.0]]
 /// Longest render a scene may ask for (and the limit on one that never falls silent).
 pub const MAX_DURATION_S: f64 = 86_400.0;
 
-/// Why a scene was refused.
+/// Why a scene was refused. Text from the scene or a file it names is shown with its control
+/// characters escaped ([`printable`]).
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The scene file could not be read.
-    #[error("cannot read scene file {}: {source}", path.display())]
+    #[error("cannot read scene file {}: {source}", shown(path))]
     Read {
         /// The file's path.
         path: PathBuf,
         /// The I/O error.
         source: std::io::Error,
     },
-    /// Not valid TOML, an unknown key or a value of the wrong type: the parser's message.
+    /// The file of a CSV lane could not be read.
+    #[error("cannot read CSV lane `{key}` file {}: {source}", shown(path))]
+    CsvFile {
+        /// The scene key.
+        key: &'static str,
+        /// The file's path.
+        path: PathBuf,
+        /// Why not.
+        source: InputFileError,
+    },
+    /// The file of a MIDI take could not be read.
+    #[error("cannot read MIDI take {}: {source}", shown(path))]
+    TakeFile {
+        /// The file's path.
+        path: PathBuf,
+        /// Why not.
+        source: InputFileError,
+    },
+    /// Not valid TOML, an unknown key or a value of the wrong type: the parser's message, its
+    /// control characters escaped.
     #[error("invalid scene: {0}")]
     Syntax(String),
     /// A value outside its allowed range.
@@ -58,15 +81,15 @@ pub enum SceneError {
         source: CsvLaneError,
     },
     /// A CSV lane's table is not one of the two forms.
-    #[error("`{key}`: {message}")]
+    #[error("`{key}`: {}", printable(message))]
     CsvForm {
         /// The scene key.
         key: &'static str,
         /// What was wrong.
         message: String,
     },
-    /// The MIDI take could not be read.
-    #[error("midi take {}: {source}", path.display())]
+    /// The MIDI take is not one the renderer reads.
+    #[error("midi take {}: {source}", shown(path))]
     Take {
         /// The take's path.
         path: PathBuf,
@@ -96,6 +119,71 @@ pub enum SceneError {
     },
 }
 
+/// Why a CSV lane's or a MIDI take's file was not read.
+#[derive(Debug, thiserror::Error)]
+pub enum InputFileError {
+    /// Opening or reading it failed.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    /// A FIFO, a device, a folder: reading it could block, never end or mean nothing.
+    #[error("it is {0}, not a regular file")]
+    NotAFile(&'static str),
+    /// Larger than the limit, by its size on disk.
+    #[error("it is {size} bytes, over the limit of {limit} bytes ({} MiB)", limit >> 20)]
+    TooLarge {
+        /// Its size (bytes).
+        size: u64,
+        /// The limit (bytes).
+        limit: u64,
+    },
+    /// More bytes than the limit came out of it, whatever its size said.
+    #[error("it holds more than the limit of {limit} bytes ({} MiB)", limit >> 20)]
+    OverLimit {
+        /// The limit (bytes).
+        limit: u64,
+    },
+    /// A CSV lane that is not UTF-8 text.
+    #[error("line {line} is not UTF-8 text")]
+    NotText {
+        /// The line, from 1.
+        line: u64,
+    },
+}
+
+/// A file a scene read besides itself: a CSV lane or its MIDI take.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct InputFile {
+    /// The scene key that names it (`midi_take` for the take).
+    pub key: &'static str,
+    /// The file, as read: the scene's folder joined with the path the scene gives.
+    pub path: PathBuf,
+    /// Whether the file lies outside the scene's folder (an absolute path, `..`, or a link out
+    /// of it), for the summary to say so. `false` for a take given to
+    /// [`Scene::with_midi_take`], which the user named.
+    pub outside_folder: bool,
+}
+
+impl InputFile {
+    /// `path`, read by the scene in `folder` for `key`.
+    fn new(key: &'static str, path: PathBuf, folder: &Path) -> Self {
+        // Canonical paths, so that a link counts where it leads; "" is the current folder.
+        let folder = if folder.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            folder
+        };
+        let inside = match (path.canonicalize(), folder.canonicalize()) {
+            (Ok(file), Ok(folder)) => file.starts_with(folder),
+            _ => false,
+        };
+        Self {
+            key,
+            path,
+            outside_folder: !inside,
+        }
+    }
+}
+
 /// A validated scene, ready to render.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
@@ -111,6 +199,8 @@ pub struct Scene {
     pub take: Option<MidiTake>,
     /// How the take's messages map to controls (the plugin's MIDI settings).
     pub midi: MidiMap,
+    /// The files read for the CSV lanes and the take, in the order read.
+    pub inputs: Vec<InputFile>,
 }
 
 /// A recorded Standard MIDI File take: its bytes, and its messages at the scene's sample rate.
@@ -126,10 +216,11 @@ pub struct MidiTake {
 impl MidiTake {
     /// Reads the take at `path` for a render at `sample_rate` (Hz).
     pub fn load(path: &Path, sample_rate: u32) -> Result<Self, SceneError> {
-        let bytes = std::fs::read(path).map_err(|source| SceneError::Read {
-            path: path.to_owned(),
-            source,
-        })?;
+        let bytes =
+            read_input_file(path, MAX_TAKE_BYTES).map_err(|source| SceneError::TakeFile {
+                path: path.to_owned(),
+                source,
+            })?;
         Self::from_bytes(path, bytes, sample_rate)
     }
 
@@ -222,8 +313,14 @@ impl Scene {
     }
 
     /// The same scene driven by the MIDI take at `path` (which replaces the scene's own).
-    pub fn with_midi_take(self, path: &Path) -> Result<Self, SceneError> {
+    pub fn with_midi_take(mut self, path: &Path) -> Result<Self, SceneError> {
         let take = Some(MidiTake::load(path, self.sample_rate)?);
+        self.inputs.retain(|input| input.key != MIDI_TAKE);
+        self.inputs.push(InputFile {
+            key: MIDI_TAKE,
+            path: path.to_owned(),
+            outside_folder: false,
+        });
         Ok(Self { take, ..self })
     }
 
@@ -305,7 +402,15 @@ struct SceneFile {
 
 impl SceneFile {
     fn parse(text: &str) -> Result<Self, SceneError> {
-        let table = toml::from_str(text).map_err(|error| SceneError::Syntax(error.to_string()))?;
+        let table = toml::from_str(text).map_err(|error| {
+            // toml's message shows the line at fault over several lines: their layout is kept.
+            let lines: Vec<_> = error
+                .to_string()
+                .split('\n')
+                .map(|line| printable(line).into_owned())
+                .collect();
+            SceneError::Syntax(lines.join("\n"))
+        })?;
         Ok(Self {
             table,
             known: Vec::new(),
@@ -325,7 +430,7 @@ impl SceneFile {
                 None => return Ok(None),
                 Some(toml::Value::Table(table)) => table,
                 Some(other) => {
-                    return Err(SceneError::Syntax(format!(
+                    return Err(syntax(&format!(
                         "`{section}`: invalid type: {}, expected a table",
                         other.type_str()
                     )))
@@ -337,7 +442,8 @@ impl SceneFile {
             Some(value) => value
                 .try_into()
                 .map(Some)
-                .map_err(|error| SceneError::Syntax(format!("`{key}`: {error}"))),
+                // toml ends a message without a place in the file with a line break.
+                .map_err(|error| syntax(&format!("`{key}`: {}", error.to_string().trim_end()))),
         }
     }
 
@@ -361,7 +467,7 @@ impl SceneFile {
         };
         let unknown = |name: &str, place: String, known: Vec<&str>| {
             let known: Vec<String> = known.iter().map(|name| format!("`{name}`")).collect();
-            SceneError::Syntax(format!(
+            syntax(&format!(
                 "unknown field `{name}`{place}, expected one of {}",
                 known.join(", ")
             ))
@@ -424,12 +530,13 @@ impl SceneFile {
             ..ModelConfig::default()
         };
         let mut lanes = PerControl::from_fn(|_| None);
+        let mut inputs = Vec::new();
         for &control in Control::ALL {
             let key = control.quantity().scene_key;
             let spec = self.take::<LaneSpec>(key)?;
             lanes[control] = Some(automation(
                 key,
-                resolve(key, spec, folder)?,
+                resolve(key, spec, folder, &mut inputs)?,
                 control.range(),
             )?);
         }
@@ -447,10 +554,15 @@ impl SceneFile {
         if self.take::<bool>(DETERMINISTIC)?.unwrap_or(false) {
             config = config.deterministic();
         }
-        let take = self
-            .take::<PathBuf>(MIDI_TAKE)?
-            .map(|path| MidiTake::load(&folder.join(path), sample_rate))
-            .transpose()?;
+        let take = match self.take::<PathBuf>(MIDI_TAKE)? {
+            None => None,
+            Some(name) => {
+                let path = folder.join(name);
+                let take = MidiTake::load(&path, sample_rate)?;
+                inputs.push(InputFile::new(MIDI_TAKE, path, folder));
+                Some(take)
+            }
+        };
         let midi = self.midi_map()?;
         self.refuse_unknown()?;
         Ok(Scene {
@@ -460,15 +572,18 @@ impl SceneFile {
             config,
             take,
             midi,
+            inputs,
         })
     }
 }
 
-/// A lane as the scene wrote it, with a CSV take read into points (relative to `folder`).
+/// A lane as the scene wrote it, with a CSV take read into points (relative to `folder`) and
+/// its file added to `inputs`.
 fn resolve(
     key: &'static str,
     spec: Option<LaneSpec>,
     folder: &Path,
+    inputs: &mut Vec<InputFile>,
 ) -> Result<Option<Automation>, SceneError> {
     let reference = match spec {
         None => return Ok(None),
@@ -503,13 +618,87 @@ fn resolve(
         }
     };
     let path = folder.join(&csv);
-    let text = std::fs::read_to_string(&path).map_err(|source| SceneError::Read {
+    let file_error = |source| SceneError::CsvFile {
+        key,
         path: path.clone(),
         source,
+    };
+    let bytes = read_input_file(&path, MAX_CSV_LANE_BYTES).map_err(file_error)?;
+    let text = String::from_utf8(bytes).map_err(|error| {
+        let bytes = &error.as_bytes()[..error.utf8_error().valid_up_to()];
+        let line = 1 + bytes.iter().filter(|&&byte| byte == b'\n').count() as u64;
+        file_error(InputFileError::NotText { line })
     })?;
     let points =
         read_csv_lane(&text, &path, &spec).map_err(|source| SceneError::Csv { key, source })?;
+    inputs.push(InputFile::new(key, path, folder));
     Ok(Some(Automation::Points(points)))
+}
+
+/// The bytes of the regular file at `path`, refused if larger than `limit` bytes.
+fn read_input_file(path: &Path, limit: u64) -> Result<Vec<u8>, InputFileError> {
+    let check = |metadata: std::fs::Metadata| {
+        if !metadata.is_file() {
+            return Err(InputFileError::NotAFile(kind(metadata.file_type())));
+        }
+        match metadata.len() {
+            size if size > limit => Err(InputFileError::TooLarge { size, limit }),
+            size => Ok(size),
+        }
+    };
+    // Checked before opening: opening a FIFO for reading waits for a writer.
+    check(std::fs::metadata(path)?)?;
+    let file = File::open(path)?;
+    // And again as opened, should the path have been replaced in between.
+    let size = check(file.metadata()?)?;
+    // A file may hold more than its size says (/proc) or grow while read.
+    read_at_most(file, size, limit)
+}
+
+/// Everything `reader` holds (`expected_size` bytes, it says), or an error once more than
+/// `limit` bytes came out of it.
+fn read_at_most(
+    reader: impl Read,
+    expected_size: u64,
+    limit: u64,
+) -> Result<Vec<u8>, InputFileError> {
+    let mut bytes = Vec::with_capacity(expected_size.min(limit) as usize);
+    reader.take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(InputFileError::OverLimit { limit });
+    }
+    Ok(bytes)
+}
+
+/// What a file that is not a regular file is, for a message.
+fn kind(file_type: FileType) -> &'static str {
+    if file_type.is_dir() {
+        return "a folder";
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if file_type.is_fifo() {
+            return "a FIFO (named pipe)";
+        }
+        if file_type.is_char_device() || file_type.is_block_device() {
+            return "a device";
+        }
+        if file_type.is_socket() {
+            return "a socket";
+        }
+    }
+    "a special file"
+}
+
+/// A path for a message.
+fn shown(path: &Path) -> String {
+    printable(&path.to_string_lossy()).into_owned()
+}
+
+/// A [`SceneError::Syntax`] whose message may quote the scene.
+fn syntax(message: &str) -> SceneError {
+    SceneError::Syntax(printable(message).into_owned())
 }
 
 fn check(key: &'static str, value: f64, range: Range) -> Result<f64, SceneError> {
@@ -557,4 +746,43 @@ fn automation(
         }
     }
     Ok(automation)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_input_file_is_read_up_to_its_limit() {
+        let folder = tempfile::tempdir().unwrap();
+        let path = folder.path().join("take.csv");
+        std::fs::write(&path, "0123456789").unwrap();
+        assert_eq!(read_input_file(&path, 10).unwrap(), b"0123456789");
+        assert!(matches!(
+            read_input_file(&path, 9),
+            Err(InputFileError::TooLarge { size: 10, limit: 9 })
+        ));
+    }
+
+    #[test]
+    fn reading_stops_past_the_limit() {
+        let endless = std::io::repeat(b'x');
+        assert!(matches!(
+            read_at_most(endless, 0, 1000),
+            Err(InputFileError::OverLimit { limit: 1000 })
+        ));
+        assert_eq!(read_at_most(&b"12345"[..], 5, 5).unwrap(), b"12345");
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn the_limit_holds_while_reading_a_file_larger_than_its_size_says() {
+        // Files of /proc say they hold 0 bytes.
+        let status = Path::new("/proc/self/status");
+        assert_eq!(std::fs::metadata(status).unwrap().len(), 0);
+        assert!(matches!(
+            read_input_file(status, 16),
+            Err(InputFileError::OverLimit { limit: 16 })
+        ));
+    }
 }

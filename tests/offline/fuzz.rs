@@ -181,6 +181,9 @@ fn fuzz_scene_toml() {
             Err(error) => {
                 let message = error.to_string();
                 prop_assert!(!message.is_empty());
+                // Only toml's own layout breaks lines.
+                let raw = |character: char| character.is_control() && character != '\n';
+                prop_assert!(!message.contains(raw), "{message:?}");
                 if text.contains('=') {
                     assert_names_its_fault(&text, &message)?;
                 }

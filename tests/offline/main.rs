@@ -10,6 +10,9 @@ mod clips_rendered;
 mod command;
 mod determinism;
 mod fuzz;
+// FIFOs, devices and links as Unix makes them.
+#[cfg(unix)]
+mod inputs;
 mod presets;
 mod readme;
 mod scene_files;

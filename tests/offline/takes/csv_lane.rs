@@ -82,7 +82,7 @@ fn refusals_name_the_file_line_and_column() {
     let cases = [
         (
             "time_s,ax,ay\n0,0,0\n".to_owned(),
-            r#"take.csv, line 1, column "az": no such column in the header, which has time_s, ax, ay"#,
+            r#"take.csv, line 1, column "az": no such column in the header"#,
         ),
         (
             "time_s,ax,ay,az,ay\n0,0,0,1,0\n".to_owned(),
@@ -142,15 +142,20 @@ fn refusals_name_the_file_line_and_column() {
 fn lines_are_counted_as_a_text_editor_counts_them() {
     let x_on = |line: u64| format!(r#"take.csv, line {line}, column "ax": "x" is not a number"#);
     let cases = [
-        ("time_s,ax,ay,az\r\n0,0,0,1\r\n\r\n\r\n0.5,x,0,1\r\n", x_on(5)),
+        (
+            "time_s,ax,ay,az\r\n0,0,0,1\r\n\r\n\r\n0.5,x,0,1\r\n",
+            x_on(5),
+        ),
         ("time_s,ax,ay,az\r0,0,0,1\r0.5,x,0,1\r", x_on(3)),
         ("time_s,ax,ay,az\n0,0,0,1\n   \n0.5,x,0,1\n", x_on(4)),
-        ("time_s,ax,ay,az,note\n0,0,0,1,\"two\nlines\"\n0.5,x,0,1,c\n", x_on(4)),
+        (
+            "time_s,ax,ay,az,note\n0,0,0,1,\"two\nlines\"\n0.5,x,0,1,c\n",
+            x_on(4),
+        ),
         ("\u{feff}time_s,ax,ay,az\n0.5,x,0,1", x_on(2)),
         (
             "\n\r\ntime_s,ax,ay\n0,0,0\n",
-            r#"take.csv, line 3, column "az": no such column in the header, which has time_s, ax, ay"#
-                .to_owned(),
+            r#"take.csv, line 3, column "az": no such column in the header"#.to_owned(),
         ),
         (
             "\n\ntime_s,ax,ay,az\n\n",

@@ -82,7 +82,11 @@ fn check_midi(bytes: &[u8], sample_rate: u32) -> Result<(), TestCaseError> {
         Ok(take) => {
             prop_assert!(take.windows(2).all(|pair| pair[0].sample <= pair[1].sample));
         }
-        Err(error) => prop_assert!(!error.to_string().is_empty()),
+        Err(error) => {
+            let message = error.to_string();
+            prop_assert!(!message.is_empty());
+            prop_assert!(!message.contains(char::is_control), "{message:?}");
+        }
     }
     Ok(())
 }
@@ -97,7 +101,11 @@ fn check_csv(text: &str) -> Result<(), TestCaseError> {
                     .all(|(t, v)| *t >= 0.0 && t.is_finite() && v.is_finite()));
                 prop_assert!(points.windows(2).all(|pair| pair[0].0 <= pair[1].0));
             }
-            Err(error) => prop_assert!(error.to_string().starts_with("fuzz.csv, line ")),
+            Err(error) => {
+                let message = error.to_string();
+                prop_assert!(message.starts_with("fuzz.csv, line "));
+                prop_assert!(!message.contains(char::is_control), "{message:?}");
+            }
         }
     }
     Ok(())

@@ -229,6 +229,14 @@ fn garbage_truncated_and_format_2_files_are_refused_clearly() {
         cut.contains("the header declares 2 tracks but the file holds 1"),
         "{cut}"
     );
+    // A chunk of another type, cut short, is named by its type with control bytes escaped.
+    let mut odd_chunk = whole[..33].to_vec();
+    odd_chunk.extend(b"\x1b]0;\0\0\0\x10");
+    let cut = message(&odd_chunk);
+    assert!(
+        cut.ends_with("chunk 3 (\\u{1b}]0;) declares 16 bytes but only 0 remain"),
+        "{cut}"
+    );
 
     // A corrupt event inside a whole chunk: track 2's first status byte made undefined.
     let mut corrupt = whole.clone();
