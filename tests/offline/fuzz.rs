@@ -7,45 +7,31 @@ use proptest::prelude::*;
 
 use crate::support::fuzz::{self, any_number, toml_number};
 use sake_glug::engine::config::{self, Range};
-use sake_glug::engine::{Constant, Control, Lane};
+use sake_glug::engine::{Constant, Control, Lane, Quantity};
 use sake_glug::offline::{Automation, Scene};
 
-/// Every key of a scene, the table it sits in, and the range of its numbers.
-const KEYS: [(&str, &str, Range); 17] = [
-    ("", "sample_rate", config::SAMPLE_RATE_HZ),
-    (
-        "",
-        "duration_s",
-        Range {
-            min: 0.0,
-            max: 86_400.0,
-            default: 1.0,
-        },
-    ),
-    ("", "tilt_deg", Control::Tilt.range()),
-    ("", "viscosity_c", Control::Viscosity.range()),
-    ("", "fill_percent", Control::Fill.range()),
-    ("", "pour_time_s", Control::PourTime.range()),
-    ("bottle", "capacity_ml", Constant::Capacity.range()),
-    ("bottle", "pocket_ml", Constant::Pocket.range()),
-    ("glug", "f1_hz", Constant::F1.range()),
-    ("glug", "f2_hz", Constant::F2.range()),
-    ("glug", "b1_per_s", Constant::B1.range()),
-    ("glug", "b2_per_s", Constant::B2.range()),
-    ("glug", "timing_jitter", Constant::TimingJitter.range()),
-    ("glug", "freq_jitter", Constant::FreqJitter.range()),
-    ("glug", "decay_sigma", Constant::DecaySigma.range()),
-    ("output", "gain_db", Control::Gain.range()),
-    (
-        "",
-        "seed",
-        Range {
-            min: 0.0,
-            max: 1e19,
-            default: 1.0,
-        },
-    ),
-];
+/// Every numeric key of a scene, the table it sits in, and the range of its numbers: the
+/// controls' and constants' from the engine's tables, and the scene's own.
+fn keys() -> Vec<(&'static str, &'static str, Range)> {
+    let split = |quantity: &'static Quantity| match quantity.scene_key.split_once('.') {
+        Some((table, key)) => (table, key, quantity.range),
+        None => ("", quantity.scene_key, quantity.range),
+    };
+    let tables = Control::ALL
+        .iter()
+        .map(|control| split(control.quantity()))
+        .chain(
+            Constant::ALL
+                .iter()
+                .map(|constant| split(constant.quantity())),
+        );
+    let scene_own = [
+        ("", "sample_rate", config::SAMPLE_RATE_HZ),
+        ("", "duration_s", Range::new(0.0, 86_400.0, 1.0)),
+        ("", "seed", Range::new(0.0, 1e19, 1.0)),
+    ];
+    tables.chain(scene_own).collect()
+}
 
 /// A number near a key's range: inside, at its edges, just outside, or anything at all.
 fn number_near(range: Range) -> impl Strategy<Value = f64> {
@@ -85,8 +71,9 @@ fn value_text(range: Range) -> impl Strategy<Value = String> {
 /// A scene file: some keys with generated values, maybe an unknown key, maybe a drain mode,
 /// maybe a deterministic flag, in any order of tables.
 fn scene_text() -> impl Strategy<Value = String> {
-    let entry = (0..KEYS.len()).prop_flat_map(|index| {
-        let (table, key, range) = KEYS[index];
+    let keys = keys();
+    let entry = (0..keys.len()).prop_flat_map(move |index| {
+        let (table, key, range) = keys[index];
         value_text(range).prop_map(move |value| (table, key.to_string(), value))
     });
     let extra = prop::sample::select(vec![
@@ -153,7 +140,7 @@ fn assert_valid(scene: &Scene) -> Result<(), TestCaseError> {
 
 /// What an error must do: name the key at fault or the place in the file.
 fn assert_names_its_fault(text: &str, message: &str) -> Result<(), TestCaseError> {
-    let names_a_key = KEYS
+    let names_a_key = keys()
         .iter()
         .map(|k| k.1)
         .chain(["drain", "deterministic", "unknown_key", "f3_hz"])
