@@ -1,4 +1,4 @@
-//! Every file the crate writes (renders, clips, VST3 presets) is first written as a temporary
+//! Every file the offline renderer writes (renders, clips, plots) is first written as a temporary
 //! file beside its target and renamed over it once complete, so none is ever left half written.
 
 /// A temporary file as the crate writes one: temporary files are private by default, but the

@@ -20,7 +20,7 @@
 
 pub mod device;
 pub mod engine;
-#[cfg(any(feature = "plugin", feature = "offline"))]
+#[cfg(feature = "offline")]
 mod files;
 #[cfg(feature = "offline")]
 pub mod offline;
