@@ -195,7 +195,14 @@ impl OscInput {
         };
         let (port, axis) = (settings.port(), settings.axis());
         let allowed = port != 0 && port == session.allowed_port;
-        session.waiting_port = if allowed { 0 } else { port };
+        let waiting = if allowed { 0 } else { port };
+        if waiting != 0 && waiting != session.waiting_port {
+            nice_log!(
+                "OSC: the project wants UDP port {port}; it stays closed until the editor's OSC \
+                 panel opens it"
+            );
+        }
+        session.waiting_port = waiting;
         let address = SocketAddr::new(session.interface, port);
         let wanted = allowed.then_some((address, axis));
         let running = session.running.as_ref().map(|now| (now.address, now.axis));

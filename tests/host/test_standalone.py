@@ -83,7 +83,10 @@ def start_jack(name):
     )
 
     def up():
-        assert server.poll() is None, "jackd exited at start"
+        if server.poll() is not None:
+            log.seek(0)
+            said = log.read().decode(errors="replace")[-2000:]
+            raise AssertionError(f"jackd exited at start ({server.returncode}): {said}")
         try:
             jack.Client("probe", servername=name, no_start_server=True).close()
             return True
@@ -96,6 +99,17 @@ def start_jack(name):
         stop(server, signal.SIGKILL)
         raise
     return server, log
+
+
+def forget_jack(name):
+    """Cleans up after a JACK server `name` that was killed: a server killed with SIGKILL keeps
+    its slot in JACK's registry of servers (8 per machine), which only a server of the same name
+    frees, and its clients' semaphores stay in /dev/shm."""
+    server, log = start_jack(name)
+    stop(server, signal.SIGTERM)
+    log.close()
+    for semaphore in Path("/dev/shm").glob(f"jack_sem.*_{name}_*"):
+        semaphore.unlink(missing_ok=True)
 
 
 @pytest.fixture(scope="module")
@@ -499,6 +513,7 @@ def test_a_jack_server_that_goes_away_is_logged_and_ends_the_app(jack_server, ap
     finally:
         stop(server, signal.SIGKILL)
         server_log.close()
+        forget_jack(name)
     print(f"the app ended {took_s * 1000:.0f} ms after its JACK server")
     said = [line for line in read(log).splitlines() if "audio stopped" in line]
     assert len(said) == 1, f"one line says the audio stopped: {read(log)}"

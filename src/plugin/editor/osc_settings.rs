@@ -105,3 +105,26 @@ fn interface_name(interface: IpAddr) -> String {
         other => other.to_string(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_panel_shows_the_port_a_project_wants_without_opening_it() {
+        let port = std::net::UdpSocket::bind("127.0.0.1:0")
+            .and_then(|socket| socket.local_addr())
+            .expect("a free port")
+            .port();
+        let (params, osc) = (GlugParams::default(), OscInput::default());
+        params.osc.set(port, Axis::PlusY);
+        osc.follow(&params.osc);
+        let ctx = egui::Context::default();
+        for _ in 0..3 {
+            let mut output = ctx.run_ui(egui::RawInput::default(), |ui| show(ui, &params, &osc));
+            // Nothing uploads the font atlas here.
+            output.textures_delta.clear();
+        }
+        assert_eq!(osc.status(), OscStatus::Waiting { port });
+    }
+}
