@@ -10,6 +10,8 @@ use crate::plugin::params::GlugParams;
 
 /// Every network interface: a phone on the network can reach the port.
 const EVERY_INTERFACE: IpAddr = IpAddr::V4(Ipv4Addr::UNSPECIFIED);
+/// Wide enough for the longest choice's name.
+const INTERFACE_WIDTH: f32 = 220.0;
 
 pub fn show(ui: &mut egui::Ui, params: &GlugParams, osc: &OscInput) {
     let (mut port, mut axis) = (params.osc.port(), params.osc.axis());
@@ -41,6 +43,7 @@ pub fn show(ui: &mut egui::Ui, params: &GlugParams, osc: &OscInput) {
     ui.horizontal(|ui| {
         ui.label("Listen on");
         egui::ComboBox::from_id_salt("osc_interface")
+            .width(INTERFACE_WIDTH)
             .selected_text(interface_name(interface))
             .show_ui(ui, |ui| {
                 // An address given on the command line stays among the choices.
@@ -100,8 +103,8 @@ pub fn show(ui: &mut egui::Ui, params: &GlugParams, osc: &OscInput) {
 
 fn interface_name(interface: IpAddr) -> String {
     match interface {
-        DEFAULT_OSC_INTERFACE => format!("this computer only ({interface})"),
-        EVERY_INTERFACE => format!("every network interface ({interface})"),
+        DEFAULT_OSC_INTERFACE => format!("this computer ({interface})"),
+        EVERY_INTERFACE => format!("every interface ({interface})"),
         other => other.to_string(),
     }
 }
