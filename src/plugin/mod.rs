@@ -13,7 +13,7 @@ mod transport;
 mod editor;
 
 pub use feed::{Feed, UnitView, Visible, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
-pub use osc_input::{OscInput, OscSettings, OscStatus, DEFAULT_AXIS};
+pub use osc_input::{OscInput, OscSettings, OscStatus, DEFAULT_AXIS, DEFAULT_OSC_INTERFACE};
 pub use params::{
     exact, float_param, format, migrate_state, parse_number, GlugParams, ModelParams, STATE_VERSION,
 };
@@ -159,9 +159,9 @@ impl<const RAW_MIDI: bool> Plugin for SakeGlugPlugin<RAW_MIDI> {
         buffer_config: &BufferConfig,
         _context: &mut impl ActivateContext<Self>,
     ) -> bool {
-        // Not the audio thread: the socket may be bound here.
-        let osc = &self.params.osc;
-        self.osc.listen(osc.port(), osc.axis());
+        // Not the audio thread: the socket may be bound here. A port a loaded state asks for
+        // waits for the user's consent.
+        self.osc.follow(&self.params.osc);
         let sample_rate = buffer_config.sample_rate as f64;
         let reusable = self
             .renderer

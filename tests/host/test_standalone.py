@@ -5,11 +5,15 @@ sends the tilt device's CCs to the app, another client ("recorder") records the 
 in the same JACK cycles, so frame times compare directly. Checked: the upright bottle is silent;
 tilted past the pouring point it glugs, and the first glug sample comes when the model says
 (the offline renderer, fed the same tilt, is the yardstick), with no delay added by the app;
-OSC over loopback tilts it too, garbage packets are counted; SIGINT and SIGTERM end it with
-exit status 0 and its JACK client gone. Every process started here is stopped, also on failure.
+OSC over loopback tilts it too, garbage packets are counted, and OSC listens on loopback
+unless asked; any sequence of SIGINT, SIGTERM and SIGHUP ends it within half a second, with exit
+status 0 and its JACK client gone, also with its editor open (under Xvfb); a JACK server that
+goes away is logged and ends it with exit status 1. Every process started here is stopped, also
+on failure.
 
-Needs `jackd` (Debian's jackd2), the release `sake-glug-standalone` (`cargo build --release
---bin sake-glug-standalone --no-default-features --features standalone`) and `sake-glug`.
+Needs `jackd` (Debian's jackd2), `Xvfb` (Debian's xvfb) for the editor, the release
+`sake-glug-standalone` (`cargo build --release --bin sake-glug-standalone --no-default-features
+--features standalone`) and `sake-glug`.
 """
 
 import os
@@ -37,6 +41,10 @@ MAX_ADDED_LATENCY_S = 0.050
 # The tilt the device sends: 14-bit on CC 16 (MSB) and CC 48 (LSB), 0..16383 over 0..180°.
 TILT_VALUE = 12287
 TILT_DEG = TILT_VALUE / 16383 * 180.0  # 134.995…°, as the plugin's decoder computes it
+# A quit signal, or several in a row, must end the app within this.
+QUIT_BOUND_S = 0.5
+# A JACK server that goes away must end the app within this (it waits 1 s for the audio).
+LOST_SERVER_BOUND_S = 3.0
 
 
 def wait_for(condition, timeout_s, what):
@@ -60,17 +68,10 @@ def stop(process, sig=signal.SIGTERM, timeout_s=10):
     return process.returncode
 
 
-@pytest.fixture(scope="module")
-def jack_server():
-    """A JACK server of our own name on the dummy driver; stopped after the tests."""
-    if shutil.which("jackd") is None:
-        if os.environ.get("CI"):
-            pytest.fail("jackd is not installed (Debian: jackd2); .ci/run installs it")
-        pytest.skip("jackd is not installed (Debian: jackd2)")
-    import jack  # libjack is loaded here, so only when a server can run
+def start_jack(name):
+    """Starts a JACK server called `name` on the dummy driver; returns (process, its log)."""
+    import jack
 
-    assert APP.exists(), f"{APP} is missing: build it with --features standalone"
-    name = f"sakeglug-test-{os.getpid()}"
     log = tempfile.TemporaryFile()
     server = subprocess.Popen(
         # Not --sync: a client leaving mid-cycle can stall a synchronous server. A cycle that
@@ -80,17 +81,50 @@ def jack_server():
         stderr=subprocess.STDOUT,
         stdin=subprocess.DEVNULL,
     )
+
+    def up():
+        if server.poll() is not None:
+            log.seek(0)
+            said = log.read().decode(errors="replace")[-2000:]
+            raise AssertionError(f"jackd exited at start ({server.returncode}): {said}")
+        try:
+            jack.Client("probe", servername=name, no_start_server=True).close()
+            return True
+        except jack.JackOpenError:
+            return False
+
     try:
-
-        def up():
-            assert server.poll() is None, "jackd exited at start"
-            try:
-                jack.Client("probe", servername=name, no_start_server=True).close()
-                return True
-            except jack.JackOpenError:
-                return False
-
         wait_for(up, 10, "the JACK server")
+    except BaseException:
+        stop(server, signal.SIGKILL)
+        raise
+    return server, log
+
+
+def forget_jack(name):
+    """Cleans up after a JACK server `name` that was killed: a server killed with SIGKILL keeps
+    its slot in JACK's registry of servers (8 per machine), which only a server of the same name
+    frees, and its clients' semaphores stay in /dev/shm."""
+    server, log = start_jack(name)
+    stop(server, signal.SIGTERM)
+    log.close()
+    for semaphore in Path("/dev/shm").glob(f"jack_sem.*_{name}_*"):
+        semaphore.unlink(missing_ok=True)
+
+
+@pytest.fixture(scope="module")
+def jack_server():
+    """A JACK server of our own name on the dummy driver; stopped after the tests."""
+    if shutil.which("jackd") is None:
+        if os.environ.get("CI"):
+            pytest.fail("jackd is not installed (Debian: jackd2); .ci/run installs it")
+        pytest.skip("jackd is not installed (Debian: jackd2)")
+    import jack  # noqa: F401  libjack is loaded here, so only when a server can run
+
+    assert APP.exists(), f"{APP} is missing: build it with --features standalone"
+    name = f"sakeglug-test-{os.getpid()}"
+    server, log = start_jack(name)
+    try:
         yield name
     finally:
         status = stop(server, signal.SIGTERM)
@@ -98,6 +132,33 @@ def jack_server():
         print(log.read().decode(errors="replace")[-2000:])
         assert server.poll() is not None, "the JACK server is stopped"
         assert status == 0, f"jackd exit status {status}"
+
+
+@pytest.fixture(scope="module")
+def display():
+    """An X display of our own (Xvfb) for the editor window; stopped after the tests."""
+    if shutil.which("Xvfb") is None:
+        if os.environ.get("CI"):
+            pytest.fail("Xvfb is not installed (Debian: xvfb); .ci/run installs it")
+        pytest.skip("Xvfb is not installed (Debian: xvfb)")
+    read_end, write_end = os.pipe()
+    server = subprocess.Popen(
+        # -displayfd: Xvfb picks a free display and writes its number once it is ready.
+        ["Xvfb", "-displayfd", str(write_end), "-screen", "0", "1024x768x24", "+extension", "GLX",
+         "-nolisten", "tcp"],
+        pass_fds=[write_end],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        stdin=subprocess.DEVNULL,
+    )
+    os.close(write_end)
+    try:
+        with os.fdopen(read_end) as ready:
+            number = ready.readline().strip()
+        assert number, "Xvfb did not start"
+        yield f":{number}"
+    finally:
+        stop(server, signal.SIGTERM)
 
 
 class Rig:
@@ -178,11 +239,17 @@ def app(jack_server):
     """Starts the app; yields (start function). Every app started is stopped afterwards."""
     started = []
 
-    def start(*extra):
-        env = dict(os.environ, JACK_DEFAULT_SERVER=jack_server, JACK_NO_START_SERVER="1")
+    def start(*extra, server=jack_server, display=None):
+        """Starts the app on JACK server `server`, headless, or with its editor on `display`;
+        returns once its JACK ports are there."""
+        env = dict(os.environ, JACK_DEFAULT_SERVER=server, JACK_NO_START_SERVER="1")
+        if display is None:
+            extra = ("--no-editor", *extra)
+        else:
+            env["DISPLAY"] = display
         log = tempfile.TemporaryFile()
         process = subprocess.Popen(
-            [str(APP), "--backend", "jack", "--no-editor", *extra],
+            [str(APP), "--backend", "jack", *extra],
             env=env,
             stdout=log,
             stderr=subprocess.STDOUT,
@@ -191,7 +258,7 @@ def app(jack_server):
         started.append((process, log))
         import jack
 
-        probe = jack.Client("probe", servername=jack_server, no_start_server=True)
+        probe = jack.Client("probe", servername=server, no_start_server=True)
         try:
 
             def ports_up():
@@ -225,17 +292,24 @@ def client_gone(server):
         probe.close()
 
 
-def quits_cleanly(process, log, server, sig):
-    process.send_signal(sig)
+def quits_cleanly(process, log, server, *signals):
+    """Sends `signals` one right after the other; the app must end within QUIT_BOUND_S of the
+    first, with exit status 0, its JACK client gone."""
+    start = time.monotonic()
+    for sig in signals:
+        process.send_signal(sig)
     try:
         status = process.wait(10)
     except subprocess.TimeoutExpired:
-        pytest.fail(f"the app did not end within 10 s of signal {sig!r}")
-    assert status == 0, f"exit status {status} after {sig!r}"
+        pytest.fail(f"the app did not end within 10 s of {signals!r}")
+    took_s = time.monotonic() - start
+    print(f"{' + '.join(sig.name for sig in signals)}: ended after {took_s * 1000:.0f} ms")
+    assert status == 0, f"exit status {status} after {signals!r}: {read(log)}"
+    assert took_s <= QUIT_BOUND_S, f"{took_s:.2f} s to end after {signals!r}"
     assert not Path(f"/proc/{process.pid}").exists(), "reaped, no zombie"
     wait_for(lambda: client_gone(server), 5, "the app's JACK client to go")
     if "did not stop within" in read(log):
-        print("(the app ended through its quit watch: the JACK backend did not stop in time)")
+        print("(the app ended through its watch: the JACK backend did not stop in time)")
 
 
 def model_first_glug_s(tilt_deg):
@@ -314,10 +388,33 @@ def osc_message(address, *floats):
     )
 
 
-def test_osc_tilt_from_loopback_pours_and_garbage_is_counted(jack_server, app):
+def free_udp_port():
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
         probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
+        return probe.getsockname()[1]
+
+
+def non_loopback_address():
+    """An IPv4 address of this machine other than loopback (the one it would send from), if any."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        try:
+            probe.connect(("192.0.2.1", 9))
+        except OSError:
+            return None
+        address = probe.getsockname()[0]
+    return None if address.startswith("127.") or address == "0.0.0.0" else address
+
+
+def udp_listeners(pid):
+    """The local addresses `ss` shows for the UDP sockets of process `pid`, or None without ss."""
+    if shutil.which("ss") is None:
+        return None
+    table = subprocess.run(["ss", "-u", "-l", "-n", "-p", "-H"], capture_output=True, text=True)
+    return {line.split()[3] for line in table.stdout.splitlines() if f"pid={pid}," in line}
+
+
+def test_osc_tilt_from_loopback_pours_and_garbage_is_counted(jack_server, app):
+    port = free_udp_port()
     process, log = app("--osc-port", str(port), "--osc-axis", "+y")
     wait_for(lambda: "OSC: listening" in read(log), 5, "the app to listen for OSC")
     rig = Rig(jack_server)
@@ -337,7 +434,89 @@ def test_osc_tilt_from_loopback_pours_and_garbage_is_counted(jack_server, app):
     quits_cleanly(process, log, jack_server, signal.SIGINT)
 
 
+def test_osc_listens_on_loopback_unless_asked(jack_server, app):
+    port = free_udp_port()
+    process, log = app("--osc-port", str(port))
+    wait_for(lambda: "OSC: listening" in read(log), 5, "the app to listen for OSC")
+    assert f"OSC: listening on UDP 127.0.0.1:{port}," in read(log)
+    listeners = udp_listeners(process.pid)
+    if listeners is not None:
+        assert listeners == {f"127.0.0.1:{port}"}, listeners
+    outside = non_loopback_address()
+    if outside is not None:
+        # Nothing of the app's on the network side: that address's port is free.
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as other:
+            other.bind((outside, port))
+    quits_cleanly(process, log, jack_server, signal.SIGTERM)
+
+    # Every interface when asked: a packet to the network address arrives.
+    port = free_udp_port()
+    process, log = app("--osc-port", str(port), "--osc-bind", "0.0.0.0")
+    wait_for(lambda: "OSC: listening" in read(log), 5, "the app to listen for OSC")
+    assert f"OSC: listening on UDP 0.0.0.0:{port}," in read(log)
+    if outside is not None:
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
+            sender.sendto(b"\x00garbage", (outside, port))
+        wait_for(lambda: "1 malformed packet" in read(log), 5, f"a packet sent to {outside}")
+    quits_cleanly(process, log, jack_server, signal.SIGTERM)
+
+
 def test_sigterm_ends_the_app_cleanly(jack_server, app):
     process, log = app()
     time.sleep(0.2)
     quits_cleanly(process, log, jack_server, signal.SIGTERM)
+
+
+@pytest.mark.parametrize(
+    "signals",
+    [
+        (signal.SIGINT,),
+        (signal.SIGHUP,),
+        (signal.SIGTERM, signal.SIGTERM),
+        (signal.SIGINT, signal.SIGINT),
+        (signal.SIGTERM, signal.SIGINT, signal.SIGHUP),
+    ],
+    ids=lambda signals: "+".join(sig.name for sig in signals),
+)
+def test_quit_signals_end_the_app_at_once(jack_server, app, signals):
+    # A few times each: how long JACK takes to let the client go varies from run to run.
+    for _ in range(3):
+        process, log = app()
+        time.sleep(0.3)
+        quits_cleanly(process, log, jack_server, *signals)
+
+
+def test_sigterm_ends_the_app_at_once_with_its_editor_open(jack_server, display, app):
+    for _ in range(2):
+        process, log = app(display=display)
+        # The window is up and idle (nothing to repaint) when the signal comes.
+        time.sleep(1.5)
+        assert process.poll() is None, f"the app with its editor ended: {read(log)}"
+        assert "No GUI available" not in read(log), "the editor is open"
+        quits_cleanly(process, log, jack_server, signal.SIGTERM)
+
+
+@pytest.mark.parametrize("kill", [signal.SIGKILL, signal.SIGTERM], ids=lambda sig: sig.name)
+def test_a_jack_server_that_goes_away_is_logged_and_ends_the_app(jack_server, app, kill):
+    name = f"sakeglug-lost-{kill.name}-{os.getpid()}"
+    server, server_log = start_jack(name)
+    try:
+        process, log = app(server=name)
+        time.sleep(0.3)
+        server.send_signal(kill)
+        start = time.monotonic()
+        try:
+            status = process.wait(LOST_SERVER_BOUND_S + 5)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"the app outlived its JACK server by {LOST_SERVER_BOUND_S + 5} s")
+        took_s = time.monotonic() - start
+    finally:
+        stop(server, signal.SIGKILL)
+        server_log.close()
+        forget_jack(name)
+    print(f"the app ended {took_s * 1000:.0f} ms after its JACK server")
+    said = [line for line in read(log).splitlines() if "audio stopped" in line]
+    assert len(said) == 1, f"one line says the audio stopped: {read(log)}"
+    assert "JACK server" in said[0], said[0]
+    assert status == 1, f"exit status {status}"
+    assert took_s <= LOST_SERVER_BOUND_S, f"{took_s:.2f} s after the server went"

@@ -1,16 +1,19 @@
 //! OSC over loopback UDP into the real plugin: a packet sent to its port moves the bottle through
-//! `process()`, as a MIDI CC would; garbage is counted and ignored; the setting is saved.
+//! `process()`, as a MIDI CC would; garbage is counted and ignored; the setting is saved; a port
+//! opens only when the user allows it in the session, on loopback unless asked, never because a
+//! loaded state asks for it.
 
-use std::net::UdpSocket;
+use std::net::{IpAddr, Ipv4Addr, SocketAddr, UdpSocket};
 use std::sync::atomic::Ordering::Relaxed;
 use std::time::{Duration, Instant};
 
 use rosc::{OscMessage, OscPacket, OscType};
 
+use crate::clap_host::ClapInstance;
 use crate::host::{peak, TestHost};
 use sake_glug::device::{Axis, LiveControls, LiveReader};
 use sake_glug::engine::Control;
-use sake_glug::plugin::OscStatus;
+use sake_glug::plugin::{OscStatus, DEFAULT_OSC_INTERFACE};
 use sake_glug::SakeGlug;
 
 const RATE: f32 = 48_000.0;
@@ -21,14 +24,23 @@ fn free_port() -> u16 {
     socket.local_addr().expect("its address").port()
 }
 
-/// A plugin listening for OSC on a free port, activated in a test host.
+/// Whether nothing listens on UDP `port`, on any address: the port can be bound on all of them.
+fn port_is_closed(port: u16) -> bool {
+    UdpSocket::bind((Ipv4Addr::UNSPECIFIED, port)).is_ok()
+}
+
+/// A plugin listening for OSC on a free port, as the user turned it on in the editor (the port,
+/// then allowed), activated in a test host.
 fn listening_host(axis: Axis) -> (TestHost, u16) {
     let plugin = SakeGlug::default();
     let port = free_port();
     plugin.glug_params().osc.set(port, axis);
+    plugin.osc().allow(port);
     let host = TestHost::with_plugin(plugin, RATE, 2);
     match host.plugin.osc().status() {
-        OscStatus::Listening(address) => assert_eq!(address.port(), port),
+        OscStatus::Listening(address) => {
+            assert_eq!(address, SocketAddr::new(DEFAULT_OSC_INTERFACE, port))
+        }
         other => panic!("the plugin should listen on {port}: {other:?}"),
     }
     (host, port)
@@ -219,21 +231,30 @@ fn fill_viscosity_and_refill_over_osc() {
     assert!(refilled > 149.9, "refilled to 150 ml: {refilled}");
 }
 
+/// The saved fields of a plugin, as a host's project keeps them.
+fn saved_fields(plugin: &SakeGlug) -> std::collections::BTreeMap<String, String> {
+    let params = plugin.glug_params().clone() as std::sync::Arc<dyn nice_plug::prelude::Params>;
+    params.serialize_fields()
+}
+
+/// A new instance with `fields` loaded, as a host loads a project.
+fn loaded(fields: &std::collections::BTreeMap<String, String>) -> SakeGlug {
+    let plugin = SakeGlug::default();
+    let params = plugin.glug_params().clone() as std::sync::Arc<dyn nice_plug::prelude::Params>;
+    params.deserialize_fields(fields);
+    plugin
+}
+
 #[test]
 fn the_osc_setting_is_saved_and_a_taken_port_is_reported() {
     let (host, port) = listening_host(Axis::MinusX);
-    let fields = {
-        let params =
-            host.plugin.glug_params().clone() as std::sync::Arc<dyn nice_plug::prelude::Params>;
-        params.serialize_fields()
-    };
+    let fields = saved_fields(&host.plugin);
     assert_eq!(fields["osc_port"], port.to_string());
-    let restored = SakeGlug::default();
-    let params = restored.glug_params().clone() as std::sync::Arc<dyn nice_plug::prelude::Params>;
-    params.deserialize_fields(&fields);
+    let restored = loaded(&fields);
     assert_eq!(restored.glug_params().osc.port(), port);
     assert_eq!(restored.glug_params().osc.axis(), Axis::MinusX);
-    // A second instance on the same port cannot bind it, and says so.
+    // A second instance on the same port, once its user allows it, cannot bind it, and says so.
+    restored.osc().allow(port);
     let second = TestHost::with_plugin(restored, RATE, 2);
     match second.plugin.osc().status() {
         OscStatus::Failed {
@@ -245,6 +266,101 @@ fn the_osc_setting_is_saved_and_a_taken_port_is_reported() {
         }
         other => panic!("the port is taken: {other:?}"),
     }
+}
+
+#[test]
+fn a_loaded_state_that_wants_osc_opens_no_port_until_the_user_allows_it() {
+    let port = free_port();
+    let saving = SakeGlug::default();
+    saving.glug_params().osc.set(port, Axis::MinusZ);
+    let fields = saved_fields(&saving);
+
+    let host = TestHost::with_plugin(loaded(&fields), RATE, 2);
+    let osc = host.plugin.osc();
+    assert_eq!(osc.status(), OscStatus::Waiting { port });
+    assert!(
+        port_is_closed(port),
+        "the project opened port {port} by itself"
+    );
+    // Activated again (a new sample rate, a state loaded again): still closed.
+    let host = TestHost::with_plugin(host.plugin, RATE * 2.0, 2);
+    let osc = host.plugin.osc();
+    assert!(port_is_closed(port));
+    // The state keeps its wish: saved again, the same fields.
+    assert_eq!(saved_fields(&host.plugin), fields);
+
+    // The user agrees (the editor's button): the port opens, on loopback only.
+    osc.allow(port);
+    osc.follow(&host.plugin.glug_params().osc);
+    let loopback = SocketAddr::new(DEFAULT_OSC_INTERFACE, port);
+    assert_eq!(osc.status(), OscStatus::Listening(loopback));
+    assert!(!port_is_closed(port));
+    // A network interface's address is free: nothing listens beyond this computer.
+    if let Some(outside) = non_loopback_address() {
+        assert!(UdpSocket::bind((outside, port)).is_ok(), "{outside}:{port}");
+    }
+
+    // Every interface only when the user picks it.
+    osc.set_interface(IpAddr::V4(Ipv4Addr::UNSPECIFIED));
+    osc.follow(&host.plugin.glug_params().osc);
+    match osc.status() {
+        OscStatus::Listening(address) => assert!(address.ip().is_unspecified(), "{address}"),
+        other => panic!("listening on every interface: {other:?}"),
+    }
+
+    // Another state, which wants another port, closes this one and waits in turn.
+    let other_port = free_port();
+    let mut other_fields = fields.clone();
+    other_fields.insert("osc_port".into(), other_port.to_string());
+    let params =
+        host.plugin.glug_params().clone() as std::sync::Arc<dyn nice_plug::prelude::Params>;
+    params.deserialize_fields(&other_fields);
+    let host = TestHost::with_plugin(host.plugin, RATE, 2);
+    assert_eq!(
+        host.plugin.osc().status(),
+        OscStatus::Waiting { port: other_port }
+    );
+    assert!(port_is_closed(port) && port_is_closed(other_port));
+}
+
+/// An address of this machine other than loopback, if it has one: the one it would send from.
+fn non_loopback_address() -> Option<IpAddr> {
+    let probe = UdpSocket::bind("0.0.0.0:0").ok()?;
+    probe.connect("192.0.2.1:9").ok()?;
+    let address = probe.local_addr().ok()?.ip();
+    (!address.is_loopback() && !address.is_unspecified()).then_some(address)
+}
+
+/// The JSON inside a CLAP state (the stream carries an 8-byte length first), and back.
+fn clap_json(bytes: &[u8]) -> serde_json::Value {
+    serde_json::from_slice(&bytes[8..]).expect("the state is JSON")
+}
+
+fn clap_bytes(json: &serde_json::Value) -> Vec<u8> {
+    let text = serde_json::to_vec(json).expect("JSON");
+    let mut bytes = (text.len() as u64).to_le_bytes().to_vec();
+    bytes.extend(text);
+    bytes
+}
+
+#[test]
+fn a_project_that_wants_osc_loads_its_values_but_opens_no_port() {
+    // A state as the last release saved it, with OSC on a port: the same field names and values.
+    let port = free_port();
+    let mut json = clap_json(&ClapInstance::new().save());
+    json["fields"]["osc_port"] = port.to_string().into();
+    json["fields"]["osc_axis"] = "5".into();
+    let mut instance = ClapInstance::new();
+    assert!(instance.load(&clap_bytes(&json)));
+    instance.activate(48_000.0);
+    instance.render(4_800, 480);
+    assert!(
+        port_is_closed(port),
+        "loading the project opened UDP port {port}"
+    );
+    let saved = clap_json(&instance.save());
+    assert_eq!(saved["fields"]["osc_port"], port.to_string());
+    assert_eq!(saved["fields"]["osc_axis"], "5");
 }
 
 #[test]

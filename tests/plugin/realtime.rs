@@ -97,6 +97,7 @@ fn process_does_not_allocate_while_osc_arrives() {
         .glug_params()
         .osc
         .set(port, sake_glug::device::Axis::PlusY);
+    plugin.osc().allow(port);
     let mut host = TestHost::with_plugin(plugin, 48_000.0, 2);
     host.guard = no_alloc;
     let client = std::net::UdpSocket::bind("127.0.0.1:0").expect("client socket");

@@ -1,18 +1,24 @@
 //! The app's own options, taken out of the command line before nice-plug's wrapper parses the
 //! rest (it refuses options it does not know).
 
+use std::net::IpAddr;
+
 use clap::{CommandFactory, Parser};
 use sake_glug::device::Axis;
-use sake_glug::plugin::DEFAULT_AXIS;
+use sake_glug::plugin::{DEFAULT_AXIS, DEFAULT_OSC_INTERFACE};
 
 /// Sake Glug's own options of the standalone app (the wrapper's follow).
 #[derive(Debug, Parser)]
 #[command(name = "sake-glug-standalone", disable_help_flag = true)]
 pub struct AppArgs {
-    /// Listen for OSC on this UDP port, on every network interface: /sakeglug/tilt, /viscosity,
-    /// /fill, /refill, and the gravity vectors of GyrOSC, TouchOSC and Sensors2OSC.
+    /// Listen for OSC on this UDP port: /sakeglug/tilt, /viscosity, /fill, /refill, and the
+    /// gravity vectors of GyrOSC, TouchOSC and Sensors2OSC.
     #[arg(long, value_name = "PORT", value_parser = clap::value_parser!(u16).range(1..))]
     pub osc_port: Option<u16>,
+    /// The address OSC listens on: 127.0.0.1 takes packets from this computer only; 0.0.0.0
+    /// (or a network interface's own address) takes them from the network, from a phone.
+    #[arg(long, value_name = "ADDRESS", default_value_t = DEFAULT_OSC_INTERFACE)]
+    pub osc_bind: IpAddr,
     /// The phone's or sensor's axis that points from the bottle's base to its mouth, for
     /// gravity vectors: +x, -x, +y, -y, +z or -z.
     #[arg(long, value_name = "AXIS", default_value_t = DEFAULT_AXIS)]
@@ -23,8 +29,9 @@ pub struct AppArgs {
 }
 
 /// Our options and whether each takes a value.
-const OWN: [(&str, bool); 3] = [
+const OWN: [(&str, bool); 4] = [
     ("--osc-port", true),
+    ("--osc-bind", true),
     ("--osc-axis", true),
     ("--no-editor", false),
 ];
@@ -85,12 +92,20 @@ mod tests {
             "9000",
             "--osc-axis",
             "-z",
+            "--osc-bind",
+            "0.0.0.0",
             "--no-editor",
             "--connect-jack-midi-input=a:b",
         ]));
         assert_eq!(
             own,
-            strings(&["app", "--osc-port=9000", "--osc-axis=-z", "--no-editor"])
+            strings(&[
+                "app",
+                "--osc-port=9000",
+                "--osc-axis=-z",
+                "--osc-bind=0.0.0.0",
+                "--no-editor"
+            ])
         );
         assert_eq!(
             rest,
@@ -99,6 +114,7 @@ mod tests {
         let parsed = parse(&own).unwrap();
         assert_eq!(parsed.osc_port, Some(9000));
         assert_eq!(parsed.osc_axis, Axis::MinusZ);
+        assert_eq!(parsed.osc_bind, IpAddr::from([0, 0, 0, 0]));
         assert!(parsed.no_editor);
     }
 
@@ -109,6 +125,7 @@ mod tests {
             (&["app", "--osc-port", "http"][..], "--osc-port"),
             (&["app", "--osc-axis=w"][..], "\"w\" is not an axis"),
             (&["app", "--osc-port"][..], "--osc-port"),
+            (&["app", "--osc-bind=everywhere"][..], "--osc-bind"),
         ] {
             let (own, _) = split(strings(args));
             let error = parse(&own).unwrap_err().to_string();
@@ -116,5 +133,9 @@ mod tests {
         }
         let defaults = parse(&strings(&["app"])).unwrap();
         assert_eq!((defaults.osc_port, defaults.osc_axis), (None, DEFAULT_AXIS));
+        assert!(
+            defaults.osc_bind.is_loopback(),
+            "this computer only, unless asked"
+        );
     }
 }

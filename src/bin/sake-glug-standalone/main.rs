@@ -5,9 +5,14 @@
 //! see `--help`). Ours are taken out of the command line first and the rest is handed to the
 //! wrapper:
 //!
-//! - `--osc-port PORT`: listen for OSC on UDP PORT (every interface);
+//! - `--osc-port PORT`: listen for OSC on UDP PORT;
+//! - `--osc-bind ADDRESS`: the address OSC listens on, 127.0.0.1 (this computer only) unless
+//!   asked (`0.0.0.0`: every network interface);
 //! - `--osc-axis AXIS`: the sensor axis from the bottle's base to its mouth (`+y` by default);
-//! - `--no-editor`: no window (no display needed); quit with Ctrl-C or SIGTERM.
+//! - `--no-editor`: no window (no display needed); quit with Ctrl-C, SIGTERM or SIGHUP.
+//!
+//! If the audio stops coming (the JACK server or the audio device went away) the app says so and
+//! exits with status 1.
 
 mod args;
 
@@ -18,8 +23,12 @@ use nice_plug::prelude::nice_export_standalone_with_args;
 use sake_glug::plugin::standalone::{self, StandaloneOptions};
 use sake_glug::SakeGlug;
 
-/// How long the wrapper gets to stop after SIGINT or SIGTERM before the process ends anyway.
-const QUIT_GRACE: Duration = Duration::from_secs(3);
+/// How long the wrapper gets to stop after a quit signal before the process ends anyway (it
+/// takes a few tens of milliseconds when the audio server answers).
+const QUIT_GRACE: Duration = Duration::from_millis(250);
+/// How long without an audio callback means that the audio server or device went away (longer
+/// than any period a JACK server or an ALSA device runs at).
+const AUDIO_LOST_AFTER: Duration = Duration::from_secs(1);
 
 fn main() -> ExitCode {
     let (own, wrapper_args) = args::split(std::env::args());
@@ -36,8 +45,9 @@ fn main() -> ExitCode {
     standalone::configure(StandaloneOptions {
         editor: !options.no_editor,
         osc: options.osc_port.map(|port| (port, options.osc_axis)),
+        osc_interface: options.osc_bind,
     });
-    standalone::spawn_quit_watch(QUIT_GRACE);
+    standalone::spawn_watch(QUIT_GRACE, AUDIO_LOST_AFTER);
     if nice_export_standalone_with_args::<SakeGlug, _>(wrapper_args) {
         ExitCode::SUCCESS
     } else {

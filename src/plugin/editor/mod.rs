@@ -50,8 +50,13 @@ pub fn create(
     feed: Arc<Feed>,
     osc: Arc<OscInput>,
 ) -> Option<EguiEditor<GlugEditor>> {
-    // The audio thread asks for redraws through the feed, when what it shows changes.
+    // The audio thread asks for redraws through the feed, when what it shows changes; so does a
+    // quit signal in the standalone app, so that the window closes at once.
     let repaint = feed.repaint.clone();
+    crate::plugin::standalone::wake_editor_with({
+        let repaint = repaint.clone();
+        move || repaint.request_repaint()
+    });
     let app = GlugEditor {
         params,
         feed,
@@ -80,7 +85,7 @@ impl NiceEguiApp for GlugEditor {
     }
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut nice_plug_egui::Frame) {
-        // The standalone app got SIGINT or SIGTERM: closing the window ends it cleanly.
+        // The standalone app got SIGINT, SIGTERM or SIGHUP: closing the window ends it cleanly.
         if crate::plugin::standalone::quit_requested() {
             ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
         }
