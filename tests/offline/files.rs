@@ -166,7 +166,9 @@ fn a_target_that_becomes_a_folder_during_the_render_changes_no_target() {
 }
 
 /// While another render holds the folder's lock, a render's files wait: two renders of one set
-/// of targets replace them one set after the other, never mixed.
+/// of targets replace them one set after the other, never mixed. (`/proc/locks` shows the
+/// render waiting for the lock.)
+#[cfg(target_os = "linux")]
 #[test]
 fn a_render_replaces_its_targets_only_while_it_holds_their_folders_lock() {
     let directory = tempfile::tempdir().unwrap();
@@ -174,9 +176,17 @@ fn a_render_replaces_its_targets_only_while_it_holds_their_folders_lock() {
     let lock = fs::File::open(dir).unwrap();
     lock.lock().unwrap();
     let mut child = spawn(dir, &["render", "-o", "pour.wav", "-o", "pour.csv"]);
-    // The default pour renders in a fraction of this; then its commit waits.
-    std::thread::sleep(Duration::from_millis(1500));
-    assert!(child.try_wait().unwrap().is_none(), "it did not wait");
+    let waiting = format!(" {} ", child.id());
+    let started = Instant::now();
+    while !fs::read_to_string("/proc/locks")
+        .unwrap()
+        .lines()
+        .any(|line| line.contains("-> FLOCK") && line.contains(&waiting))
+    {
+        assert!(child.try_wait().unwrap().is_none(), "it did not wait");
+        assert!(started.elapsed() < Duration::from_secs(20), "it never got there");
+        std::thread::sleep(Duration::from_millis(10));
+    }
     assert!(!dir.join("pour.wav").exists() && !dir.join("pour.csv").exists());
     lock.unlock().unwrap();
     assert!(child.wait().unwrap().success());

@@ -1,5 +1,5 @@
-//! The offline renderer: scene files, the `sake-glug` command line, and the same samples on
-//! every run and at every block size.
+//! The offline renderer: scene files, the `sake-glug` command line, the same samples on every
+//! run and at every block size, and what a render leaves on disk and holds in memory.
 
 #[path = "../support/mod.rs"]
 mod support;

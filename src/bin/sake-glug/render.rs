@@ -112,6 +112,8 @@ pub fn run(args: RenderArgs) -> ExitCode {
     let mut failed = 0;
     for (index, job) in jobs.iter().enumerate() {
         let progress = |fraction| out.progress.set(index, fraction);
+        let signal_name =
+            |signal| signal_hook::low_level::signal_name(signal).unwrap_or("a signal");
         match render_job(job, &args, &options, &stop, progress) {
             Ok(report) => {
                 for leftover in &report.leftovers {
@@ -123,19 +125,27 @@ pub fn run(args: RenderArgs) -> ExitCode {
                 }
                 out.summary(&summary(job, &report));
             }
-            Err(JobError::Output(OutputError::Render(RenderError::Interrupted))) => {}
+            Err(JobError::Output(OutputError::Render(RenderError::Interrupted))) => {
+                let signal = stop.signal().map_or("a signal", signal_name);
+                out.error(&format!(
+                    "{}: stopped by {signal}; its files were not written",
+                    job.name
+                ));
+            }
             Err(error) => {
                 failed += 1;
                 out.error(&format!("error: {}: {error}", job.name));
             }
         }
         if let Some(signal) = stop.signal() {
+            let left = jobs.len() - index - 1;
+            if left > 0 {
+                out.error(&format!(
+                    "stopped by {}: {left} more scene(s) not rendered",
+                    signal_name(signal)
+                ));
+            }
             out.progress.finish();
-            eprintln!(
-                "{}: stopped by {}; its files were not written",
-                job.name,
-                signal_hook::low_level::signal_name(signal).unwrap_or("a signal")
-            );
             return ExitCode::from((128 + signal).clamp(0, 255) as u8);
         }
     }
