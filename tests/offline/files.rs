@@ -184,7 +184,10 @@ fn a_render_replaces_its_targets_only_while_it_holds_their_folders_lock() {
         .any(|line| line.contains("-> FLOCK") && line.contains(&waiting))
     {
         assert!(child.try_wait().unwrap().is_none(), "it did not wait");
-        assert!(started.elapsed() < Duration::from_secs(20), "it never got there");
+        assert!(
+            started.elapsed() < Duration::from_secs(20),
+            "it never got there"
+        );
         std::thread::sleep(Duration::from_millis(10));
     }
     assert!(!dir.join("pour.wav").exists() && !dir.join("pour.csv").exists());

@@ -75,17 +75,17 @@ impl PendingFile {
             .iter()
             .map(|file| file.prepare().map_err(OutputError::io(&file.path)))
             .collect::<Result<Vec<_>, _>>()?;
-        let mut replaced = Vec::with_capacity(files.len());
+        let mut tried = Vec::with_capacity(files.len());
         for (file, mut target) in files.into_iter().zip(targets) {
             let path = file.path.clone();
             let result = file.replace(&mut target);
-            replaced.push((path, target));
-            if let Err(error) = result {
-                let path = replaced.last().map(|(path, _)| path.clone());
-                for (path, target) in replaced.into_iter().rev() {
+            // The one that failed too: its target may be aside already.
+            tried.push((path.clone(), target));
+            if let Err(source) = result {
+                for (path, target) in tried.into_iter().rev() {
                     target.restore(&path);
                 }
-                return Err(OutputError::io(&path.unwrap_or_default())(error));
+                return Err(OutputError::Io { path, source });
             }
         }
         // The renames themselves are durable once their folders are synced.
@@ -116,6 +116,7 @@ impl PendingFile {
         Ok(Target {
             existed: existing.is_some(),
             backup,
+            moved_aside: false,
             replaced: false,
         })
     }
@@ -127,6 +128,7 @@ impl PendingFile {
             target.backup = Some(backup_of(&self.path, |target, backup| {
                 fs::rename(target, backup)
             })?);
+            target.moved_aside = true;
         }
         self.temp.persist(&self.path).map_err(|error| error.error)?;
         target.replaced = true;
@@ -140,6 +142,8 @@ struct Target {
     existed: bool,
     /// The previous target, under another name, removed when dropped.
     backup: Option<NamedTempFile<()>>,
+    /// The backup was renamed from the target, not linked: the target is gone.
+    moved_aside: bool,
     /// The new file is in place.
     replaced: bool,
 }
@@ -148,9 +152,12 @@ impl Target {
     /// Puts back what was at `path` before the commit.
     fn restore(self, path: &Path) {
         match self.backup {
-            Some(backup) => {
+            // A rename onto another link of the same file would do nothing and leave both: a
+            // link beside an untouched target is only removed, as dropping it does.
+            Some(backup) if self.replaced || self.moved_aside => {
                 let _ = backup.persist(path);
             }
+            Some(_) => {}
             None if self.replaced => {
                 let _ = fs::remove_file(path);
             }
@@ -317,22 +324,31 @@ mod tests {
         names
     }
 
-    /// The second rename fails (its temporary file was removed behind the render's back, as a
-    /// cleaner of temporary files may): the first target, already replaced, is put back.
+    /// The second rename fails (its temporary file was replaced behind the render's back): the
+    /// first target, already replaced, is put back, the second is as it was, the third is not
+    /// written, and nothing is left beside them.
     #[test]
     fn a_failed_replacement_puts_back_the_ones_done() {
         let folder = tempfile::tempdir().unwrap();
-        let (kept, added) = (
-            folder.path().join("keep.wav"),
-            folder.path().join("new.csv"),
-        );
+        let [kept, failing, added] =
+            ["keep.wav", "keep.csv", "new.haptic"].map(|name| folder.path().join(name));
         fs::write(&kept, "old").unwrap();
-        let files = vec![pending(&kept, "new"), pending(&added, "1\n")];
-        fs::remove_file(files[1].temp.path()).unwrap();
+        fs::write(&failing, "old").unwrap();
+        let files = vec![
+            pending(&kept, "new"),
+            pending(&failing, "new"),
+            pending(&added, "new"),
+        ];
+        // A folder where the second file was: its rename is the one that fails.
+        let obstacle = files[1].temp.path().to_owned();
+        fs::remove_file(&obstacle).unwrap();
+        fs::create_dir(&obstacle).unwrap();
         let error = PendingFile::commit_all(files).unwrap_err();
-        assert!(error.to_string().contains("new.csv"), "{error}");
+        fs::remove_dir(&obstacle).unwrap();
+        assert!(error.to_string().contains("keep.csv"), "{error}");
         assert_eq!(fs::read_to_string(&kept).unwrap(), "old");
-        assert_eq!(names(folder.path()), ["keep.wav"]);
+        assert_eq!(fs::read_to_string(&failing).unwrap(), "old");
+        assert_eq!(names(folder.path()), ["keep.csv", "keep.wav"]);
     }
 
     #[test]
