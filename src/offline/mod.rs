@@ -1,16 +1,18 @@
 //! The offline renderer: scene files ([`Scene`]) with their automation lanes ([`Automation`]),
 //! rendered by [`render_scene`] through the engine; [`render_to_files`] feeds one render to the
 //! [`sinks`] of every file asked for (WAV, CSV, the haptic clips written from the glugs of
-//! [`clips`], the pour plot), all or nothing.
+//! [`clips`], the pour plot), all or nothing, refused up front if it cannot fit in memory.
 
 mod automation;
 pub mod clips;
+mod memory;
 mod outputs;
 mod render;
 mod scene;
 pub mod sinks;
 
 pub use automation::Automation;
+pub use memory::human_bytes;
 pub use outputs::{render_to_files, RenderReport};
 pub use render::{render_scene, render_scene_to_vec, RenderError, RenderObserver, RenderSummary};
 pub use scene::{

@@ -2,14 +2,18 @@
 //! units and samples), and the files replace their targets all or nothing.
 //!
 //! Every sink writes to a temporary file beside its target; the targets are replaced only once
-//! every sink has finished, so a failed render leaves no partial file.
+//! every sink has finished, so a failed or interrupted render leaves no partial file, and a
+//! render that may need more memory than the machine has is refused before it starts.
 
 use std::cell::RefCell;
 use std::path::PathBuf;
 
-use super::render::{render_scene, RenderObserver, RenderSummary};
+use super::memory::available_bytes;
+use super::render::{render_scene, RenderError, RenderObserver, RenderSummary};
 use super::scene::Scene;
-use super::sinks::{OutputError, OutputFormat, OutputOptions, PendingFile, Sink, SinkContext};
+use super::sinks::{
+    remove_stale_temps, OutputError, OutputFormat, OutputOptions, PendingFile, Sink, SinkContext,
+};
 use crate::engine::UnitOnset;
 
 /// What a render wrote.
@@ -19,22 +23,30 @@ pub struct RenderReport {
     pub summary: RenderSummary,
     /// Each file written, with its size in bytes, in the order they were asked for.
     pub files: Vec<(PathBuf, u64)>,
+    /// Temporary files of another render found beside the targets, whose process the system
+    /// could not say is gone: perhaps left by a render that was killed, to be named to the user.
+    pub leftovers: Vec<PathBuf>,
 }
 
 /// Renders `scene` once and writes every file of `outputs` from that pass, each in the format
-/// its extension names. `scene_name` goes into the clips' metadata; `progress` hears the samples
-/// rendered so far.
+/// its extension names. `scene_name` goes into the clips' metadata; `observer` hears what the
+/// render reports (a closure: the samples rendered so far), and is asked after every block
+/// whether to stop (then nothing is written).
 pub fn render_to_files(
     scene: &Scene,
     scene_name: &str,
     outputs: &[PathBuf],
     options: &OutputOptions,
-    progress: impl FnMut(u64),
+    observer: impl RenderObserver,
 ) -> Result<RenderReport, OutputError> {
     let formats = outputs
         .iter()
         .map(|path| OutputFormat::of_path(path))
         .collect::<Result<Vec<_>, _>>()?;
+    let leftovers = outputs
+        .iter()
+        .flat_map(|path| remove_stale_temps(path))
+        .collect();
     // Each sink refuses here, before the render starts, what it knows it cannot write.
     let sinks = outputs
         .iter()
@@ -48,8 +60,18 @@ pub fn render_to_files(
             })
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let bottle_every = sinks.iter().filter_map(|sink| sink.bottle_every()).min();
+    refuse_what_cannot_fit(outputs, &sinks)?;
+    let bottle_every = sinks
+        .iter()
+        .filter_map(|sink| sink.bottle_every())
+        .chain(observer.bottle_every())
+        .min();
     let sinks = RefCell::new(sinks);
+    let mut fanout = Fanout {
+        sinks: &sinks,
+        bottle_every,
+        observer,
+    };
     let summary = render_scene(
         scene,
         |block: &[f32]| {
@@ -58,43 +80,69 @@ pub fn render_to_files(
                 .iter_mut()
                 .try_for_each(|sink| sink.samples(block))
         },
-        &mut Fanout {
-            sinks: &sinks,
-            bottle_every,
-            progress,
-        },
+        &mut fanout,
     )?;
+    let observer = fanout.observer;
     let finished = sinks
         .into_inner()
         .into_iter()
         .map(|sink| sink.finish(&summary))
         .collect::<Result<Vec<_>, _>>()?;
-    // Every file is complete: only now do they replace their targets.
-    let files = finished
-        .into_iter()
-        .map(PendingFile::commit)
-        .collect::<Result<_, _>>()?;
-    Ok(RenderReport { summary, files })
+    if observer.interrupted() {
+        return Err(RenderError::Interrupted.into());
+    }
+    // Every file is complete: only now do they replace their targets, all together.
+    let files = PendingFile::commit_all(finished)?;
+    Ok(RenderReport {
+        summary,
+        files,
+        leftovers,
+    })
 }
 
-/// Tells every sink what the render reports besides its samples (which the render hands to
-/// its sample closure, hence the shared cell).
-struct Fanout<'s, 'a, P> {
+/// Refuses a render whose sinks may together keep more memory than the machine has available.
+fn refuse_what_cannot_fit(
+    outputs: &[PathBuf],
+    sinks: &[Box<dyn Sink + '_>],
+) -> Result<(), OutputError> {
+    let files: Vec<(PathBuf, u64)> = outputs
+        .iter()
+        .zip(sinks)
+        .map(|(path, sink)| (path.clone(), sink.memory_bytes()))
+        .filter(|&(_, bytes)| bytes > 0)
+        .collect();
+    let needed = files
+        .iter()
+        .fold(0u64, |sum, &(_, bytes)| sum.saturating_add(bytes));
+    match available_bytes() {
+        Some(available) if needed > available => Err(OutputError::TooBig {
+            needed,
+            available,
+            files,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// Tells every sink, and the caller's observer, what the render reports besides its samples
+/// (which the render hands to its sample closure, hence the shared cell).
+struct Fanout<'s, 'a, O> {
     sinks: &'s RefCell<Vec<Box<dyn Sink + 'a>>>,
-    /// The finest any sink asked for.
+    /// The finest any sink or the observer asked for.
     bottle_every: Option<usize>,
-    progress: P,
+    observer: O,
 }
 
-impl<P: FnMut(u64)> RenderObserver for Fanout<'_, '_, P> {
+impl<O: RenderObserver> RenderObserver for Fanout<'_, '_, O> {
     fn progress(&mut self, rendered: u64) {
-        (self.progress)(rendered)
+        self.observer.progress(rendered)
     }
 
     fn unit_started(&mut self, onset: &UnitOnset, output_gain: f64) {
         for sink in self.sinks.borrow_mut().iter_mut() {
             sink.unit_started(onset, output_gain);
         }
+        self.observer.unit_started(onset, output_gain);
     }
 
     fn bottle_every(&self) -> Option<usize> {
@@ -105,5 +153,10 @@ impl<P: FnMut(u64)> RenderObserver for Fanout<'_, '_, P> {
         for sink in self.sinks.borrow_mut().iter_mut() {
             sink.bottle(position, volume_ml);
         }
+        self.observer.bottle(position, volume_ml);
+    }
+
+    fn interrupted(&self) -> bool {
+        self.observer.interrupted()
     }
 }

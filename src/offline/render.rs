@@ -37,6 +37,9 @@ pub enum RenderError {
         /// The slowest decay that falls silent within the limit.
         min_decay_per_s: f64,
     },
+    /// The caller stopped the render ([`RenderObserver::interrupted`]).
+    #[error("interrupted")]
+    Interrupted,
 }
 
 /// What a finished render did.
@@ -81,6 +84,11 @@ pub trait RenderObserver {
     }
     /// The residual volume (ml) after `position` samples.
     fn bottle(&mut self, _position: u64, _volume_ml: f64) {}
+    /// Whether the render is to stop (its user interrupted it), asked after every block: the
+    /// render then ends with [`RenderError::Interrupted`].
+    fn interrupted(&self) -> bool {
+        false
+    }
 }
 
 impl<F: FnMut(u64)> RenderObserver for F {
@@ -136,6 +144,9 @@ pub fn render_scene<E: From<RenderError>>(
         observer.progress(engine.position());
         if observer.bottle_every().is_some() {
             observer.bottle(engine.position(), engine.volume_ml());
+        }
+        if observer.interrupted() {
+            return Err(RenderError::Interrupted.into());
         }
 
         match block.iter().rposition(|y| *y != 0.0) {

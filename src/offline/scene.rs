@@ -97,13 +97,13 @@ pub enum SceneError {
         source: TakeError,
     },
     /// A value that must be a whole number (the sample rate) has a fraction.
-    #[error("`{key}` = {value} is not a whole number: {what} must be whole")]
+    #[error("`{key}` = {value} is not a whole number: {what}")]
     NotWhole {
         /// The scene key (also for the command line's override of it).
         key: &'static str,
         /// The value given.
         value: f64,
-        /// What the value is, in the message.
+        /// Why it must be whole, in the message.
         what: &'static str,
     },
     /// An automation point whose time is not finite, is negative or comes before the previous
@@ -721,7 +721,7 @@ fn check_sample_rate(sample_rate: f64) -> Result<u32, SceneError> {
         return Err(SceneError::NotWhole {
             key: "sample_rate",
             value: sample_rate,
-            what: "a sample rate is a number of samples per second",
+            what: "a sample rate counts whole samples per second",
         });
     }
     Ok(sample_rate as u32)

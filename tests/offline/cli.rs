@@ -159,28 +159,44 @@ fn a_decay_too_slow_to_end_is_refused_before_anything_is_rendered() {
     );
 }
 
+/// A sample rate on the command line is checked before anything is rendered, as a command-line
+/// error (exit status 2), with the message a scene's `sample_rate` gets.
 #[test]
-fn a_fractional_sample_rate_is_refused_on_the_command_line_as_in_a_scene() {
+fn a_bad_sample_rate_is_refused_on_the_command_line_as_in_a_scene() {
     let directory = tempfile::tempdir().unwrap();
-    let output = sake_glug(
-        directory.path(),
-        &["render", "--sample-rate", "44100.9", "-o", "out.wav"],
-    );
-    assert_eq!(output.status.code(), Some(1));
-    let message = String::from_utf8_lossy(&output.stderr);
+    for (rate, expected) in [
+        ("44100.9", "`sample_rate` = 44100.9 is not a whole number: a sample rate counts whole samples per second"),
+        ("0", "`sample_rate` = 0 is out of range: allowed 1000 to 768000"),
+        ("10", "`sample_rate` = 10 is out of range"),
+        ("nan", "`sample_rate` = NaN is out of range"),
+        ("fast", "`fast` is not a number of Hz"),
+    ] {
+        let output = sake_glug(
+            directory.path(),
+            &["render", "--sample-rate", rate, "-o", "out.wav"],
+        );
+        assert_eq!(output.status.code(), Some(2), "{rate}");
+        let message = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            message.starts_with("error: ") && message.contains(expected),
+            "{rate}: {message}"
+        );
+        assert!(files_in(directory.path()).is_empty());
+    }
     let in_scene = Scene::parse("sample_rate = 44100.9")
         .unwrap_err()
         .to_string();
-    assert!(message.contains(&in_scene), "{message}");
-    assert!(files_in(directory.path()).is_empty());
+    assert_eq!(
+        in_scene,
+        "`sample_rate` = 44100.9 is not a whole number: a sample rate counts whole samples per second"
+    );
 }
 
 #[test]
 fn bad_arguments_are_errors_not_panics() {
     let directory = tempfile::tempdir().unwrap();
-    let cases: [&[&str]; 3] = [
+    let cases: [&[&str]; 2] = [
         &["render", "missing.toml"],
-        &["render", "--sample-rate", "10"],
         &["render", "-o", "no/such/dir/out.wav"],
     ];
     for args in cases {

@@ -1,5 +1,5 @@
-//! The offline renderer: scene files, the `sake-glug` command line, and the same samples on
-//! every run and at every block size.
+//! The offline renderer: scene files, the `sake-glug` command line, the same samples on every
+//! run and at every block size, and what a render leaves on disk and holds in memory.
 
 #[path = "../support/mod.rs"]
 mod support;
@@ -9,10 +9,12 @@ mod clip_rules;
 mod clips_rendered;
 mod command;
 mod determinism;
+mod files;
 mod fuzz;
 // FIFOs, devices and links as Unix makes them.
 #[cfg(unix)]
 mod inputs;
+mod memory;
 mod presets;
 mod readme;
 mod scene_files;

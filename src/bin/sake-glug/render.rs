@@ -1,9 +1,11 @@
 //! `sake-glug render`: scenes (or the built-in pour) to WAV, `.haptic`, `.ahap`, CSV and a plot,
 //! every file of a scene from one render pass, all or nothing.
 
-use std::io::IsTerminal;
+use std::io::{self, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
 
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -11,8 +13,8 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sake_glug::engine::Preset;
 use sake_glug::offline::clips::HapticBand;
 use sake_glug::offline::{
-    render_to_files, OutputError, OutputFormat, OutputOptions, RenderReport, SampleFormat, Scene,
-    SceneError,
+    human_bytes, render_to_files, OutputError, OutputFormat, OutputOptions, RenderError,
+    RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
 };
 
 #[derive(Args)]
@@ -58,7 +60,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "TAKE.mid")]
     midi: Option<PathBuf>,
     /// Overrides the scenes' sample rate (Hz).
-    #[arg(long)]
+    #[arg(long, value_parser = sample_rate_hz)]
     sample_rate: Option<f64>,
     /// Sample format of WAV files: f32, s24 or s16.
     #[arg(long, default_value = "f32")]
@@ -85,7 +87,8 @@ enum JobError {
 }
 
 /// Runs the command: every scene is rendered, a bad one is reported and skipped; the exit
-/// status is 1 if any failed, 2 if the command line itself is wrong (nothing is rendered then).
+/// status is 1 if any failed, 2 if the command line itself is wrong (nothing is rendered then),
+/// 128 + the signal's number if a signal stopped it.
 pub fn run(args: RenderArgs) -> ExitCode {
     let jobs = match plan(&args) {
         Ok(jobs) => jobs,
@@ -104,27 +107,113 @@ pub fn run(args: RenderArgs) -> ExitCode {
         sample_format: args.sample_format,
         haptic_band: args.haptic_band,
     };
-    let progress = BatchProgress::new(jobs.len());
+    let stop = Stop::on_signals();
+    let mut out = Output::new(jobs.len());
     let mut failed = 0;
     for (index, job) in jobs.iter().enumerate() {
-        match render_job(job, &args, &options, |fraction| {
-            progress.set(index, fraction)
-        }) {
-            Ok(report) => progress.println(&summary(job, &report)),
+        let progress = |fraction| out.progress.set(index, fraction);
+        let signal_name =
+            |signal| signal_hook::low_level::signal_name(signal).unwrap_or("a signal");
+        match render_job(job, &args, &options, &stop, progress) {
+            Ok(report) => {
+                for leftover in &report.leftovers {
+                    out.error(&format!(
+                        "warning: {} looks left by an interrupted render; remove it unless a \
+                         render is writing it",
+                        leftover.display()
+                    ));
+                }
+                out.summary(&summary(job, &report));
+            }
+            Err(JobError::Output(OutputError::Render(RenderError::Interrupted))) => {
+                let signal = stop.signal().map_or("a signal", signal_name);
+                out.error(&format!(
+                    "{}: stopped by {signal}; its files were not written",
+                    job.name
+                ));
+            }
             Err(error) => {
                 failed += 1;
-                progress.println(&format!("error: {}: {error}", job.name));
+                out.error(&format!("error: {}: {error}", job.name));
             }
         }
-    }
-    progress.finish();
-    if failed > 0 {
-        if jobs.len() > 1 {
-            eprintln!("{failed} of {} scenes failed", jobs.len());
+        if let Some(signal) = stop.signal() {
+            let left = jobs.len() - index - 1;
+            if left > 0 {
+                out.error(&format!(
+                    "stopped by {}: {left} more scene(s) not rendered",
+                    signal_name(signal)
+                ));
+            }
+            out.progress.finish();
+            return ExitCode::from((128 + signal).clamp(0, 255) as u8);
         }
+    }
+    out.progress.finish();
+    if failed > 0 && jobs.len() > 1 {
+        out.error(&format!("{failed} of {} scenes failed", jobs.len()));
+    }
+    if let Some(error) = &out.stdout_error {
+        out.error(&format!("error: cannot print the summary: {error}"));
+    }
+    if failed > 0 || out.stdout_error.is_some() {
         ExitCode::FAILURE
     } else {
         ExitCode::SUCCESS
+    }
+}
+
+/// `--sample-rate`: a number refused, before anything is rendered, as a scene's `sample_rate`
+/// would be.
+fn sample_rate_hz(text: &str) -> Result<f64, String> {
+    let sample_rate: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number of Hz"))?;
+    Scene::default()
+        .with_sample_rate(sample_rate)
+        .map(|_| sample_rate)
+        .map_err(|error| error.to_string())
+}
+
+/// The signals that stop a render: Ctrl-C, `kill`'s default, a closed terminal. The render stops
+/// at its next block and removes its temporary files, and the command ends with 128 + the
+/// signal's number; a second signal ends it at once, as the signal would have (the temporary
+/// files are then removed by the next render to the same targets).
+#[cfg(unix)]
+const STOP_SIGNALS: [i32; 3] = [
+    signal_hook::consts::SIGINT,
+    signal_hook::consts::SIGTERM,
+    signal_hook::consts::SIGHUP,
+];
+#[cfg(not(unix))]
+const STOP_SIGNALS: [i32; 2] = [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM];
+
+/// The last of [`STOP_SIGNALS`] that came, if any.
+struct Stop {
+    signal: Arc<AtomicUsize>,
+}
+
+impl Stop {
+    fn on_signals() -> Self {
+        let signal = Arc::new(AtomicUsize::new(0));
+        let stopping = Arc::new(AtomicBool::new(false));
+        for number in STOP_SIGNALS {
+            use signal_hook::flag;
+            // In this order: a signal that finds `stopping` set ends the process, then sets it.
+            // Not being able to catch a signal leaves it as it was: it ends the process.
+            let _ = flag::register_conditional_default(number, Arc::clone(&stopping))
+                .and_then(|_| flag::register(number, Arc::clone(&stopping)))
+                .and_then(|_| flag::register_usize(number, Arc::clone(&signal), number as usize));
+        }
+        Self { signal }
+    }
+
+    fn signal(&self) -> Option<i32> {
+        match self.signal.load(Ordering::Relaxed) {
+            0 => None,
+            number => Some(number as i32),
+        }
     }
 }
 
@@ -162,6 +251,12 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
     };
     let mut jobs = Vec::new();
     if let Some(directory) = &args.out_dir {
+        if directory.exists() && !directory.is_dir() {
+            return Err(format!(
+                "--out-dir {}: it is a file, not a folder",
+                directory.display()
+            ));
+        }
         let formats = args
             .formats
             .iter()
@@ -234,7 +329,8 @@ fn render_job(
     job: &Job,
     args: &RenderArgs,
     options: &OutputOptions,
-    mut progress: impl FnMut(f64),
+    stop: &Stop,
+    progress: impl FnMut(f64),
 ) -> Result<RenderReport, JobError> {
     let mut scene = match (&job.scene, args.preset.as_deref().and_then(Preset::find)) {
         (Some(path), _) => Scene::load(path)?,
@@ -247,14 +343,34 @@ fn render_job(
     if let Some(sample_rate) = args.sample_rate {
         scene = scene.with_sample_rate(sample_rate)?;
     }
-    let total = scene.duration_samples();
-    let report = render_to_files(&scene, &job.name, &job.outputs, options, |done| {
-        // A scene without a duration ends where it falls silent: its share is unknown.
-        if let Some(total) = total {
-            progress(done as f64 / total.max(1) as f64);
-        }
-    })?;
+    let observer = JobObserver {
+        total: scene.duration_samples(),
+        progress,
+        stop,
+    };
+    let report = render_to_files(&scene, &job.name, &job.outputs, options, observer)?;
     Ok(report)
+}
+
+/// What a job's render reports to: the progress bar, and whether a signal came.
+struct JobObserver<'a, P> {
+    /// Samples of the scene, if it has a duration.
+    total: Option<u64>,
+    progress: P,
+    stop: &'a Stop,
+}
+
+impl<P: FnMut(f64)> RenderObserver for JobObserver<'_, P> {
+    fn progress(&mut self, done: u64) {
+        // A scene without a duration ends where it falls silent: its share is unknown.
+        if let Some(total) = self.total {
+            (self.progress)(done as f64 / total.max(1) as f64);
+        }
+    }
+
+    fn interrupted(&self) -> bool {
+        self.stop.signal().is_some()
+    }
 }
 
 /// The line printed for a finished scene.
@@ -277,15 +393,54 @@ fn summary(job: &Job, report: &RenderReport) -> String {
     )
 }
 
-fn human_bytes(bytes: u64) -> String {
-    match bytes {
-        0..1_000 => format!("{bytes} B"),
-        1_000..1_000_000 => format!("{:.1} kB", bytes as f64 / 1e3),
-        _ => format!("{:.1} MB", bytes as f64 / 1e6),
+/// Where a batch reports: the summary lines on stdout, whatever stderr is; errors and the
+/// progress bar (on a terminal only) on stderr. Output that cannot be written ends the printing,
+/// never the batch: a reader that has gone (`| head -1`) is no error, any other (a full disk)
+/// fails the command once every scene is written.
+struct Output {
+    progress: BatchProgress,
+    /// Stdout can no longer be written.
+    stdout_closed: bool,
+    /// Why, unless its reader had gone.
+    stdout_error: Option<io::Error>,
+}
+
+impl Output {
+    fn new(scenes: usize) -> Self {
+        Self {
+            progress: BatchProgress::new(scenes),
+            stdout_closed: false,
+            stdout_error: None,
+        }
+    }
+
+    /// Prints a scene's summary line on stdout (above the bar, if there is one).
+    fn summary(&mut self, line: &str) {
+        if self.stdout_closed {
+            return;
+        }
+        let written = self
+            .progress
+            .bar
+            .suspend(|| writeln!(io::stdout().lock(), "{line}"));
+        if let Err(error) = written {
+            self.stdout_closed = true;
+            if error.kind() != io::ErrorKind::BrokenPipe {
+                self.stdout_error = Some(error);
+            }
+        }
+    }
+
+    /// Prints a line on stderr (above the bar, if there is one); one that cannot be written is
+    /// lost, as there is nowhere else to say so.
+    fn error(&self, line: &str) {
+        self.progress.bar.suspend(|| {
+            let _ = writeln!(io::stderr().lock(), "{line}");
+        });
     }
 }
 
-/// One progress bar over the whole batch on a terminal; nothing when stderr is redirected.
+/// One progress bar over the whole batch on stderr when it is a terminal; nothing otherwise.
 struct BatchProgress {
     bar: ProgressBar,
 }
@@ -295,7 +450,7 @@ const STEPS_PER_SCENE: u64 = 1000;
 
 impl BatchProgress {
     fn new(scenes: usize) -> Self {
-        if !std::io::stderr().is_terminal() {
+        if !io::stderr().is_terminal() {
             return Self {
                 bar: ProgressBar::hidden(),
             };
@@ -313,19 +468,6 @@ impl BatchProgress {
         let within = (fraction.clamp(0.0, 1.0) * STEPS_PER_SCENE as f64) as u64;
         self.bar
             .set_position(index as u64 * STEPS_PER_SCENE + within);
-    }
-
-    /// Prints a line above the bar (or alone, without one).
-    fn println(&self, line: &str) {
-        if self.bar.is_hidden() {
-            if line.starts_with("error:") {
-                eprintln!("{line}");
-            } else {
-                println!("{line}");
-            }
-        } else {
-            self.bar.println(line);
-        }
     }
 
     fn finish(&self) {

@@ -81,6 +81,15 @@ impl TiltCurve {
         }
     }
 
+    /// The largest value at any tilt: a breakpoint's, the curve being linear between them and
+    /// held beyond them.
+    pub fn max(&self) -> f64 {
+        self.points
+            .iter()
+            .map(|&(_, value)| value)
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
     /// Whether `tilt_deg` lies in piece `piece`.
     #[inline]
     fn contains(&self, piece: usize, tilt_deg: f64) -> bool {

@@ -15,8 +15,12 @@ use crate::offline::clips::{
 
 /// The sink of an `.ahap` output (its sharpness always on the default band).
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    ClipSink::open(context, |source, _| ahap_json(source))
+    ClipSink::open(context, |source, _| ahap_json(source), BYTES_PER_GLUG)
 }
+
+/// Memory a glug takes until the pattern is written: the glug, its events and their text (a
+/// dense render peaks near 1.2 kB a glug).
+const BYTES_PER_GLUG: u64 = 1536;
 
 #[derive(Serialize)]
 #[serde(rename_all = "PascalCase")]

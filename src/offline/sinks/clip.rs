@@ -6,6 +6,7 @@ use std::io::Write;
 use super::{OutputError, OutputOptions, PendingFile, Sink, SinkContext};
 use crate::engine::UnitOnset;
 use crate::offline::clips::{ClipSource, Glug};
+use crate::offline::memory::max_units;
 use crate::offline::RenderSummary;
 
 /// The sink of a clip, a document written from the render's glugs once it has ended: it keeps
@@ -15,23 +16,31 @@ pub(super) struct ClipSink<'a> {
     context: SinkContext<'a>,
     glugs: Vec<Glug>,
     document: fn(&ClipSource, &OutputOptions) -> String,
+    /// Memory one glug takes until the document is written (see [`Sink::memory_bytes`]).
+    bytes_per_glug: u64,
 }
 
 impl<'a> ClipSink<'a> {
     pub(super) fn open(
         context: SinkContext<'a>,
         document: fn(&ClipSource, &OutputOptions) -> String,
+        bytes_per_glug: u64,
     ) -> Result<Box<dyn Sink + 'a>, OutputError> {
         Ok(Box::new(Self {
             file: PendingFile::beside(context.path, "").map_err(OutputError::io(context.path))?,
             context,
             glugs: Vec::new(),
             document,
+            bytes_per_glug,
         }))
     }
 }
 
 impl Sink for ClipSink<'_> {
+    fn memory_bytes(&self) -> u64 {
+        max_units(self.context.scene).saturating_mul(self.bytes_per_glug)
+    }
+
     fn unit_started(&mut self, onset: &UnitOnset, output_gain: f64) {
         let sample_rate = self.context.scene.sample_rate;
         self.glugs

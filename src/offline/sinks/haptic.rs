@@ -11,10 +11,16 @@ use crate::offline::clips::{
 
 /// The sink of a `.haptic` output, its frequencies on the band of the options.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    ClipSink::open(context, |source, options| {
-        haptic_json(source, &options.haptic_band)
-    })
+    ClipSink::open(
+        context,
+        |source, options| haptic_json(source, &options.haptic_band),
+        BYTES_PER_GLUG,
+    )
 }
+
+/// Memory a glug takes until the clip is written: the glug, its breakpoints and their text
+/// (a dense render peaks near 0.8 kB a glug).
+const BYTES_PER_GLUG: u64 = 1024;
 
 #[derive(Serialize)]
 struct HapticFile {

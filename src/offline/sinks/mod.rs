@@ -21,11 +21,12 @@ mod wav;
 use std::path::{Path, PathBuf};
 
 use super::clips::HapticBand;
+use super::memory::human_bytes;
 use super::render::{RenderError, RenderSummary};
 use super::scene::Scene;
 use crate::engine::UnitOnset;
 use clip::ClipSink;
-pub(crate) use pending::PendingFile;
+pub(crate) use pending::{remove_stale_temps, PendingFile};
 #[cfg(feature = "plot")]
 use plot::open as open_plot;
 
@@ -33,8 +34,7 @@ pub use ahap::ahap_json;
 pub use csv::write_csv_samples;
 pub use haptic::haptic_json;
 #[cfg(feature = "plot")]
-pub use plot::{draw_pour_plot, PlotData, PlotError};
-
+pub use plot::{draw_pour_plot, PlotData, PlotError, Waveform};
 pub use wav::{SampleFormat, WavError};
 
 /// One file of a render, written from the render's single pass. Every method but
@@ -55,6 +55,11 @@ pub(crate) trait Sink {
     }
     /// The residual volume (ml) after `position` samples.
     fn bottle(&mut self, _position: u64, _volume_ml: f64) {}
+    /// The most memory (bytes) the sink may keep, as far as it can tell before the render: a
+    /// render whose sinks may need more than the machine has is refused before it starts.
+    fn memory_bytes(&self) -> u64 {
+        0
+    }
     /// The render has ended (`summary`): completes the file in its temporary file, which
     /// replaces the target only once every sink of the render has finished.
     fn finish(self: Box<Self>, summary: &RenderSummary) -> Result<PendingFile, OutputError>;
@@ -220,6 +225,28 @@ pub enum OutputError {
     /// The render itself failed.
     #[error(transparent)]
     Render(#[from] RenderError),
+    /// The files asked for may need more memory than the machine has: refused before the
+    /// render starts.
+    #[error(
+        "the files asked for may need {} of memory ({}), more than the {} available; give the \
+         scene a shorter duration_s, or leave out the files that keep every glug (.haptic, \
+         .ahap, .png): a .wav or .csv keeps none",
+        human_bytes(*needed),
+        files
+            .iter()
+            .map(|(path, bytes)| format!("{} {}", path.display(), human_bytes(*bytes)))
+            .collect::<Vec<_>>()
+            .join(", "),
+        human_bytes(*available)
+    )]
+    TooBig {
+        /// Bytes all the files may need together.
+        needed: u64,
+        /// Bytes the machine has available.
+        available: u64,
+        /// Each file that keeps something, with the bytes it may need.
+        files: Vec<(PathBuf, u64)>,
+    },
     /// A WAV file could not be written.
     #[error(transparent)]
     Wav(#[from] WavError),

@@ -79,10 +79,12 @@ pub enum WavError {
     },
     /// The render is longer than a WAV file can hold: its sizes are 32-bit byte counts.
     #[error(
-        "{}: {samples} samples of {format:?} would pass the 4 GiB a WAV file can hold (at most \
+        "{}: {samples} samples of {} would pass the 4 GiB a WAV file can hold (at most \
          {max_samples} samples, {max_hours:.2} h at {sample_rate} Hz); give the scene a shorter \
-         duration_s, write s16 or s24, or write a .csv instead",
-        path.display()
+         duration_s, {}or write a .csv instead",
+        path.display(),
+        format.name(),
+        format.narrower_advice()
     )]
     TooLong {
         /// The file asked for.
@@ -239,6 +241,29 @@ impl WavFile {
 }
 
 impl SampleFormat {
+    /// The name the command line uses for it.
+    fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(format, _)| *format == self)
+            .map_or("", |(_, name)| name)
+    }
+
+    /// "write s24 or s16, ": the formats whose files hold more samples, as advice; nothing for
+    /// the narrowest.
+    fn narrower_advice(self) -> String {
+        let narrower: Vec<&str> = Self::ALL
+            .iter()
+            .filter(|(format, _)| format.bytes_per_sample() < self.bytes_per_sample())
+            .map(|(_, name)| *name)
+            .collect();
+        if narrower.is_empty() {
+            String::new()
+        } else {
+            format!("write {} (--sample-format), ", narrower.join(" or "))
+        }
+    }
+
     /// Bytes one sample takes in the file.
     fn bytes_per_sample(self) -> usize {
         match self {
@@ -305,6 +330,28 @@ mod tests {
         assert!(error.to_string().contains("4 GiB"), "{error}");
     }
 
+    /// Each format is told of the narrower ones only: an s16 render is not told to write s16.
+    #[test]
+    fn a_too_long_render_is_told_only_of_narrower_formats() {
+        let path = Path::new("long.wav");
+        let advice = |format| {
+            let samples = WavFile::max_samples(format) + 1;
+            let error = WavFile::check_length(path, samples, 48_000, format).unwrap_err();
+            let message = error.to_string();
+            let start = message.find("duration_s, ").unwrap() + "duration_s, ".len();
+            message[start..].to_owned()
+        };
+        assert_eq!(
+            advice(SampleFormat::F32),
+            "write s24 or s16 (--sample-format), or write a .csv instead"
+        );
+        assert_eq!(
+            advice(SampleFormat::S24),
+            "write s16 (--sample-format), or write a .csv instead"
+        );
+        assert_eq!(advice(SampleFormat::S16), "or write a .csv instead");
+    }
+
     /// Every format, written in blocks, against the same samples written by hound alone, one
     /// by one as the renderer used to: the same bytes.
     #[test]
@@ -321,7 +368,7 @@ mod tests {
                 for block in samples[..len].chunks(777) {
                     file.write(block).unwrap();
                 }
-                file.complete().unwrap().commit().unwrap();
+                PendingFile::commit_all(vec![file.complete().unwrap()]).unwrap();
                 let theirs = dir.path().join(format!("hound-{name}-{len}.wav"));
                 write_with_hound(&theirs, &samples[..len], format);
                 assert!(

@@ -10,7 +10,7 @@ use sake_glug::offline::clips::{
     envelope_at, envelope_breakpoints, is_audible, BandParseError, ClipSource, Glug, HapticBand,
 };
 use sake_glug::offline::sinks::{
-    ahap_json, draw_pour_plot, haptic_json, write_csv_samples, PlotData, PlotError,
+    ahap_json, draw_pour_plot, haptic_json, write_csv_samples, PlotData, PlotError, Waveform,
 };
 
 const GLUG_COUNT: usize = 50;
@@ -366,7 +366,7 @@ fn pour_plot_is_drawn() {
         .collect();
     let data = PlotData {
         sample_rate: SAMPLE_RATE,
-        samples: &samples,
+        waveform: &Waveform::of(&samples),
         envelope: &envelope,
         onsets_s: &onsets,
         volume_ml: &volume,
