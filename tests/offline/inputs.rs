@@ -350,3 +350,26 @@ fn control_characters_from_a_scene_are_escaped_in_its_errors() {
         .to_string();
     assert!(message.lines().count() > 2, "{message}");
 }
+
+#[test]
+fn the_summary_names_a_file_read_from_outside_the_scene_folder() {
+    let root = tempfile::tempdir().unwrap();
+    let scenes = root.path().join("scenes");
+    std::fs::create_dir(&scenes).unwrap();
+    std::fs::write(root.path().join("lane.csv"), "time_s,v\n0,90\n1,135\n").unwrap();
+    std::fs::write(scenes.join("inside.csv"), "time_s,v\n0,0.3\n").unwrap();
+    std::fs::write(
+        scenes.join("scene.toml"),
+        "duration_s = 0.5\ntilt_deg = { csv = \"../lane.csv\", column = \"v\" }\n\
+         viscosity_c = { csv = \"inside.csv\", column = \"v\" }\n",
+    )
+    .unwrap();
+    let output = crate::command::sake_glug(&scenes, &["render", "scene.toml", "-o", "x.wav"]);
+    assert!(output.status.success());
+    let stdout = String::from_utf8(output.stdout).unwrap();
+    assert!(
+        stdout.contains("read from outside the scene's folder: ") && stdout.contains("lane.csv"),
+        "{stdout}"
+    );
+    assert!(!stdout.contains("inside.csv"), "{stdout}");
+}

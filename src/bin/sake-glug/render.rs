@@ -16,6 +16,7 @@ use sake_glug::offline::{
     human_bytes, render_to_files, OutputError, OutputFormat, OutputOptions, RenderError,
     RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
 };
+use sake_glug::text::printable;
 
 #[derive(Args)]
 pub struct RenderArgs {
@@ -115,7 +116,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
         let signal_name =
             |signal| signal_hook::low_level::signal_name(signal).unwrap_or("a signal");
         match render_job(job, &args, &options, &stop, progress) {
-            Ok(report) => {
+            Ok((report, outside)) => {
                 for leftover in &report.leftovers {
                     out.error(&format!(
                         "warning: {} looks left by an interrupted render; remove it unless a \
@@ -123,7 +124,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
                         leftover.display()
                     ));
                 }
-                out.summary(&summary(job, &report));
+                out.summary(&summary(job, &report, &outside));
             }
             Err(JobError::Output(OutputError::Render(RenderError::Interrupted))) => {
                 let signal = stop.signal().map_or("a signal", signal_name);
@@ -331,7 +332,7 @@ fn render_job(
     options: &OutputOptions,
     stop: &Stop,
     progress: impl FnMut(f64),
-) -> Result<RenderReport, JobError> {
+) -> Result<(RenderReport, Vec<PathBuf>), JobError> {
     let mut scene = match (&job.scene, args.preset.as_deref().and_then(Preset::find)) {
         (Some(path), _) => Scene::load(path)?,
         (None, Some(preset)) => Scene::parse(&Scene::preset_toml(preset))?,
@@ -349,7 +350,13 @@ fn render_job(
         stop,
     };
     let report = render_to_files(&scene, &job.name, &job.outputs, options, observer)?;
-    Ok(report)
+    let outside = scene
+        .inputs
+        .iter()
+        .filter(|input| input.outside_folder)
+        .map(|input| input.path.clone())
+        .collect();
+    Ok((report, outside))
 }
 
 /// What a job's render reports to: the progress bar, and whether a signal came.
@@ -374,7 +381,9 @@ impl<P: FnMut(f64)> RenderObserver for JobObserver<'_, P> {
 }
 
 /// The line printed for a finished scene.
-fn summary(job: &Job, report: &RenderReport) -> String {
+/// The line a finished scene prints; files the scene read from outside its own folder are named
+/// at its end, so a scene from elsewhere cannot read one unseen.
+fn summary(job: &Job, report: &RenderReport, outside: &[PathBuf]) -> String {
     let summary = &report.summary;
     let files: Vec<String> = report
         .files
@@ -390,6 +399,20 @@ fn summary(job: &Job, report: &RenderReport) -> String {
         20.0 * (summary.peak.max(1e-12) as f64).log10(),
         summary.realtime_factor(),
         files.join(", ")
+    ) + &outside_note(outside)
+}
+
+fn outside_note(outside: &[PathBuf]) -> String {
+    if outside.is_empty() {
+        return String::new();
+    }
+    let paths: Vec<String> = outside
+        .iter()
+        .map(|path| printable(&path.display().to_string()).into_owned())
+        .collect();
+    format!(
+        "; read from outside the scene's folder: {}",
+        paths.join(", ")
     )
 }
 
