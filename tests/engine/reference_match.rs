@@ -92,6 +92,36 @@ fn other_capacities_and_viscosities_match_the_reference() {
 }
 
 #[test]
+fn a_bottle_of_its_own_matches_the_reference() {
+    // MODEL.md §12: curves, V0 and a spread of its own, tilts through every piece of each curve
+    // and back, and a refill, so that the reference's own reading of the curves is held against
+    // the engine's in every state.
+    for drain in ["simulate", "follow"] {
+        assert_matches_reference(
+            &format!(
+                r#"
+                seed = 11
+                tilt_deg = [[0.0, 80.0], [1.0, 120.0], [2.0, 172.0], [2.5, 100.0], [3.5, 140.0]]
+                fill_percent = [[0.0, 100.0], [2.6, 100.0], [2.6, 90.0], [4.0, 60.0]]
+                [bottle]
+                capacity_ml = 500.0
+                [amplitude]
+                silent_below_ml = 120.0
+                spread = 0.4
+                [curves]
+                rest = [[70.0, 1.0], [95.0, 0.5], [110.0, 0.1], [150.0, 0.0]]
+                submerged = [[70.0, 1.0], [100.0, 0.6], [140.0, 0.05]]
+                drain = [[50.0, 0.0], [100.0, 0.5], [135.0, 1.0], [170.0, 0.7]]
+                [output]
+                drain = "{drain}"
+                "#
+            ),
+            4.5,
+        );
+    }
+}
+
+#[test]
 fn a_short_flood_is_started_by_the_contracts_caps() {
     // 625 pockets are due per sample for 10 ms: 8 a sample are started (§11), and of those the
     // start budget admits a burst of 8 units and then 6000 per second, about 68 units, whose
