@@ -91,6 +91,25 @@ mod tests {
     }
 
     #[test]
+    fn the_default_keeps_the_arithmetic_of_every_render_before_v0_was_data() {
+        // Bit for bit, so that those renders stay byte-identical (MODEL.md §5).
+        let before = |volume_ml: f64, capacity_ml: f64| {
+            (0.0027 * (300.0 * volume_ml / capacity_ml) - 0.2277).max(0.0)
+                / (0.0027 * 300.0 - 0.2277)
+        };
+        for capacity_ml in [1.0, 180.0, 300.0, 720.0, 1234.5, 100_000.0] {
+            for step in 0..=10_000 {
+                let volume_ml = capacity_ml * step as f64 / 10_000.0;
+                assert_eq!(
+                    PAPERS.amplitude(volume_ml, capacity_ml).to_bits(),
+                    before(volume_ml, capacity_ml).to_bits(),
+                    "V {volume_ml} of {capacity_ml}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn the_papers_arithmetic_is_the_general_law_at_the_papers_v0() {
         // The same function, to a few units in the last place: the general form is the rule.
         for capacity_ml in [1.0, 180.0, 300.0, 720.0, 1234.5, 100_000.0] {

@@ -224,7 +224,8 @@ struct Unit {
     /// t_i in samples: n + x.
     onset: f64,
     first_sample: u64,
-    /// A1 = c·a(V_i), A2 = (1 − c)·a(V_i); the gain G is applied per sample, on its ramp.
+    /// A1 = c·Asum_i, A2 = (1 − c)·Asum_i, Asum_i = a(V_i)·exp(σ_A·z_i); the gain G is applied
+    /// per sample, on its ramp.
     amplitudes: [f64; 2],
     frequency_hz: [f64; 2],
     decay_per_s: [f64; 2],
