@@ -1,7 +1,11 @@
 //! The model's constants, each declared once in [`declare_constants!`]'s table below with its scene
-//! key, parameter id, range, default and knob, and the ranges of the settings that are no plain
-//! number (sample rate, seed, ceiling). The engine's sanitising, the scene validator, the
-//! plugin's parameters and the presets all read them here, so that all agree.
+//! key, parameter id, range, default and knob, the bottle's curves ([`Curve`]) by their scene
+//! keys, and the ranges of the settings that are no plain number (sample rate, seed, ceiling).
+//! The engine's sanitising, the scene validator, the plugin's parameters and the presets all read
+//! them here, so that all agree.
+
+use super::amplitude::{SilentBelow, PAPERS_SILENT_BELOW_ML};
+use super::pour::{BottleCurves, CurveError, TiltCurve, REFERENCE_TILT_DEG};
 
 /// An input's allowed closed range and its default (MODEL.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -128,9 +132,10 @@ pub struct Quantity {
     pub name: &'static str,
     /// The unit shown after the value (with its leading space, if any).
     pub unit: &'static str,
-    /// Its key in a scene file (`section.key` inside a table).
+    /// Its key in a scene file (`section.key` inside a table); empty if scenes have none.
     pub scene_key: &'static str,
-    /// The plugin parameter's stable id (saved states and automation depend on it).
+    /// The plugin parameter's stable id (saved states and automation depend on it); empty for a
+    /// constant that scenes set but the plugin has no parameter for.
     pub param_id: &'static str,
     /// What it is, in a few words (the README's table of parameters).
     pub note: &'static str,
@@ -163,14 +168,15 @@ pub struct ConstantSpec {
 
 macro_rules! declare_constants {
     ($( $(#[$doc:meta])* $variant:ident => $spec:expr; )*) => {
-        /// A constant of the model that a scene, a preset or the plugin sets (MODEL.md §2–§7).
+        /// A constant of the model that a scene, a preset or the plugin sets (MODEL.md §2–§7, §12).
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
         pub enum Constant {
             $( $(#[$doc])* $variant, )*
         }
 
         impl Constant {
-            /// Every constant, in table order (the order of the plugin's Model group).
+            /// Every constant, in table order (the order of the plugin's Model group, for those
+            /// it has a parameter for).
             pub const ALL: &'static [Constant] = &[$( Constant::$variant ),*];
 
             /// Everything declared about this constant.
@@ -181,6 +187,9 @@ macro_rules! declare_constants {
         }
     };
 }
+
+/// Bottle capacity C (ml): its range bounds V0's too.
+const CAPACITY_ML: Range = Range::new(1.0, 100_000.0, 300.0);
 
 declare_constants! {
     /// Frequency f1 of the first component, the air pocket bouncing in the neck (Hz).
@@ -263,7 +272,7 @@ declare_constants! {
             scene_key: "bottle.capacity_ml",
             param_id: "cap",
             note: "bottle capacity C",
-            range: Range::new(1.0, 100_000.0, 300.0),
+            range: CAPACITY_ML,
             knob: Knob::full(0).within(10.0, 5_000.0).skewed(-1.5),
         },
         get: |config| config.capacity_ml,
@@ -312,6 +321,39 @@ declare_constants! {
         get: |config| config.decay_sigma,
         set: |config, value| config.decay_sigma = value,
     };
+    /// V0 (ml): the residual volume from which down a unit is silent (MODEL.md §12). Its
+    /// default is the paper's, scaled with the capacity ([`SilentBelow::PapersFit`]; the range's
+    /// default is its value at the default capacity), and it stays below C: both depend on the
+    /// capacity, which is why it comes after it in this table.
+    SilentBelow => ConstantSpec {
+        quantity: Quantity {
+            name: "Silent below",
+            unit: " ml",
+            scene_key: "amplitude.silent_below_ml",
+            param_id: "",
+            note: "V0 of MODEL.md §12, below C: a(V) reaches 0 there; by default the paper's, \
+                   scaled with C",
+            range: Range::new(0.0, CAPACITY_ML.max, PAPERS_SILENT_BELOW_ML),
+            knob: Knob::full(2),
+        },
+        get: |config| config.silent_below.ml(config.capacity_ml),
+        set: |config, value| config.silent_below = SilentBelow::Ml(value),
+    };
+    /// Log-normal spread σ_A of each unit's summed amplitude (dimensionless, MODEL.md §12):
+    /// Asum·exp(σ_A·z), z standard normal.
+    AmplitudeSpread => ConstantSpec {
+        quantity: Quantity {
+            name: "Amplitude spread",
+            unit: "",
+            scene_key: "amplitude.spread",
+            param_id: "",
+            note: "σ_A of MODEL.md §12: log-normal spread of each unit's Asum",
+            range: Range::new(0.0, 3.0, 0.0),
+            knob: Knob::full(3),
+        },
+        get: |config| config.amplitude_spread,
+        set: |config, value| config.amplitude_spread = value,
+    };
 }
 
 impl Constant {
@@ -333,6 +375,91 @@ impl Constant {
     /// Sets it to `value` in `config`.
     pub fn set(self, config: &mut ModelConfig, value: f64) {
         (self.spec().set)(config, value)
+    }
+
+    /// Whether the plugin has a parameter for it; the others are set by scenes only.
+    pub fn is_parameter(self) -> bool {
+        !self.quantity().param_id.is_empty()
+    }
+
+    /// The constants the plugin has a parameter for, in table order.
+    pub fn parameters() -> impl Iterator<Item = Constant> {
+        Self::ALL
+            .iter()
+            .copied()
+            .filter(|constant| constant.is_parameter())
+    }
+
+    /// Sets its default in `config`: its range's, but V0's follows the capacity.
+    fn set_default(self, config: &mut ModelConfig) {
+        match self {
+            Constant::SilentBelow => config.silent_below = SilentBelow::PapersFit,
+            _ => self.set(config, self.range().default),
+        }
+    }
+
+    /// Brings its value in `config` into range (MODEL.md §11); V0's range ends below the
+    /// capacity, which must be in range already.
+    fn sanitize(self, config: &mut ModelConfig) {
+        match self {
+            Constant::SilentBelow => {
+                config.silent_below = config.silent_below.sanitized(config.capacity_ml)
+            }
+            _ => self.set(config, self.range().sanitize(self.get(config))),
+        }
+    }
+}
+
+/// One of the bottle's curves of tilt (MODEL.md §2, §3), which a scene may give as points (§12).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Curve {
+    /// r(θ) of §2.
+    Rest,
+    /// s(θ) of §2.
+    Submerged,
+    /// h(θ) of §3.
+    Drain,
+}
+
+impl Curve {
+    /// Every curve, in the order a scene's `[curves]` table lists them.
+    pub const ALL: [Curve; 3] = [Curve::Rest, Curve::Submerged, Curve::Drain];
+
+    /// Its key in a scene file.
+    pub const fn scene_key(self) -> &'static str {
+        match self {
+            Curve::Rest => "curves.rest",
+            Curve::Submerged => "curves.submerged",
+            Curve::Drain => "curves.drain",
+        }
+    }
+
+    /// The curve through `points` (tilt in degrees, value), checked as MODEL.md §12 asks; h
+    /// must be 1 at 135°, where a full bottle empties in the pour time.
+    pub fn from_points(self, points: &[(f64, f64)]) -> Result<TiltCurve, CurveError> {
+        let curve = TiltCurve::new(points)?;
+        match self {
+            Curve::Drain => curve.through(REFERENCE_TILT_DEG, 1.0),
+            Curve::Rest | Curve::Submerged => Ok(curve),
+        }
+    }
+
+    /// This curve of `curves`.
+    pub fn of(self, curves: &BottleCurves) -> &TiltCurve {
+        match self {
+            Curve::Rest => &curves.rest,
+            Curve::Submerged => &curves.submerged,
+            Curve::Drain => &curves.drain,
+        }
+    }
+
+    /// This curve of `curves`, to replace.
+    pub fn of_mut(self, curves: &mut BottleCurves) -> &mut TiltCurve {
+        match self {
+            Curve::Rest => &mut curves.rest,
+            Curve::Submerged => &mut curves.submerged,
+            Curve::Drain => &mut curves.drain,
+        }
     }
 }
 
@@ -365,6 +492,12 @@ pub struct ModelConfig {
     pub freq_jitter: f64,
     /// Log-normal spread σ of each unit's B1, B2 (§7).
     pub decay_sigma: f64,
+    /// V0 of the amplitude law (§12).
+    pub silent_below: SilentBelow,
+    /// Log-normal spread σ_A of each unit's summed amplitude (§12).
+    pub amplitude_spread: f64,
+    /// r(θ), s(θ) and h(θ) (§2, §3, §12): inline, so that the constants stay `Copy`.
+    pub curves: BottleCurves,
     /// Seed of the random generator of §7, applied again at every reset.
     pub seed: u64,
     /// How the residual volume evolves: simulate or follow (§8).
@@ -383,12 +516,15 @@ impl Default for ModelConfig {
             timing_jitter: 0.0,
             freq_jitter: 0.0,
             decay_sigma: 0.0,
+            silent_below: SilentBelow::PapersFit,
+            amplitude_spread: 0.0,
+            curves: BottleCurves::default(),
             seed: SEED.range.default as u64,
             drain: DrainMode::Simulate,
             ceiling: CEILING.default,
         };
         for &constant in Constant::ALL {
-            constant.set(&mut config, constant.range().default);
+            constant.set_default(&mut config);
         }
         config
     }
@@ -401,15 +537,16 @@ impl ModelConfig {
             timing_jitter: 0.0,
             freq_jitter: 0.0,
             decay_sigma: 0.0,
+            amplitude_spread: 0.0,
             ..self
         }
     }
 
-    /// Every field brought into its range, so that no input can make the engine misbehave.
+    /// Every field brought into its range, so that no input can make the engine misbehave (the
+    /// curves are in range as made: [`TiltCurve`] checks them).
     pub fn sanitized(mut self) -> Self {
         for &constant in Constant::ALL {
-            let value = constant.range().sanitize(constant.get(&self));
-            constant.set(&mut self, value);
+            constant.sanitize(&mut self);
         }
         self.ceiling = CEILING.sanitize(self.ceiling);
         self
@@ -432,11 +569,72 @@ mod tests {
 
     #[test]
     fn deterministic_zeroes_every_spread_only() {
-        let config = ModelConfig::default().deterministic();
+        let spread = ModelConfig {
+            amplitude_spread: 0.4,
+            ..ModelConfig::default()
+        };
+        let config = spread.deterministic();
         assert_eq!(
-            (config.timing_jitter, config.freq_jitter, config.decay_sigma),
-            (0.0, 0.0, 0.0)
+            (
+                config.timing_jitter,
+                config.freq_jitter,
+                config.decay_sigma,
+                config.amplitude_spread
+            ),
+            (0.0, 0.0, 0.0, 0.0)
         );
         assert_eq!(config.pocket_ml, 5.0);
+    }
+
+    #[test]
+    fn v0_defaults_to_the_papers_and_follows_the_capacity() {
+        let config = ModelConfig::default();
+        assert_eq!(config.silent_below, SilentBelow::PapersFit);
+        assert_eq!(
+            Constant::SilentBelow.get(&config),
+            Constant::SilentBelow.range().default
+        );
+        let mut large = config;
+        Constant::Capacity.set(&mut large, 600.0);
+        assert_eq!(
+            Constant::SilentBelow.get(&large),
+            2.0 * PAPERS_SILENT_BELOW_ML
+        );
+        // Brought into range against the capacity, itself brought in first.
+        Constant::SilentBelow.set(&mut large, 1e9);
+        Constant::Capacity.set(&mut large, 1e9);
+        let sanitized = large.sanitized();
+        assert_eq!(sanitized.capacity_ml, CAPACITY_ML.max);
+        assert!(sanitized.silent_below.fits(CAPACITY_ML.max));
+        assert_eq!(config.sanitized(), config);
+    }
+
+    #[test]
+    fn the_scene_only_constants_have_no_parameter() {
+        let scene_only: Vec<_> = Constant::ALL
+            .iter()
+            .filter(|constant| !constant.is_parameter())
+            .collect();
+        assert_eq!(
+            scene_only,
+            [&Constant::SilentBelow, &Constant::AmplitudeSpread]
+        );
+        assert_eq!(Constant::parameters().count(), Constant::ALL.len() - 2);
+    }
+
+    #[test]
+    fn only_h_is_held_to_1_at_135_degrees() {
+        let points = [(90.0, 0.5), (180.0, 0.9)];
+        assert!(Curve::Rest.from_points(&points).is_ok());
+        assert!(Curve::Submerged.from_points(&points).is_ok());
+        assert!(matches!(
+            Curve::Drain.from_points(&points),
+            Err(CurveError::Anchor { .. })
+        ));
+        let default = BottleCurves::default();
+        for curve in Curve::ALL {
+            let points = curve.of(&default).points();
+            assert_eq!(curve.from_points(points).as_ref(), Ok(curve.of(&default)));
+        }
     }
 }

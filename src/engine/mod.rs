@@ -13,8 +13,8 @@ pub mod pour;
 mod presets;
 pub mod synthesis;
 
-pub use amplitude::unit_amplitude;
-pub use config::{Constant, ConstantSpec, DrainMode, Knob, ModelConfig, Quantity, Range};
+pub use amplitude::{SilentBelow, PAPERS_SILENT_BELOW_ML};
+pub use config::{Constant, ConstantSpec, Curve, DrainMode, Knob, ModelConfig, Quantity, Range};
 pub use controls::{
     Control, ControlSource, ControlSpec, ControlValues, Controls, DeviceInput, Lane, PerControl,
 };

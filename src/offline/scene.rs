@@ -11,9 +11,10 @@ use crate::device::csv_lane::{read_csv_lane, CsvLaneError, CsvLaneSpec, MAX_CSV_
 use crate::device::midi::{MidiMap, MidiSetting};
 use crate::device::midi_take::{read_midi_take, TakeError, TimedInput, MAX_TAKE_BYTES};
 use crate::engine::config::{self, Range};
+use crate::engine::pour::CurveError;
 use crate::engine::{
-    Constant, Control, ControlSource, ControlValues, Controls, DrainMode, ModelConfig, PerControl,
-    Preset, PresetValue, Quantity,
+    Constant, Control, ControlSource, ControlValues, Controls, Curve, DrainMode, ModelConfig,
+    PerControl, Preset, PresetValue, Quantity,
 };
 use crate::text::printable;
 
@@ -71,6 +72,26 @@ pub enum SceneError {
         min: f64,
         /// Highest allowed value.
         max: f64,
+    },
+    /// A value that must lie below another one (V0 below the capacity).
+    #[error("`{key}` = {value} is out of range: it must lie below `{limit_key}` ({limit})")]
+    NotBelow {
+        /// The scene key.
+        key: &'static str,
+        /// The value given.
+        value: f64,
+        /// The key of the value it must lie below.
+        limit_key: &'static str,
+        /// That value.
+        limit: f64,
+    },
+    /// A list of points that is no curve of the bottle (MODEL.md §12).
+    #[error("`{key}`: {source}")]
+    Curve {
+        /// The scene key.
+        key: &'static str,
+        /// What was wrong.
+        source: CurveError,
     },
     /// A CSV lane could not be read: the error names the file, line and column.
     #[error("`{key}`: {source}")]
@@ -544,11 +565,25 @@ impl SceneFile {
             let Quantity {
                 scene_key, range, ..
             } = *constant.quantity();
-            let value = self.take::<f64>(scene_key)?;
-            constant.set(
-                &mut config,
-                check(scene_key, value.unwrap_or(range.default), range)?,
-            );
+            if let Some(value) = self.take::<f64>(scene_key)? {
+                constant.set(&mut config, check(scene_key, value, range)?);
+            }
+        }
+        if !config.silent_below.fits(config.capacity_ml) {
+            return Err(SceneError::NotBelow {
+                key: Constant::SilentBelow.quantity().scene_key,
+                value: Constant::SilentBelow.get(&config),
+                limit_key: Constant::Capacity.quantity().scene_key,
+                limit: config.capacity_ml,
+            });
+        }
+        for curve in Curve::ALL {
+            let key = curve.scene_key();
+            if let Some(points) = self.take::<Vec<toml::Value>>(key)? {
+                *curve.of_mut(&mut config.curves) = curve
+                    .from_points(&curve_points(key, &points)?)
+                    .map_err(|source| SceneError::Curve { key, source })?;
+            }
         }
         config.drain = self.take::<DrainMode>(DRAIN)?.unwrap_or_default();
         if self.take::<bool>(DETERMINISTIC)?.unwrap_or(false) {
@@ -694,6 +729,28 @@ fn kind(file_type: FileType) -> &'static str {
 /// A path for a message.
 fn shown(path: &Path) -> String {
     printable(&path.to_string_lossy()).into_owned()
+}
+
+/// A curve's points as a scene writes them: `[tilt_deg, value]` pairs of numbers, integer or
+/// float.
+fn curve_points(key: &str, points: &[toml::Value]) -> Result<Vec<(f64, f64)>, SceneError> {
+    let number = |value: &toml::Value| {
+        (value.as_float()).or_else(|| value.as_integer().map(|integer| integer as f64))
+    };
+    let pair = |point: &toml::Value| match point.as_array()?.as_slice() {
+        [tilt_deg, value] => Some((number(tilt_deg)?, number(value)?)),
+        _ => None,
+    };
+    points
+        .iter()
+        .map(|point| {
+            pair(point).ok_or_else(|| {
+                syntax(&format!(
+                    "`{key}`: each point must be a [tilt_deg, value] pair of numbers"
+                ))
+            })
+        })
+        .collect()
 }
 
 /// A [`SceneError::Syntax`] whose message may quote the scene.

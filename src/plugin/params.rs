@@ -156,7 +156,8 @@ pub fn migrate_state(state: &mut PluginState) {
 
 /// The Model group of parameters (MODEL.md §5, §7, §8).
 pub struct ModelParams {
-    /// One parameter per model constant, in the order of [`Constant::ALL`].
+    /// One parameter per model constant the plugin has one for, in the order of
+    /// [`Constant::parameters`] (the others are set by scenes only).
     pub constants: Vec<FloatParam>,
     /// Seed of the random generator, see [`config::SEED`].
     pub seed: IntParam,
@@ -167,9 +168,12 @@ pub struct ModelParams {
 }
 
 impl ModelParams {
-    /// The parameter of `constant`.
+    /// The parameter of `constant`, which must be one the plugin has.
     pub fn constant(&self, constant: Constant) -> &FloatParam {
-        &self.constants[constant as usize]
+        let index = Constant::parameters()
+            .position(|parameter| parameter == constant)
+            .expect("only a constant with a parameter id has a parameter");
+        &self.constants[index]
     }
 }
 
@@ -191,8 +195,7 @@ impl Default for GlugParams {
 impl Default for ModelParams {
     fn default() -> Self {
         Self {
-            constants: Constant::ALL
-                .iter()
+            constants: Constant::parameters()
                 .map(|constant| float_param(constant.quantity()))
                 .collect(),
             seed: IntParam::new(
@@ -274,11 +277,11 @@ unsafe impl Params for GlugParams {
 // SAFETY: every pointer in `param_map` points into `self`, whose parameters never move.
 unsafe impl Params for ModelParams {
     fn param_map(&self) -> Vec<(String, ParamPtr, String)> {
-        let mut map: Vec<(String, ParamPtr, String)> = Constant::ALL
-            .iter()
-            .map(|&constant| {
+        let mut map: Vec<(String, ParamPtr, String)> = Constant::parameters()
+            .zip(&self.constants)
+            .map(|(constant, param)| {
                 let id = constant.quantity().param_id.to_owned();
-                (id, self.constant(constant).as_ptr(), String::new())
+                (id, param.as_ptr(), String::new())
             })
             .collect();
         map.push((
@@ -318,8 +321,8 @@ impl GlugParams {
             ceiling: 10f64.powf(exact(&CEILING_DB.knob, model.ceiling.value()) / 20.0),
             ..ModelConfig::default()
         };
-        for &constant in Constant::ALL {
-            let value = exact(&constant.quantity().knob, model.constant(constant).value());
+        for (constant, param) in Constant::parameters().zip(&model.constants) {
+            let value = exact(&constant.quantity().knob, param.value());
             constant.set(&mut config, value);
         }
         config

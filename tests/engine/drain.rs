@@ -1,8 +1,14 @@
-//! MODEL.md §2–3: the bottle drains at C/T·h(θ), stops at r(θ)·C, and glugs only above s(θ)·C.
+//! MODEL.md §2–3: the bottle drains at C/T·h(θ), stops at r(θ)·C, and glugs only above s(θ)·C;
+//! §12: with curves of its own, the same by those.
 
 use crate::support::{pour_onsets, tilt_only};
-use sake_glug::engine::pour::{REST, SUBMERGED};
-use sake_glug::engine::{ControlValues, ModelConfig, Pour};
+use sake_glug::engine::pour::BottleCurves;
+use sake_glug::engine::{ControlValues, Curve, ModelConfig, Pour};
+
+/// `curve`'s default value at `tilt_deg`.
+fn default_at(curve: Curve, tilt_deg: f64) -> f64 {
+    curve.of(&BottleCurves::default()).at(tilt_deg)
+}
 
 const FS: f64 = 48_000.0;
 
@@ -50,7 +56,7 @@ fn outflow_rate_follows_the_tilt_response() {
 #[test]
 fn nothing_pours_while_the_volume_is_at_or_below_the_rest_level() {
     for tilt in [60.0, 74.5, 79.0, 84.0, 90.0, 96.0, 100.0] {
-        let rest_percent = REST.at(tilt) * 100.0;
+        let rest_percent = default_at(Curve::Rest, tilt) * 100.0;
         let at_rest = ControlValues {
             fill_percent: rest_percent,
             ..tilt_only(tilt)
@@ -78,7 +84,7 @@ fn draining_stops_exactly_at_the_rest_level() {
             pour.step(sample, tilt_only(tilt), |_| {});
         }
         assert!(
-            (pour.volume_ml() - REST.at(tilt) * 300.0).abs() < 1e-9,
+            (pour.volume_ml() - default_at(Curve::Rest, tilt) * 300.0).abs() < 1e-9,
             "tilt {tilt}"
         );
     }
@@ -89,7 +95,7 @@ fn nothing_glugs_while_the_volume_is_at_or_below_the_submerged_level() {
     let config = ModelConfig::default().deterministic();
     // At 100° the bottle pours from 300 ml down to 25 ml but glugs only above 110.1 ml.
     let (onsets, glugging) = pour_onsets(FS, config, |_| tilt_only(100.0), 20.0);
-    let submerged_ml = SUBMERGED.at(100.0) * 300.0;
+    let submerged_ml = default_at(Curve::Submerged, 100.0) * 300.0;
     let max_outflow_per_sample = 300.0 / 5.0 * 0.833 / FS;
     assert!(!onsets.is_empty());
     for onset in &onsets {
@@ -103,4 +109,60 @@ fn nothing_glugs_while_the_volume_is_at_or_below_the_submerged_level() {
         pour.step(sample, tilt_only(100.0), |_| {});
     }
     assert!(pour.volume_ml() < submerged_ml - 80.0);
+}
+
+/// The first sample's outflow at `tilt_deg` from a full bottle (ml).
+fn first_outflow_ml(config: ModelConfig, tilt_deg: f64) -> f64 {
+    let mut pour = Pour::new(FS, config);
+    pour.reset();
+    pour.step(0, tilt_only(tilt_deg), |_| {}).amount_ml
+}
+
+#[test]
+fn a_drain_curve_of_its_own_sets_the_rate_where_it_differs() {
+    // The default h is 1 at 135° and at 155°; this one falls to 0.8 at 155°.
+    let mut config = ModelConfig::default();
+    config.curves.drain = Curve::Drain
+        .from_points(&[(60.0, 0.1), (135.0, 1.0), (155.0, 0.8), (180.0, 0.6)])
+        .unwrap();
+    let rate = |config, tilt| first_outflow_ml(config, tilt) * FS;
+    let default = ModelConfig::default();
+    assert!((rate(default, 155.0) - 60.0).abs() < 1e-9);
+    assert!((rate(config, 155.0) - 0.8 * 60.0).abs() < 1e-9);
+    assert!((rate(config, 145.0) - 0.9 * 60.0).abs() < 1e-9);
+    // Where both curves are 1 the rate is the same: the pour time still holds at 135°.
+    assert_eq!(rate(config, 135.0), rate(default, 135.0));
+}
+
+#[test]
+fn rest_and_submerged_curves_of_their_own_set_where_it_stops_and_stops_glugging() {
+    let mut config = ModelConfig::default().deterministic();
+    config.curves.rest = Curve::Rest
+        .from_points(&[(90.0, 1.0), (150.0, 0.2)])
+        .unwrap();
+    config.curves.submerged = Curve::Submerged
+        .from_points(&[(90.0, 1.0), (150.0, 0.5)])
+        .unwrap();
+    // At 150° the pour stops at 60 ml, and glugs only above 150 ml (to within the sample that
+    // crosses it).
+    let per_sample_ml = 60.0 / FS;
+    let (onsets, glugging) = pour_onsets(FS, config, |_| tilt_only(150.0), 8.0);
+    assert!(
+        (glugging - 150.0).abs() < per_sample_ml,
+        "{glugging} ml glugged"
+    );
+    assert!(onsets.len() >= 29, "{} units", onsets.len());
+    assert!(onsets
+        .iter()
+        .all(|onset| onset.volume_ml > 150.0 - per_sample_ml));
+    let mut pour = Pour::new(FS, config);
+    pour.reset();
+    for sample in 0..(8.0 * FS) as u64 {
+        pour.step(sample, tilt_only(150.0), |_| {});
+    }
+    assert!(
+        (pour.volume_ml() - 60.0).abs() < 1e-9,
+        "{} ml",
+        pour.volume_ml()
+    );
 }

@@ -1,9 +1,10 @@
 //! The engine against the model of MODEL.md: the drain and onsets (§2–4), the units (§5), the
-//! f64 reference (§9) and the work it skips.
+//! f64 reference (§9), the bottle as data (§12) and the work it skips.
 
 #[path = "../support/mod.rs"]
 mod support;
 
+mod amplitude;
 mod drain;
 mod onsets;
 mod output_ramps;

@@ -92,6 +92,42 @@ fn other_capacities_and_viscosities_match_the_reference() {
 }
 
 #[test]
+fn a_bottle_of_its_own_matches_the_reference() {
+    // MODEL.md §12: curves, V0 and a spread of its own. The tilt ramps slowly (each sample's
+    // levels then come from the engine's span path) and holds (its per-sample path); the bottle
+    // drains past the submerged level of its own curves, and at high tilts, where its rest
+    // level lies above its submerged level, glugs down to the rest level: in simulate mode with
+    // a refill and in follow mode with the fill level falling, so that the reference's own
+    // reading of each curve is held against the engine's where it decides an audible unit.
+    for (drain, fill) in [
+        ("simulate", "[[0.0, 100.0], [7.0, 100.0], [7.0, 80.0]]"),
+        ("follow", "[[0.0, 100.0], [8.0, 5.0]]"),
+    ] {
+        assert_matches_reference(
+            &format!(
+                r#"
+                seed = 11
+                tilt_deg = [[0.0, 80.0], [6.0, 130.0], [6.5, 130.0], [8.0, 172.0]]
+                fill_percent = {fill}
+                [bottle]
+                capacity_ml = 500.0
+                [amplitude]
+                silent_below_ml = 40.0
+                spread = 0.4
+                [curves]
+                rest = [[70.0, 1.0], [95.0, 0.5], [120.0, 0.3], [180.0, 0.2]]
+                submerged = [[70.0, 1.0], [100.0, 0.8], [140.0, 0.1], [180.0, 0.05]]
+                drain = [[50.0, 0.0], [100.0, 0.5], [135.0, 1.0], [170.0, 0.7]]
+                [output]
+                drain = "{drain}"
+                "#
+            ),
+            8.0,
+        );
+    }
+}
+
+#[test]
 fn a_short_flood_is_started_by_the_contracts_caps() {
     // 625 pockets are due per sample for 10 ms: 8 a sample are started (§11), and of those the
     // start budget admits a burst of 8 units and then 6000 per second, about 68 units, whose

@@ -32,6 +32,7 @@ fn unit(viscosity: f64, decay_per_s: [f64; 2]) -> UnitOnset {
         shape: UnitShape {
             frequency_hz: [80.0, 300.0],
             decay_per_s,
+            amplitude_factor: 1.0,
         },
     }
 }

@@ -3,7 +3,8 @@
 
 use std::path::Path;
 
-use sake_glug::engine::{DrainMode, ModelConfig};
+use sake_glug::engine::pour::{BottleCurves, TiltCurve};
+use sake_glug::engine::{DrainMode, ModelConfig, SilentBelow};
 use sake_glug::offline::{Automation, Scene, SceneError};
 
 fn fixtures(kind: &str) -> Vec<(String, String)> {
@@ -87,6 +88,13 @@ fn the_full_fixture_reads_every_key_with_its_own_value() {
             timing_jitter: 0.0,
             freq_jitter: 0.0,
             decay_sigma: 0.0,
+            silent_below: SilentBelow::Ml(150.0),
+            amplitude_spread: 0.0,
+            curves: BottleCurves {
+                rest: TiltCurve::new(&[(60.0, 1.0), (90.0, 0.4), (120.0, 0.0)]).unwrap(),
+                submerged: TiltCurve::new(&[(70.0, 0.9), (130.0, 0.0)]).unwrap(),
+                drain: TiltCurve::new(&[(45.0, 0.0), (135.0, 1.0), (180.0, 0.5)]).unwrap(),
+            },
             seed: 42,
             drain: DrainMode::Follow,
             ceiling: default.ceiling,
@@ -103,10 +111,12 @@ fn the_full_fixture_reads_every_key_with_its_own_value() {
         ),
         (0.21, 0.07, 0.5)
     );
+    assert_eq!(scene.config.amplitude_spread, 0.25);
     // Every value differs from its default, so a key that is not read shows.
     assert_ne!(scene.config.timing_jitter, default.timing_jitter);
     assert_ne!(scene.config.freq_jitter, default.freq_jitter);
     assert_ne!(scene.config.decay_sigma, default.decay_sigma);
+    assert_ne!(scene.config.amplitude_spread, default.amplitude_spread);
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! `sake-glug parameters`: every control and model constant as the engine's tables declare it
 //! (plugin parameter id, scene key, name, range, default), as the Markdown table the README
-//! shows. `cargo xtask docs` writes it there; a test checks the README holds it.
+//! shows; a constant the plugin has no parameter for shows as set by scenes only. `cargo xtask
+//! docs` writes it there; a test checks the README holds it.
 
 use std::process::ExitCode;
 
@@ -41,26 +42,44 @@ fn table() -> String {
 }
 
 fn number_row(quantity: &Quantity) -> String {
-    let (min, max) = quantity.knob_bounds();
     let unit = quantity.unit;
-    let mut range = format!("{min}–{max}{unit}");
-    if quantity.knob.skew.is_some() {
-        range.push_str(" (skewed)");
-    }
     let engine = quantity.range;
-    if (min, max) != (engine.min, engine.max) && !quantity.scene_key.is_empty() {
-        range.push_str(&format!("; scenes {}–{}", engine.min, engine.max));
-    }
-    row(quantity, &range, &format!("{}{unit}", engine.default))
+    let range = if quantity.param_id.is_empty() {
+        format!("scenes only: {}–{}{unit}", engine.min, engine.max)
+    } else {
+        let (min, max) = quantity.knob_bounds();
+        let mut range = format!("{min}–{max}{unit}");
+        if quantity.knob.skew.is_some() {
+            range.push_str(" (skewed)");
+        }
+        if (min, max) != (engine.min, engine.max) && !quantity.scene_key.is_empty() {
+            range.push_str(&format!("; scenes {}–{}", engine.min, engine.max));
+        }
+        range
+    };
+    row(
+        quantity,
+        &range,
+        &format!("{}{unit}", shown(engine.default)),
+    )
+}
+
+/// A default as the table shows it: to four decimals at most (V0's is 84.333…).
+fn shown(value: f64) -> String {
+    let text = format!("{value:.4}");
+    text.trim_end_matches('0').trim_end_matches('.').to_owned()
 }
 
 fn row(quantity: &Quantity, range: &str, default: &str) -> String {
-    let scene_key = match quantity.scene_key {
+    let code_or_dash = |text: &str| match text {
         "" => "—".to_owned(),
-        key => format!("`{key}`"),
+        text => format!("`{text}`"),
     };
     format!(
-        "| `{}` | {scene_key} | {} | {range} | {default} | {} |",
-        quantity.param_id, quantity.name, quantity.note
+        "| {} | {} | {} | {range} | {default} | {} |",
+        code_or_dash(quantity.param_id),
+        code_or_dash(quantity.scene_key),
+        quantity.name,
+        quantity.note
     )
 }

@@ -1,6 +1,6 @@
 //! The bottle's residual volume and its tilt-dependent drain (MODEL.md §2, §3, §8).
 
-use super::curves::{CurveSegment, FLOW, REST, SUBMERGED};
+use super::curves::CurveSegment;
 use crate::engine::config::{DrainMode, ModelConfig};
 use crate::engine::controls::ControlValues;
 
@@ -115,7 +115,8 @@ pub struct Bottle {
     refill_pending: bool,
     last_fill_percent: f64,
     levels: Levels,
-    /// The tilt, pour time and capacity that `levels` are of.
+    /// The tilt, pour time and capacity that `levels` are of (under the curves of the constants
+    /// last set: see [`Bottle::forget_levels`]).
     levels_key: [f64; 3],
     /// The segments of r, s and h that the last tilt fell in: a tilt that moves a little from
     /// sample to sample rarely leaves them.
@@ -146,6 +147,13 @@ impl Bottle {
     /// Sets V after steps taken elsewhere in closed form (see `super::span`).
     pub fn set_volume_ml(&mut self, volume_ml: f64) {
         self.volume_ml = volume_ml;
+    }
+
+    /// Works the levels out again at the next step: the constants changed, the curves perhaps.
+    /// The curves' segments start over too, as they may have fewer pieces now.
+    pub fn forget_levels(&mut self) {
+        self.levels_key = [f64::NAN; 3];
+        self.segments = [CurveSegment::default(); 3];
     }
 
     /// The levels of the last step.
@@ -188,7 +196,7 @@ impl Bottle {
     /// Advances one sample; `controls` must be sanitised.
     #[inline]
     pub fn step(&mut self, controls: &ControlValues, config: &ModelConfig) -> Outflow {
-        let levels = self.levels(controls, config.capacity_ml);
+        let levels = self.levels(controls, config);
         self.step_with(controls.fill_percent, &levels, config)
     }
 
@@ -219,14 +227,15 @@ impl Bottle {
         &mut self,
         tilts: &[f64],
         pour_times: &[f64],
-        capacity_ml: f64,
+        config: &ModelConfig,
         levels: &mut SpanLevels,
     ) {
         let len = tilts.len();
+        let (capacity_ml, curves) = (config.capacity_ml, &config.curves);
         let [rest, submerged, flow] = &mut self.segments;
-        REST.fill(tilts, &mut levels.rest_ml[..len], rest);
-        SUBMERGED.fill(tilts, &mut levels.submerged_ml[..len], submerged);
-        FLOW.fill(tilts, &mut levels.max_outflow_ml[..len], flow);
+        curves.rest.fill(tilts, &mut levels.rest_ml[..len], rest);
+        (curves.submerged).fill(tilts, &mut levels.submerged_ml[..len], submerged);
+        (curves.drain).fill(tilts, &mut levels.max_outflow_ml[..len], flow);
         let sample_rate = self.sample_rate;
         for (rest, submerged) in levels.rest_ml[..len]
             .iter_mut()
@@ -264,15 +273,16 @@ impl Bottle {
     }
 
     #[inline]
-    fn levels(&mut self, controls: &ControlValues, capacity_ml: f64) -> Levels {
+    fn levels(&mut self, controls: &ControlValues, config: &ModelConfig) -> Levels {
+        let (capacity_ml, curves) = (config.capacity_ml, &config.curves);
         let key = [controls.tilt_deg, controls.pour_time_s, capacity_ml];
         if key != self.levels_key {
             let tilt = controls.tilt_deg;
             let [rest, submerged, flow] = &mut self.segments;
-            let rate_ml_per_s = capacity_ml / controls.pour_time_s * FLOW.at_in(tilt, flow);
+            let rate_ml_per_s = capacity_ml / controls.pour_time_s * curves.drain.at_in(tilt, flow);
             self.levels = Levels {
-                rest_ml: REST.at_in(tilt, rest) * capacity_ml,
-                submerged_ml: SUBMERGED.at_in(tilt, submerged) * capacity_ml,
+                rest_ml: curves.rest.at_in(tilt, rest) * capacity_ml,
+                submerged_ml: curves.submerged.at_in(tilt, submerged) * capacity_ml,
                 max_outflow_per_sample_ml: rate_ml_per_s / self.sample_rate,
             };
             self.levels_key = key;

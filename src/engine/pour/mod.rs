@@ -9,11 +9,12 @@ mod randomness;
 mod span;
 
 pub use bottle::Outflow;
-pub use curves::{CurveSegment, TiltCurve, FLOW, REST, SUBMERGED};
+pub use curves::{
+    BottleCurves, CurveError, CurveSegment, TiltCurve, MAX_CURVE_POINTS, REFERENCE_TILT_DEG,
+};
 pub use onsets::MAX_ONSETS_PER_SAMPLE;
 pub use randomness::UnitShape;
 
-use crate::engine::amplitude::unit_amplitude;
 use crate::engine::config::{ModelConfig, Range};
 use crate::engine::controls::{Control, ControlValues, Controls, Lane, PerControl};
 use bottle::{fill_ml, Bottle, SpanLevels, SPAN};
@@ -70,11 +71,11 @@ pub struct UnitOnset {
     pub fraction: f64,
     /// V_i.
     pub volume_ml: f64,
-    /// a(V_i), before the output gain.
+    /// Asum_i = a(V_i)·exp(σ_A·z_i) (§5, §12), before the output gain.
     pub amplitude: f64,
     /// c_i, clamped to [0, 1].
     pub viscosity: f64,
-    /// f1_i, f2_i, B1_i, B2_i as drawn for this unit (§7).
+    /// f1_i, f2_i, B1_i, B2_i and the amplitude's factor as drawn for this unit (§7, §12).
     pub shape: UnitShape,
 }
 
@@ -167,6 +168,8 @@ impl Pour {
         self.config = config.sanitized();
         self.config_changed = true;
         self.plain = None;
+        // The bottle's levels are of the old curves, perhaps.
+        self.bottle.forget_levels();
     }
 
     /// MODEL.md §8 reset: refill, re-seed, clear the counts.
@@ -302,7 +305,6 @@ impl Pour {
     ) -> Advanced {
         self.plain = None;
         let mut advanced = Advanced::nothing_yet(self.bottle.volume_ml());
-        let capacity_ml = self.config.capacity_ml;
         let mut inputs = SpanInputs::splat([0.0; SPAN]);
         let mut levels = SpanLevels::default();
         let mut start = 0;
@@ -313,7 +315,7 @@ impl Pour {
             self.bottle.levels_of_span(
                 &inputs.tilt_deg[..len],
                 &inputs.pour_time_s[..len],
-                capacity_ml,
+                &self.config,
                 &mut levels,
             );
             self.config_changed = false;
@@ -449,7 +451,7 @@ impl Pour {
         outflow: Outflow,
         mut emit: impl FnMut(&UnitOnset),
     ) -> Outflow {
-        let capacity_ml = self.config.capacity_ml;
+        let (capacity_ml, silent_below) = (self.config.capacity_ml, self.config.silent_below);
         let mut started = 0;
         let skipped = self.onsets.feed(
             &outflow,
@@ -461,7 +463,8 @@ impl Pour {
                     sample,
                     fraction: crossing.fraction,
                     volume_ml: crossing.volume_ml,
-                    amplitude: unit_amplitude(crossing.volume_ml, capacity_ml),
+                    amplitude: silent_below.amplitude(crossing.volume_ml, capacity_ml)
+                        * shape.amplitude_factor,
                     viscosity,
                     shape,
                 });

@@ -1,7 +1,10 @@
-//! The per-unit random draws of MODEL.md §7, from one seeded generator.
+//! The per-unit random draws of MODEL.md §7 and §12, from one seeded generator.
 //!
-//! Every unit draws the same sequence of numbers whatever the spreads are, so changing one spread
-//! never reshuffles the others, and a seed reproduces its output on every platform.
+//! Every unit draws the same sequence of numbers whatever the spreads of §7 are, so changing one
+//! spread never reshuffles the others, and a seed reproduces its output on every platform. The
+//! amplitude's factor (§12), a later addition, comes from a stream of its own (the same seed,
+//! 2^128 draws further on) and only while its spread is above 0: with it at 0 every render is
+//! what it was before, and at any spread the onsets, f and B stay those of spread 0.
 
 use rand::{RngExt, SeedableRng};
 use rand_distr::StandardNormal;
@@ -16,18 +19,25 @@ pub struct UnitShape {
     pub frequency_hz: [f64; 2],
     /// B1_i, B2_i: the unit's amplitude decay rates (1/s).
     pub decay_per_s: [f64; 2],
+    /// exp(σ_A·z_i): the factor on the unit's a(V_i) (§12); exactly 1 when σ_A = 0.
+    pub amplitude_factor: f64,
 }
 
 pub struct UnitDraws {
     rng: Xoshiro256PlusPlus,
+    /// z_i of the amplitude's factor (§12), drawn only while σ_A > 0: `rng` jumped 2^128 draws
+    /// ahead, a stream that no draw of `rng` ever reaches.
+    amplitude_rng: Xoshiro256PlusPlus,
     /// u of the next unit's pocket volume, drawn ahead because the onset test needs it.
     next_pocket_u: f64,
 }
 
 impl UnitDraws {
     pub fn new(seed: u64) -> Self {
+        let rng = Xoshiro256PlusPlus::seed_from_u64(seed);
         let mut draws = Self {
-            rng: Xoshiro256PlusPlus::seed_from_u64(seed),
+            amplitude_rng: rng.clone(),
+            rng,
             next_pocket_u: 0.0,
         };
         draws.reseed(seed);
@@ -37,6 +47,8 @@ impl UnitDraws {
     /// Restarts the sequence (MODEL.md §8, reset).
     pub fn reseed(&mut self, seed: u64) {
         self.rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        self.amplitude_rng = self.rng.clone();
+        self.amplitude_rng.jump();
         self.next_pocket_u = self.uniform();
     }
 
@@ -46,11 +58,13 @@ impl UnitDraws {
         config.pocket_ml * (1.0 + config.timing_jitter * self.next_pocket_u)
     }
 
-    /// Draws the shape of the unit that is starting now, then the next unit's pocket volume.
+    /// Draws the shape of the unit that is starting now, then the next unit's pocket volume,
+    /// then (only while σ_A > 0) the unit's amplitude factor.
     pub fn next_unit(&mut self, config: &ModelConfig) -> UnitShape {
         let mut shape = UnitShape {
             frequency_hz: config.frequency_hz,
             decay_per_s: config.decay_per_s,
+            amplitude_factor: 1.0,
         };
         for f in &mut shape.frequency_hz {
             *f *= 1.0 + config.freq_jitter * self.uniform();
@@ -60,6 +74,10 @@ impl UnitDraws {
             *b *= (config.decay_sigma * z).exp();
         }
         self.next_pocket_u = self.uniform();
+        if config.amplitude_spread > 0.0 {
+            let z: f64 = self.amplitude_rng.sample(StandardNormal);
+            shape.amplitude_factor = (config.amplitude_spread * z).exp();
+        }
         shape
     }
 
@@ -81,6 +99,38 @@ mod tests {
         let shape = draws.next_unit(&config);
         assert_eq!(shape.frequency_hz, [80.0, 300.0]);
         assert_eq!(shape.decay_per_s, [45.0, 40.0]);
+        assert_eq!(shape.amplitude_factor, 1.0);
+    }
+
+    #[test]
+    fn the_amplitude_spread_moves_no_other_draw_and_draws_nothing_at_0() {
+        let still = ModelConfig::default();
+        let spread = ModelConfig {
+            amplitude_spread: 0.5,
+            ..still
+        };
+        let (mut plain, mut spreading) = (UnitDraws::new(9), UnitDraws::new(9));
+        let mut factors = Vec::new();
+        for _ in 0..200 {
+            assert_eq!(
+                plain.next_pocket_ml(&still),
+                spreading.next_pocket_ml(&spread)
+            );
+            let (a, b) = (plain.next_unit(&still), spreading.next_unit(&spread));
+            assert_eq!(
+                (a.frequency_hz, a.decay_per_s),
+                (b.frequency_hz, b.decay_per_s)
+            );
+            assert_eq!(a.amplitude_factor, 1.0);
+            factors.push(b.amplitude_factor);
+        }
+        assert!(factors.iter().all(|&factor| factor > 0.0 && factor != 1.0));
+        // Units at σ_A = 0 drew nothing from the amplitude's stream: it starts where it would.
+        let mut late = UnitDraws::new(9);
+        for _ in 0..50 {
+            late.next_unit(&still);
+        }
+        assert_eq!(late.next_unit(&spread).amplitude_factor, factors[0]);
     }
 
     #[test]

@@ -139,6 +139,7 @@ mod tests {
             shape: UnitShape {
                 frequency_hz: [80.0, 300.0],
                 decay_per_s: [decay_per_s; 2],
+                amplitude_factor: 1.0,
             },
         }
     }

@@ -1,17 +1,23 @@
 //! The f64 direct evaluator of MODEL.md §3–6: every unit's closed form summed at every sample, no
 //! recursion, no dropping above −260 dB. Slow by design; the yardstick the fast paths are held to.
 //!
-//! It takes only the onset schedule from the engine: [`Pour`] gives each unit's onset time, V_i
-//! and drawn f/B (MODEL.md §3, §4, §7; checked on their own by `tests/engine/drain.rs` and
-//! `onsets.rs`). Everything after that it computes itself from the contract, with its own copies
-//! of the contract's formulas and constants and none of the engine's: the amplitude law a(V), the
-//! c / (1 − c) split, the gain in dB, the ceiling, the ranges inputs are brought into (§11), the
-//! onset cap and the start budget (§11). So a fault in any of the engine's copies shows as a
-//! difference from this evaluator (`tests/engine/reference_match.rs`).
+//! It takes only the onset schedule from the engine: [`Pour`] gives the sample and the fraction
+//! of it at which each unit starts, and its draws: f, B and the amplitude's factor (MODEL.md §4,
+//! §7, §12; the schedule is checked on its own by `tests/engine/drain.rs` and `onsets.rs`).
+//! Everything else it computes itself from the contract, with its own copies of the contract's
+//! formulas and constants and none of the engine's: the drain of §3 and §8 through its own reading
+//! of the bottle's curves r, s and h (§2, §12), and from it each unit's V_i; the amplitude law
+//! a(V) with its V0 (§5, §12); the c / (1 − c) split, the gain in dB, the ceiling, the ranges
+//! inputs are brought into (§11), the onset cap and the start budget (§11). A unit the schedule
+//! starts in a sample where its own drain has no glugging outflow it leaves silent. So a fault in
+//! any of the engine's copies shows as a difference from this evaluator
+//! (`tests/engine/reference_match.rs`).
 
 use std::ops::Range;
 
-use crate::engine::{ControlSource, ModelConfig, Pour, UnitOnset};
+use crate::engine::{
+    ControlSource, ControlValues, DrainMode, ModelConfig, Pour, SilentBelow, UnitOnset,
+};
 
 /// MODEL.md §5: Asum = 0.0027·V − 0.2277, V in ml of the paper's 300 ml bottle, normalised by
 /// its value for a full bottle, 0.5823.
@@ -42,6 +48,21 @@ const SAMPLE_RATE_HZ: Allowed = Allowed {
     min: 1_000.0,
     max: 768_000.0,
     default: 48_000.0,
+};
+const TILT_DEG: Allowed = Allowed {
+    min: 0.0,
+    max: 180.0,
+    default: 0.0,
+};
+const FILL_PERCENT: Allowed = Allowed {
+    min: 0.0,
+    max: 100.0,
+    default: 100.0,
+};
+const POUR_TIME_S: Allowed = Allowed {
+    min: 0.01,
+    max: 3_600.0,
+    default: 5.0,
 };
 const VISCOSITY: Allowed = Allowed {
     min: 0.0,
@@ -125,12 +146,86 @@ pub struct ReferenceWindow {
     pub onsets: Vec<UnitOnset>,
 }
 
+/// MODEL.md §2, §12: a curve of tilt at `tilt_deg`: linear between its points, constant outside
+/// them (the points as the constants give them: data, not the engine's evaluation).
+fn curve_at(points: &[(f64, f64)], tilt_deg: f64) -> f64 {
+    let (first, last) = (points[0], points[points.len() - 1]);
+    if tilt_deg <= first.0 {
+        return first.1;
+    }
+    if tilt_deg > last.0 {
+        return last.1;
+    }
+    // The first point at or beyond the tilt, and the one before it.
+    let next = points.partition_point(|&(tilt, _)| tilt < tilt_deg);
+    let ((t0, v0), (t1, v1)) = (points[next - 1], points[next]);
+    v0 + (v1 - v0) * (tilt_deg - t0) / (t1 - t0)
+}
+
+/// MODEL.md §3 and §8, sample by sample: the residual volume, and what each sample poured.
+struct Drain {
+    volume_ml: f64,
+    /// The fill level of the sample before (simulate mode refills when it changes).
+    fill_percent: f64,
+}
+
+/// One sample of [`Drain`]: V at its start, its outflow, and whether it glugs.
+struct Poured {
+    volume_before_ml: f64,
+    outflow_ml: f64,
+    /// The mouth is submerged (V > s(θ)·C) and liquid flows: §4 counts this outflow.
+    glugs: bool,
+}
+
+impl Drain {
+    /// Sample `sample` under `values`, the first one after a reset at sample 0.
+    fn step(
+        &mut self,
+        sample: u64,
+        values: &ControlValues,
+        config: &ModelConfig,
+        capacity_ml: f64,
+        sample_rate: f64,
+    ) -> Poured {
+        let tilt_deg = TILT_DEG.bring_in(values.tilt_deg);
+        let fill_percent = FILL_PERCENT.bring_in(values.fill_percent);
+        let pour_time_s = POUR_TIME_S.bring_in(values.pour_time_s);
+        let curves = &config.curves;
+        let simulate = config.drain == DrainMode::Simulate;
+        // §8: a reset fills the bottle; in simulate mode so does any change of the fill level;
+        // in follow mode V is the fill level at every sample.
+        let refill = sample == 0 || (simulate && fill_percent != self.fill_percent);
+        self.fill_percent = fill_percent;
+        let volume_before_ml = if refill || !simulate {
+            fill_percent / 100.0 * capacity_ml
+        } else {
+            self.volume_ml
+        };
+        // §3: k(θ) = (C/T)·h(θ); the outflow is min(k/fs, max(0, V − r(θ)·C)).
+        let rate_ml_per_s = capacity_ml / pour_time_s * curve_at(curves.drain.points(), tilt_deg);
+        let rest_ml = curve_at(curves.rest.points(), tilt_deg) * capacity_ml;
+        let outflow_ml = (rate_ml_per_s / sample_rate).min((volume_before_ml - rest_ml).max(0.0));
+        let submerged_ml = curve_at(curves.submerged.points(), tilt_deg) * capacity_ml;
+        self.volume_ml = if simulate {
+            volume_before_ml - outflow_ml
+        } else {
+            volume_before_ml
+        };
+        Poured {
+            volume_before_ml,
+            outflow_ml,
+            glugs: volume_before_ml > submerged_ml && outflow_ml > 0.0,
+        }
+    }
+}
+
 /// One started unit: what §5 needs, computed here.
 struct Unit {
     /// t_i in samples: n + x.
     onset: f64,
     first_sample: u64,
-    /// A1 = c·a(V_i), A2 = (1 − c)·a(V_i); the gain G is applied per sample, on its ramp.
+    /// A1 = c·Asum_i, A2 = (1 − c)·Asum_i, Asum_i = a(V_i)·exp(σ_A·z_i); the gain G is applied
+    /// per sample, on its ramp.
     amplitudes: [f64; 2],
     frequency_hz: [f64; 2],
     decay_per_s: [f64; 2],
@@ -148,6 +243,10 @@ pub fn evaluate(
     let ceiling = CEILING.bring_in(config.ceiling);
     let mut pour = Pour::new(sample_rate, config);
     pour.reset();
+    let mut drain = Drain {
+        volume_ml: 0.0,
+        fill_percent: f64::NAN,
+    };
     let mut onsets = Vec::new();
     let mut units = Vec::new();
     let mut budget = (BUDGET_UNITS, 0.0f64);
@@ -158,9 +257,13 @@ pub fn evaluate(
         let gain_db = values.gain_db;
         // §5: c is taken at the onset's sample, brought into [0, 1].
         let viscosity = VISCOSITY.bring_in(values.viscosity);
+        let poured = drain.step(sample, &values, &config, capacity_ml, sample_rate);
         let mut this_sample = 0;
         pour.step(sample, values, |onset| {
             onsets.push(*onset);
+            if !poured.glugs {
+                return;
+            }
             this_sample += 1;
             if this_sample > ONSETS_PER_SAMPLE {
                 return;
@@ -174,7 +277,10 @@ pub fn evaluate(
                 return;
             }
             *units_left -= 1.0;
-            let amplitude = amplitude_law(onset.volume_ml, capacity_ml);
+            // §4: V_i = V at the sample's start less the part of its outflow before the onset.
+            let volume_ml = poured.volume_before_ml - onset.fraction * poured.outflow_ml;
+            let amplitude = amplitude_law(volume_ml, capacity_ml, config.silent_below)
+                * onset.shape.amplitude_factor;
             units.push(Unit {
                 onset: onset.sample as f64 + onset.fraction,
                 first_sample: onset.sample + 1,
@@ -199,10 +305,19 @@ pub fn evaluate(
     ReferenceWindow { samples, onsets }
 }
 
-/// a(V) of MODEL.md §5.
-fn amplitude_law(volume_ml: f64, capacity_ml: f64) -> f64 {
-    let in_papers_bottle_ml = FIT_BOTTLE_ML * volume_ml / capacity_ml;
-    (FIT_SLOPE_PER_ML * in_papers_bottle_ml - FIT_OFFSET).max(0.0) / FIT_FULL_BOTTLE
+/// a(V) of MODEL.md §5 and §12: max(0, (V − V0)/(C − V0)). V0 is brought into 0 ≤ V0 < C (a NaN
+/// is the default); the default, the paper's V0 scaled with C, is evaluated as the paper's line,
+/// the same function in the arithmetic renders have always used.
+fn amplitude_law(volume_ml: f64, capacity_ml: f64, silent_below: SilentBelow) -> f64 {
+    let silent_ml = match silent_below {
+        SilentBelow::Ml(ml) if !ml.is_nan() => ml.max(0.0).min(capacity_ml.next_down()),
+        _ => {
+            let in_papers_bottle_ml = FIT_BOTTLE_ML * volume_ml / capacity_ml;
+            return (FIT_SLOPE_PER_ML * in_papers_bottle_ml - FIT_OFFSET).max(0.0)
+                / FIT_FULL_BOTTLE;
+        }
+    };
+    ((volume_ml - silent_ml) / (capacity_ml - silent_ml)).max(0.0)
 }
 
 /// q_i(τ) of MODEL.md §5 (without G), added at every sample of `window` with τ ≥ 0. A component
