@@ -5,7 +5,7 @@
 //! is the most glugs the scene can start, which the pour's rates bound (MODEL.md §3, §4).
 
 use super::scene::Scene;
-use crate::engine::pour::{FLOW, MAX_ONSETS_PER_SAMPLE};
+use crate::engine::pour::MAX_ONSETS_PER_SAMPLE;
 use crate::engine::DrainMode;
 
 /// The most glugs `scene` can start. A unit starts each time a pocket of at least
@@ -23,7 +23,7 @@ pub(crate) fn max_units(scene: &Scene) -> u64 {
         .values()
         .fold(f64::INFINITY, f64::min);
     let smallest_pocket_ml = config.pocket_ml * (1.0 - config.timing_jitter);
-    let fastest_ml_per_s = config.capacity_ml / shortest_pour_s * FLOW.max();
+    let fastest_ml_per_s = config.capacity_ml / shortest_pour_s * config.curves.drain.max();
     let units_per_s =
         (fastest_ml_per_s / smallest_pocket_ml).min(MAX_ONSETS_PER_SAMPLE as f64 * sample_rate);
     let bottles = |count: f64| count * config.capacity_ml / smallest_pocket_ml;

@@ -223,7 +223,7 @@ impl TiltCurve {
     /// The largest value at any tilt: a breakpoint's, the curve being linear between them and
     /// held beyond them.
     pub fn max(&self) -> f64 {
-        self.points
+        self.points()
             .iter()
             .map(|&(_, value)| value)
             .fold(f64::NEG_INFINITY, f64::max)
