@@ -12,6 +12,31 @@ pub fn sake_glug(directory: &Path, args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// [`sake_glug`] for a command that must end by itself within `limit`: one that does not is
+/// killed and the test fails (rather than hanging the suite).
+pub fn sake_glug_within(directory: &Path, args: &[&str], limit: std::time::Duration) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sake-glug"))
+        .current_dir(directory)
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if started.elapsed() > limit {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            panic!(
+                "`sake-glug {}` did not end within {limit:?}",
+                args.join(" ")
+            );
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
 /// The names of the files in `directory`, sorted.
 pub fn files_in(directory: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(directory)

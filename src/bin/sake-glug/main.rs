@@ -11,6 +11,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use sake_glug::offline::Scene;
+
 #[derive(Parser)]
 #[command(
     name = "sake-glug",
@@ -34,6 +36,19 @@ enum Command {
     Presets(presets::PresetsArgs),
     /// Every control and model constant: parameter id, scene key, range and default.
     Parameters(parameters::ParametersArgs),
+}
+
+/// A `--sample-rate` as a scene's `sample_rate` is checked (in range, whole), refused by the
+/// command line (exit status 2) before anything is rendered.
+fn sample_rate_hz(text: &str) -> Result<f64, String> {
+    let sample_rate: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number of Hz"))?;
+    Scene::default()
+        .with_sample_rate(sample_rate)
+        .map(|_| sample_rate)
+        .map_err(|error| error.to_string())
 }
 
 fn main() -> ExitCode {

@@ -61,7 +61,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "TAKE.mid")]
     midi: Option<PathBuf>,
     /// Overrides the scenes' sample rate (Hz).
-    #[arg(long, value_parser = sample_rate_hz)]
+    #[arg(long, value_parser = crate::sample_rate_hz)]
     sample_rate: Option<f64>,
     /// Sample format of WAV files: f32, s24 or s16.
     #[arg(long, default_value = "f32")]
@@ -166,16 +166,6 @@ pub fn run(args: RenderArgs) -> ExitCode {
 
 /// `--sample-rate`: a number refused, before anything is rendered, as a scene's `sample_rate`
 /// would be.
-fn sample_rate_hz(text: &str) -> Result<f64, String> {
-    let sample_rate: f64 = text
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{text}` is not a number of Hz"))?;
-    Scene::default()
-        .with_sample_rate(sample_rate)
-        .map(|_| sample_rate)
-        .map_err(|error| error.to_string())
-}
 
 /// The signals that stop a render: Ctrl-C, `kill`'s default, a closed terminal. The render stops
 /// at its next block and removes its temporary files, and the command ends with 128 + the
