@@ -164,9 +164,6 @@ pub fn run(args: RenderArgs) -> ExitCode {
     }
 }
 
-/// `--sample-rate`: a number refused, before anything is rendered, as a scene's `sample_rate`
-/// would be.
-
 /// The signals that stop a render: Ctrl-C, `kill`'s default, a closed terminal. The render stops
 /// at its next block and removes its temporary files, and the command ends with 128 + the
 /// signal's number; a second signal ends it at once, as the signal would have (the temporary
