@@ -2,12 +2,11 @@
 //! CLAP state extension of the exported plugin, [`ClapInstance`]), as a host saves and reopens a
 //! project: the reopened instance saves the very same bytes and renders the very same samples.
 
-use nice_plug::prelude::Enum;
 use serde_json::json;
 
 use crate::clap_host::ClapInstance;
-use sake_glug::engine::config::{self, Quantity, CEILING_DB};
-use sake_glug::engine::{Constant, Control, DrainMode};
+use crate::fuzz::checks::{assert_saved_state_valid, bytes_of, float_quantity, json_of};
+use sake_glug::engine::config;
 
 /// Every parameter, by the name a host lists, with a value other than its default.
 const CHANGED: [(&str, &str); 17] = [
@@ -39,20 +38,6 @@ const MIDI_FIELDS: [(&str, &str); 5] = [
     ("midi_cc_viscosity", "74"),
     ("midi_cc_fill", "255"),
 ];
-
-/// The JSON inside saved state bytes (CLAP's stream carries an 8-byte length first).
-fn json_of(bytes: &[u8]) -> serde_json::Value {
-    let length = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
-    assert_eq!(length, bytes.len() - 8);
-    serde_json::from_slice(&bytes[8..]).unwrap()
-}
-
-fn bytes_of(json: &serde_json::Value) -> Vec<u8> {
-    let text = serde_json::to_vec(json).unwrap();
-    let mut bytes = (text.len() as u64).to_le_bytes().to_vec();
-    bytes.extend(text);
-    bytes
-}
 
 /// An instance with every parameter changed by a host's automation and the MIDI settings
 /// changed (there is no other way in from outside than a state: the editor sets them).
@@ -114,46 +99,6 @@ fn bytes_that_are_not_a_state_are_refused_and_change_nothing() {
     ] {
         assert!(!instance.load(bad), "{bad:?} was accepted");
         assert_eq!(instance.save(), before, "{bad:?} changed the state");
-    }
-}
-
-/// Every parameter a state holds, as the engine's tables declare it: the float parameters'
-/// knob range and default, as the plugin's f32.
-fn float_quantity(id: &str) -> Option<&'static Quantity> {
-    Control::ALL
-        .iter()
-        .map(|control| control.quantity())
-        .chain(Constant::ALL.iter().map(|constant| constant.quantity()))
-        .chain([&CEILING_DB])
-        .find(|quantity| quantity.param_id == id)
-}
-
-/// What a host needs of saved `bytes`: a new instance loads them and saves them again byte for
-/// byte, and they hold only values the plugin's parameters can take (every float finite and in
-/// its range, the seed in its range, the drain mode one of its ids).
-pub fn assert_saved_state_valid(bytes: &[u8]) {
-    let reopened = ClapInstance::new();
-    assert!(reopened.load(bytes), "the plugin refuses its own state");
-    assert_eq!(reopened.save(), bytes, "save, load, save changed the state");
-    let json = json_of(bytes);
-    for (id, value) in json["params"].as_object().unwrap() {
-        let valid = if let Some(quantity) = float_quantity(id) {
-            let (min, max) = quantity.knob_bounds();
-            // JSON holds the shortest decimal that reads back as the f32.
-            value["f32"]
-                .as_f64()
-                .is_some_and(|v| (min as f32..=max as f32).contains(&(v as f32)))
-        } else if id == config::SEED.param_id {
-            value["i32"]
-                .as_f64()
-                .is_some_and(|v| config::SEED.range.contains(v))
-        } else if id == config::DRAIN.param_id {
-            let ids = <DrainMode as Enum>::ids().unwrap();
-            value["string"].as_str().is_some_and(|id| ids.contains(&id))
-        } else {
-            panic!("an unknown parameter {id} was saved");
-        };
-        assert!(valid, "{id} = {value}");
     }
 }
 
