@@ -305,7 +305,8 @@ impl Clock {
 
 /// Refuses an SMPTE division with a frame rate byte that is not one of the four rates, before
 /// midly reads it: midly negates the byte as an `i8`, which overflows (a panic in debug builds)
-/// for 0x80.
+/// for 0x80. `bytes` starts at a chunk; midly reads every `MThd` chunk as a header, a later one
+/// too, so [`count_track_chunks`] checks each.
 fn check_frame_rate(bytes: &[u8]) -> Result<(), TakeError> {
     let header_length = bytes
         .get(4..8)
@@ -321,12 +322,13 @@ fn check_frame_rate(bytes: &[u8]) -> Result<(), TakeError> {
 }
 
 /// Walks the chunks of a file that starts with `MThd` and counts its `MTrk` chunks, refusing a
-/// chunk that runs past the end of the file.
+/// chunk that runs past the end of the file or a header with a frame rate midly cannot read.
 fn count_track_chunks(bytes: &[u8]) -> Result<usize, TakeError> {
     let mut rest = bytes;
     let mut tracks = 0;
     let mut index = 0;
     while !rest.is_empty() {
+        check_frame_rate(rest)?;
         let Some((head, body)) = rest.split_first_chunk::<8>() else {
             return Err(TakeError::Truncated {
                 detail: format!(

@@ -137,8 +137,10 @@ impl<const RAW_MIDI: bool> Plugin for SakeGlugPlugin<RAW_MIDI> {
     type SysExMessage = ();
     type BackgroundTask = ();
 
+    /// An old layout brought up to date, then every value into range (a newer layout's too).
     fn filter_state(state: &mut PluginState) {
         migrate_state(state);
+        params::validate_state(state);
     }
 
     fn params(&self) -> Arc<dyn Params> {

@@ -6,11 +6,12 @@
 //! f64, not the nearest f32). So typing `4.2` in a host and writing `4.2` in a scene file give
 //! the engine the same number, and the same samples.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::Arc;
 
 use nice_plug::params::persist::{self, PersistentField};
+use nice_plug::plugin::ParamValue;
 use nice_plug::prelude::*;
 
 use crate::device::midi::{MidiMap, MidiSetting};
@@ -152,6 +153,131 @@ pub fn migrate_state(state: &mut PluginState) {
     state
         .fields
         .insert(STATE_VERSION_KEY.into(), STATE_VERSION.to_string());
+}
+
+/// Brings every value of a saved state to one the parameters can hold, before it loads, and logs
+/// each change: nice-plug takes a saved value as it is, so an enum index out of range panicked on
+/// the next save (inside a C callback: the host died), and a float beyond f32's range (JSON's
+/// `1e39`) stayed infinite and saved as `null`, which no load accepts. A float is clamped to its
+/// range, an integer too; a value that is not finite, an enum index or id the parameter does not
+/// know, or a value of the wrong type loads as the default. The persisted fields load as the
+/// plugin would save them again (a MIDI byte out of range as off, a field that does not parse as
+/// its default). So a state the plugin saves is always one it loads.
+pub fn validate_state(state: &mut PluginState) {
+    // Fresh parameters: their ranges and defaults, and a scratch copy to read the fields into.
+    let scratch = GlugParams::default();
+    let params: HashMap<String, ParamPtr> = scratch
+        .param_map()
+        .into_iter()
+        .map(|(id, param, _)| (id, param))
+        .collect();
+    for (id, value) in &mut state.params {
+        // An unknown id is skipped by nice-plug's load, and never saved again.
+        let Some(&param) = params.get(id) else {
+            continue;
+        };
+        // SAFETY: `param` points into `scratch`, alive until the end of this function, and is
+        // checked once (an id is a key of the map), so it still holds its default.
+        if let Err((kept, reason)) = unsafe { checked(param, value) } {
+            nice_warn!("state: parameter {id:?} = {value:?} {reason}: loads as {kept:?}");
+            *value = kept;
+        }
+    }
+    scratch.deserialize_fields(&state.fields);
+    scratch.set_midi_map(scratch.midi_map());
+    scratch.osc.set(scratch.osc.port(), scratch.osc.axis());
+    for (key, kept) in scratch.serialize_fields() {
+        if let Some(saved) = state.fields.get_mut(&key).filter(|saved| **saved != kept) {
+            nice_warn!("state: field {key:?} = {saved:?} is out of range: loads as {kept:?}");
+            *saved = kept;
+        }
+    }
+}
+
+/// `Ok` if `param` can hold `value` as it is; otherwise the value it loads instead, and why.
+///
+/// # Safety
+///
+/// `param` must point to a live parameter that holds its default value and that nothing else
+/// uses: trying an enum id sets it.
+unsafe fn checked(param: ParamPtr, value: &ParamValue) -> Result<(), (ParamValue, &'static str)> {
+    let default = unsafe { default_value(param) };
+    let out_of_range = "is out of range";
+    match (param, value) {
+        (ParamPtr::FloatParam(float), &ParamValue::F32(value)) => {
+            let (min, max) = float_bounds(unsafe { &*float }.range());
+            if !value.is_finite() {
+                Err((default, "is not a finite number"))
+            } else if value < min || value > max {
+                Err((ParamValue::F32(value.clamp(min, max)), out_of_range))
+            } else {
+                Ok(())
+            }
+        }
+        (ParamPtr::IntParam(int), &ParamValue::I32(value)) => {
+            let (min, max) = int_bounds(unsafe { &*int }.range());
+            if (min..=max).contains(&value) {
+                Ok(())
+            } else {
+                Err((ParamValue::I32(value.clamp(min, max)), out_of_range))
+            }
+        }
+        (ParamPtr::EnumParam(choice), &ParamValue::I32(index)) => {
+            let known = usize::try_from(index).is_ok_and(|index| index < unsafe { &*choice }.len());
+            if known {
+                Ok(())
+            } else {
+                Err((default, "is not one of its choices"))
+            }
+        }
+        // The only way to ask an enum whether it knows an id is to set it: `param` is scratch.
+        (ParamPtr::EnumParam(choice), ParamValue::String(id)) => {
+            if unsafe { &*choice }.set_from_id(id) {
+                Ok(())
+            } else {
+                Err((default, "is not one of its choices"))
+            }
+        }
+        (ParamPtr::BoolParam(_), ParamValue::Bool(_)) => Ok(()),
+        _ => Err((default, "is of the wrong type")),
+    }
+}
+
+/// What nice-plug saves for `param` at its default value.
+///
+/// # Safety
+///
+/// `param` must point to a live parameter that holds its default value.
+unsafe fn default_value(param: ParamPtr) -> ParamValue {
+    unsafe {
+        match param {
+            ParamPtr::FloatParam(float) => ParamValue::F32((*float).default_plain_value()),
+            ParamPtr::IntParam(int) => ParamValue::I32((*int).default_plain_value()),
+            ParamPtr::BoolParam(flag) => ParamValue::Bool((*flag).default_plain_value()),
+            ParamPtr::EnumParam(choice) => match (*choice).unmodulated_plain_id() {
+                Some(id) => ParamValue::String(id.to_owned()),
+                None => ParamValue::I32((*choice).default_plain_value()),
+            },
+        }
+    }
+}
+
+/// The lowest and highest value of a float range.
+fn float_bounds(range: FloatRange) -> (f32, f32) {
+    match range {
+        FloatRange::Linear { min, max }
+        | FloatRange::Skewed { min, max, .. }
+        | FloatRange::SymmetricalSkewed { min, max, .. } => (min, max),
+        FloatRange::Reversed(range) => float_bounds(*range),
+    }
+}
+
+/// The lowest and highest value of an integer range.
+fn int_bounds(range: IntRange) -> (i32, i32) {
+    match range {
+        IntRange::Linear { min, max } => (min, max),
+        IntRange::Reversed(range) => int_bounds(*range),
+    }
 }
 
 /// The Model group of parameters (MODEL.md §5, §7, §8).

@@ -1,7 +1,8 @@
-//! Fuzz targets for the offline renderer's outside data: scene files (TOML) and their automation
-//! lanes. Property: never a panic, never a hang, and either a valid scene or an error that names
-//! the fault (a scene key, or the line of the file). `cargo xtask fuzz` runs a million cases of
-//! each; a normal test run, proptest's default of 256.
+//! Property-based fuzz tests for the offline renderer's outside data: scene files (TOML) and their
+//! automation lanes, proptest's default of 256 cases a run. Property: never a panic, never a
+//! hang, and either a valid scene or an error that names the fault (a scene key, or the line of
+//! the file). The libFuzzer targets `scene_toml` and `automation_lanes` (fuzz/) search further
+//! with coverage guidance.
 
 use proptest::prelude::*;
 

@@ -1,15 +1,60 @@
-//! Fuzz targets for what the plugin reads from outside: its saved state (bytes a host hands
-//! back from a project, through nice-plug's state deserialisation in the CLAP state extension)
-//! and the MIDI CC decoder of the tilt device. Property: never a panic, never a hang, and either
-//! a valid result or a refusal. `cargo xtask fuzz` runs a million cases of each; a normal test
-//! run, proptest's default of 256.
+//! The fuzz targets in the ordinary test suite. Every input that coverage-guided fuzzing kept
+//! (fuzz/corpus/<target>/, a minimised corpus) or that once crashed a target
+//! (fuzz/regressions/<target>/) goes through that target's own check ([`checks`], the file the
+//! libFuzzer targets call) without libFuzzer. Then property-based fuzz tests (proptest, 256 cases
+//! a run) for the plugin's saved state, with the same check, and for the MIDI CC decoder against
+//! an independent model of its mapping table.
 
 use proptest::prelude::*;
+
+use std::path::Path;
 
 use crate::clap_host::ClapInstance;
 use crate::support::fuzz::{self, any_number};
 use sake_glug::device::midi::{CcDecoder, MidiMap};
 use sake_glug::engine::Control;
+
+/// What each target feeds and asserts, shared with the libFuzzer targets.
+#[path = "../../fuzz/src/checks.rs"]
+pub mod checks;
+
+#[test]
+fn every_input_kept_by_the_fuzzers_passes_its_target() {
+    let fuzz = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz");
+    let targets: Vec<&str> = checks::TARGETS.iter().map(|(name, _)| *name).collect();
+    for folder in ["corpus", "regressions"] {
+        for entry in std::fs::read_dir(fuzz.join(folder)).unwrap() {
+            let name = entry.unwrap().file_name();
+            let name = name.to_string_lossy();
+            assert!(
+                targets.contains(&&*name),
+                "fuzz/{folder}/{name} is no target"
+            );
+        }
+    }
+    for (target, check) in checks::TARGETS {
+        let mut inputs = 0;
+        for folder in ["corpus", "regressions"] {
+            let Ok(entries) = std::fs::read_dir(fuzz.join(folder).join(target)) else {
+                continue;
+            };
+            for entry in entries {
+                let path = entry.unwrap().path();
+                let data = std::fs::read(&path).unwrap();
+                if let Err(panic) = std::panic::catch_unwind(|| check(&data)) {
+                    let message = panic
+                        .downcast_ref::<String>()
+                        .map(String::as_str)
+                        .or(panic.downcast_ref::<&str>().copied())
+                        .unwrap_or("");
+                    panic!("{}: {message}", path.display());
+                }
+                inputs += 1;
+            }
+        }
+        assert!(inputs > 0, "no input kept for {target}");
+    }
+}
 
 /// A JSON value of any kind, numbers from every corner.
 fn json_value() -> impl Strategy<Value = serde_json::Value> {
@@ -101,48 +146,14 @@ fn state_bytes(template: serde_json::Value) -> impl Strategy<Value = Vec<u8>> {
     ]
 }
 
-/// Every parameter's CLAP value, checked finite and within the range the plugin declares.
-fn assert_parameters_valid(instance: &ClapInstance) -> Result<(), TestCaseError> {
-    for (name, value, min, max) in instance.parameter_values() {
-        prop_assert!(
-            value.is_finite() && (min..=max).contains(&value),
-            "{} = {} outside {}..{}",
-            name.to_string_lossy(),
-            value,
-            min,
-            max
-        );
-    }
-    Ok(())
-}
-
 #[test]
 fn fuzz_plugin_state_bytes() {
-    // One instance for every case, as a host reloading projects into the same plugin.
-    let instance = ClapInstance::new();
-    let template: serde_json::Value = {
-        let bytes = instance.save();
-        serde_json::from_slice(&bytes[8..]).unwrap()
-    };
+    let template: serde_json::Value = checks::json_of(&ClapInstance::new().save());
     fuzz::run(
         "plugin state bytes (CLAP state load)",
         state_bytes(template),
         |bytes| {
-            let before = instance.save();
-            if instance.load(&bytes) {
-                // A state it took holds only valid values, and saves and reloads as itself.
-                assert_parameters_valid(&instance)?;
-                let saved = instance.save();
-                prop_assert!(instance.load(&saved));
-                prop_assert_eq!(&instance.save(), &saved);
-            } else {
-                // A state it refused changed nothing.
-                prop_assert_eq!(
-                    &instance.save(),
-                    &before,
-                    "a refused state changed the plugin"
-                );
-            }
+            checks::state(&bytes);
             Ok(())
         },
     );

@@ -129,7 +129,8 @@ proptest! {
     }
 }
 
-// The target of `cargo xtask fuzz` (a million cases there, proptest's default here).
+// Every kind of packet at once (the libFuzzer target `osc_packet`, fuzz/, searches further with
+// coverage guidance).
 
 #[test]
 fn fuzz_osc_packets() {

@@ -2,7 +2,11 @@
 //! CLAP state extension of the exported plugin, [`ClapInstance`]), as a host saves and reopens a
 //! project: the reopened instance saves the very same bytes and renders the very same samples.
 
+use serde_json::json;
+
 use crate::clap_host::ClapInstance;
+use crate::fuzz::checks::{assert_saved_state_valid, bytes_of, float_quantity, json_of};
+use sake_glug::engine::config;
 
 /// Every parameter, by the name a host lists, with a value other than its default.
 const CHANGED: [(&str, &str); 17] = [
@@ -34,20 +38,6 @@ const MIDI_FIELDS: [(&str, &str); 5] = [
     ("midi_cc_viscosity", "74"),
     ("midi_cc_fill", "255"),
 ];
-
-/// The JSON inside saved state bytes (CLAP's stream carries an 8-byte length first).
-fn json_of(bytes: &[u8]) -> serde_json::Value {
-    let length = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
-    assert_eq!(length, bytes.len() - 8);
-    serde_json::from_slice(&bytes[8..]).unwrap()
-}
-
-fn bytes_of(json: &serde_json::Value) -> Vec<u8> {
-    let text = serde_json::to_vec(json).unwrap();
-    let mut bytes = (text.len() as u64).to_le_bytes().to_vec();
-    bytes.extend(text);
-    bytes
-}
 
 /// An instance with every parameter changed by a host's automation and the MIDI settings
 /// changed (there is no other way in from outside than a state: the editor sets them).
@@ -109,5 +99,140 @@ fn bytes_that_are_not_a_state_are_refused_and_change_nothing() {
     ] {
         assert!(!instance.load(bad), "{bad:?} was accepted");
         assert_eq!(instance.save(), before, "{bad:?} changed the state");
+    }
+}
+
+/// The state a new instance saves, with `value` for the parameter `id`.
+fn crafted(id: &str, value: serde_json::Value) -> Vec<u8> {
+    let mut json = json_of(&ClapInstance::new().save());
+    json["params"][id] = value;
+    bytes_of(&json)
+}
+
+/// The value `id` has in `bytes`.
+fn saved_value(bytes: &[u8], id: &str) -> serde_json::Value {
+    json_of(bytes)["params"][id].clone()
+}
+
+// A drain index out of range was taken as it was, and the next save panicked indexing the ids
+// (inside a C callback, so the host aborted).
+#[test]
+fn an_enum_index_out_of_range_loads_as_the_default() {
+    let defaults = ClapInstance::new().save();
+    for index in [2, -1, i32::MAX, i32::MIN] {
+        let instance = changed_instance();
+        assert!(instance.load(&crafted("drain", json!({ "i32": index }))));
+        let saved = instance.save();
+        assert_saved_state_valid(&saved);
+        assert_eq!(
+            saved_value(&saved, "drain"),
+            saved_value(&defaults, "drain")
+        );
+    }
+    for unknown in ["sideways", "", "Follow"] {
+        let instance = changed_instance();
+        assert!(instance.load(&crafted("drain", json!({ "string": unknown }))));
+        let saved = instance.save();
+        assert_saved_state_valid(&saved);
+        assert_eq!(
+            saved_value(&saved, "drain"),
+            saved_value(&defaults, "drain")
+        );
+    }
+}
+
+// A float beyond f32's range read as ±inf, saved as `null`, and the plugin then refused its own
+// state: the project lost every setting of the instance.
+#[test]
+fn a_float_out_of_range_loads_clamped_and_one_not_finite_as_the_default() {
+    let defaults = ClapInstance::new().save();
+    let floats: Vec<String> = json_of(&defaults)["params"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .filter(|(_, value)| value.get("f32").is_some())
+        .map(|(id, _)| id.clone())
+        .collect();
+    assert_eq!(floats.len(), 15, "every float parameter");
+    // The saved f32, read back as one (JSON holds its shortest decimal).
+    let f32_of = |value: serde_json::Value| value["f32"].as_f64().map(|v| v as f32);
+    for id in &floats {
+        let (min, max) = float_quantity(id).unwrap().knob_bounds();
+        let default = f32_of(saved_value(&defaults, id));
+        for (written, expected) in [
+            (1e39, default),
+            (-1e39, default),
+            (1e30, Some(max as f32)),
+            (-1e30, Some(min as f32)),
+        ] {
+            let instance = changed_instance();
+            assert!(
+                instance.load(&crafted(id, json!({ "f32": written }))),
+                "{id}"
+            );
+            let saved = instance.save();
+            assert_saved_state_valid(&saved);
+            assert_eq!(
+                f32_of(saved_value(&saved, id)),
+                expected,
+                "{id} = {written}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_seed_out_of_range_or_a_value_of_the_wrong_type_is_brought_into_range() {
+    let defaults = ClapInstance::new().save();
+    let max = config::SEED.range.max as i32;
+    for (id, written, expected) in [
+        ("seed", json!({ "i32": i32::MAX }), json!({ "i32": max })),
+        ("seed", json!({ "i32": -5 }), json!({ "i32": 0 })),
+        (
+            "seed",
+            json!({ "f32": 3.0 }),
+            saved_value(&defaults, "seed"),
+        ),
+        ("tilt", json!({ "i32": 3 }), saved_value(&defaults, "tilt")),
+        (
+            "drain",
+            json!({ "bool": true }),
+            saved_value(&defaults, "drain"),
+        ),
+    ] {
+        let instance = changed_instance();
+        assert!(instance.load(&crafted(id, written.clone())));
+        let saved = instance.save();
+        assert_saved_state_valid(&saved);
+        assert_eq!(saved_value(&saved, id), expected, "{id} = {written}");
+    }
+}
+
+#[test]
+fn persisted_fields_out_of_range_load_as_what_they_mean() {
+    let defaults = json_of(&ClapInstance::new().save());
+    let default_of = |field: &str| defaults["fields"][field].as_str().unwrap().to_owned();
+    for (field, written, expected) in [
+        // A MIDI byte above 127 (or a channel above 15) means off, and is saved as off.
+        ("midi_channel", "16", "255".to_owned()),
+        ("midi_cc_tilt", "200", "255".to_owned()),
+        // Not a byte at all: the default.
+        ("midi_cc_viscosity", "-1", default_of("midi_cc_viscosity")),
+        ("midi_cc_fill", "1e3", default_of("midi_cc_fill")),
+        ("midi_cc_tilt_lsb", "null", default_of("midi_cc_tilt_lsb")),
+        // An OSC axis that is no axis: the default axis.
+        ("osc_axis", "200", default_of("osc_axis")),
+    ] {
+        let instance = changed_instance();
+        let mut json = json_of(&instance.save());
+        json["fields"][field] = json!(written);
+        assert!(instance.load(&bytes_of(&json)), "{field} = {written}");
+        let saved = instance.save();
+        assert_saved_state_valid(&saved);
+        assert_eq!(
+            json_of(&saved)["fields"][field],
+            json!(expected),
+            "{field} = {written}"
+        );
     }
 }

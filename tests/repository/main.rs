@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// How a repository path starts: one of the top-level folders, or it is a top-level file.
-const FOLDERS: [&str; 9] = [
+const FOLDERS: [&str; 10] = [
     "src/",
+    "fuzz/",
     "tests/",
     "docs/",
     "benches/",

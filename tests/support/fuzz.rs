@@ -1,7 +1,6 @@
-//! The harness of the fuzz targets: proptest's runner with the case count of `PROPTEST_CASES`
-//! (proptest's default, 256, in a normal test run; `cargo xtask fuzz` asks for a million), a
-//! watchdog that turns a hang into a failure, and one summary line per target that
-//! `cargo xtask fuzz` copies into docs/fuzzing.md.
+//! The harness of the property-based fuzz tests: proptest's runner with the case count of
+//! `PROPTEST_CASES` (proptest's default, 256, in a normal test run) and a watchdog that turns a
+//! hang into a failure.
 
 use std::fmt::Debug;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -27,7 +26,6 @@ where
         failure_persistence: None,
         ..Config::default()
     };
-    let cases = config.cases;
     let finished = Arc::new(AtomicU64::new(0));
     let done = Arc::new(AtomicBool::new(false));
     let watchdog = {
@@ -46,7 +44,6 @@ where
             }
         })
     };
-    let started = Instant::now();
     let mut runner = TestRunner::new(config);
     let result = runner.run(&strategy, |value| {
         let outcome = property(value);
@@ -55,13 +52,6 @@ where
     });
     done.store(true, Ordering::Relaxed);
     watchdog.join().unwrap();
-    let seconds = started.elapsed().as_secs_f64();
-    let verdict = match &result {
-        Ok(()) => "passed".to_string(),
-        Err(error) => format!("FAILED: {error}"),
-    };
-    // On a line of its own, after libtest's "test NAME ... ".
-    println!("\nfuzz-summary | {target} | {cases} | {seconds:.1} | {verdict}");
     if let Err(error) = result {
         panic!("fuzz target {target}: {error}");
     }

@@ -14,9 +14,9 @@
 //! - `cargo xtask screenshots`: the editor in a real window (the standalone app under Xvfb), idle
 //!   and while a phone's OSC gravity pours, written to docs/editor-idle.png and
 //!   docs/editor-pouring.png.
-//! - `cargo xtask fuzz`: every fuzz target (tests named `fuzz_…`) with a million cases each
-//!   (`FUZZ_CASES` to change it), summarised in docs/fuzzing.md; built with every feature, or
-//!   every one but `standalone` without the app's libraries.
+//! - `cargo xtask fuzz`: every libFuzzer target of fuzz/ (`cargo install cargo-fuzz`) for
+//!   `FUZZ_SECONDS` each (60 by default), keeping their minimised corpora and any failing input
+//!   as a regression the ordinary tests replay; summarised in docs/fuzzing.md.
 //!
 //! Each product is built with only its features: the bundles with `editor` (which brings
 //! `plugin`), the command line with `cli`, the standalone app with `standalone`, so none compiles
@@ -456,79 +456,185 @@ fn stamp(took: std::time::Duration) -> String {
     )
 }
 
-/// Runs every fuzz target (test functions named `fuzz_…`) with `FUZZ_CASES` cases each (a
-/// million by default) in the test profile, debug assertions and overflow checks on, and writes
-/// their summary lines to docs/fuzzing.md.
+/// The fuzz crate (cargo-fuzz's layout), a workspace of its own.
+const FUZZ_DIR: &str = "fuzz";
+
+/// Runs every libFuzzer target of fuzz/ for `FUZZ_SECONDS` each (60 by default) on its kept
+/// corpus and its regressions, keeps any input that fails as a regression, minimises the corpus,
+/// and writes what it ran to docs/fuzzing.md. The ordinary test suite replays both folders
+/// (tests/plugin/fuzz.rs).
 fn fuzz() -> nice_plug_xtask::Result<()> {
-    let cases = std::env::var("FUZZ_CASES").unwrap_or_else(|_| "1000000".into());
-    // No fuzz target needs the standalone app: without its libraries, every other feature.
-    let missing = standalone_missing();
-    let features = if missing.is_empty() {
-        "--all-features".to_owned()
-    } else {
-        format!("--features={}", features_but_standalone()?)
+    let seconds: u64 = match std::env::var("FUZZ_SECONDS") {
+        Ok(text) => text
+            .parse()
+            .map_err(|_| anyhow::anyhow!("FUZZ_SECONDS={text:?} is not a whole number"))?,
+        Err(_) => 60,
     };
-    let started = std::time::Instant::now();
-    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .args(["test", &features, "--tests", "fuzz_", "--", "--nocapture"])
-        .args(["--test-threads", "1"])
-        .env("PROPTEST_CASES", &cases)
-        .stderr(std::process::Stdio::inherit())
-        .output()?;
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    print!("{stdout}");
-    let rows: Vec<String> = stdout
-        .lines()
-        // libtest may print "test NAME ... " before the harness's line.
-        .filter_map(|line| line.split_once("fuzz-summary ").map(|(_, row)| row))
-        .map(|row| format!("{row} |"))
-        .collect();
-    let mut table = String::from("| target | cases | time (s) | result |\n|---|---:|---:|---|\n");
-    for row in &rows {
-        table += row;
-        table.push('\n');
+    if !fuzz_command(&["--version"])
+        .output()
+        .is_ok_and(|out| out.status.success())
+    {
+        anyhow::bail!("`cargo fuzz` is missing: install it with `cargo install cargo-fuzz`");
     }
-    if !out.status.success() {
-        table += "\nThe run FAILED (a target panicked, hung or aborted): see its output.\n";
+    let started = std::time::Instant::now();
+    let list = fuzz_command(&["list"]).output()?;
+    if !list.status.success() {
+        anyhow::bail!("`cargo fuzz list` failed ({})", list.status);
+    }
+    let list = String::from_utf8(list.stdout)?;
+    // One build for every target; each run below finds it done.
+    let status = fuzz_command(&["build"]).status()?;
+    if !status.success() {
+        anyhow::bail!("`cargo fuzz build` failed ({status})");
+    }
+    let mut runs = Vec::new();
+    for target in list.lines().map(str::trim) {
+        runs.push(fuzz_target(target, seconds)?);
+    }
+    let mut table = String::from(
+        "| target | seconds | executions | per second | corpus kept | found |\n\
+         |---|---:|---:|---:|---:|---|\n",
+    );
+    for run in &runs {
+        let found = run.regression.as_ref().map_or("nothing".into(), |name| {
+            format!("**{name}**, kept in fuzz/regressions/{}/", run.target)
+        });
+        table += &format!(
+            "| {} | {} | {} | {} | {} inputs, {} bytes | {found} |\n",
+            run.target,
+            run.seconds,
+            run.executions,
+            run.executions / run.seconds.max(1),
+            run.corpus_files,
+            run.corpus_bytes,
+        );
     }
     let fuzz_stamp = stamp(started.elapsed())
         .replace("cargo xtask docs", "cargo xtask fuzz")
         .replace(
             "(release build)",
-            "(test profile: optimised, debug assertions on)",
+            "(libFuzzer: release build, debug assertions and overflow checks on)",
         );
     replace_block(
         "docs/fuzzing.md",
         "fuzz-results",
         &format!("{fuzz_stamp}\n{table}"),
     )?;
-    if !missing.is_empty() {
-        println!(
-            "{}",
-            standalone_skipped("the `standalone` feature", &missing)
-        );
-    }
-    if rows.is_empty() || !out.status.success() {
-        anyhow::bail!("the fuzz run failed or found no target");
+    let found: Vec<String> = runs
+        .iter()
+        .filter_map(|run| Some(format!("{} in {}", run.regression.as_ref()?, run.target)))
+        .collect();
+    if !found.is_empty() {
+        anyhow::bail!("fuzzing found {}", found.join(", "));
     }
     Ok(())
 }
 
-/// Every feature of Cargo.toml's `[features]` but `default` and `standalone`, comma-separated.
-fn features_but_standalone() -> nice_plug_xtask::Result<String> {
-    let manifest = std::fs::read_to_string("Cargo.toml")?;
-    let Some((_, table)) = manifest.split_once("\n[features]\n") else {
-        anyhow::bail!("Cargo.toml has no [features]");
-    };
-    let features: Vec<&str> = table
+/// What one target's run did.
+struct FuzzRun {
+    target: String,
+    seconds: u64,
+    executions: u64,
+    corpus_files: usize,
+    corpus_bytes: u64,
+    /// The failing input kept as a regression (crash-…, timeout-… or oom-…), if any.
+    regression: Option<String>,
+}
+
+/// Fuzzes `target` for `seconds` on its corpus (libFuzzer adds there every input that reaches
+/// new code) and its regressions; keeps a failing input as a regression; minimises the corpus.
+fn fuzz_target(target: &str, seconds: u64) -> nice_plug_xtask::Result<FuzzRun> {
+    let fuzz = Path::new(FUZZ_DIR);
+    let corpus = Path::new("corpus").join(target);
+    let regressions = Path::new("regressions").join(target);
+    // Where cargo-fuzz has libFuzzer write a failing input.
+    let artifacts = fuzz.join("artifacts").join(target);
+    std::fs::create_dir_all(fuzz.join(&corpus))?;
+    std::fs::create_dir_all(&artifacts)?;
+    let known = files_in(&artifacts)?;
+    let mut folders = vec![corpus.clone()];
+    if fuzz.join(&regressions).is_dir() {
+        folders.push(regressions.clone());
+    }
+    println!("fuzz {target}: {seconds} s");
+    let out = fuzz_command(&["run", target])
+        .args(&folders)
+        .arg("--")
+        .arg(format!("-max_total_time={seconds}"))
+        .arg("-print_final_stats=1")
+        // An input that runs this long is a hang, kept as a regression like a crash.
+        .arg("-timeout=10")
+        .stdout(std::process::Stdio::inherit())
+        .output()?;
+    let log = String::from_utf8_lossy(&out.stderr);
+    let executions = log
         .lines()
-        .take_while(|line| !line.starts_with('['))
-        // An entry starts its line; its list's continuation lines and comments do not.
-        .filter(|line| line.starts_with(|c: char| c.is_ascii_alphabetic()))
-        .filter_map(|line| line.split_once('=').map(|(name, _)| name.trim()))
-        .filter(|name| !["default", "standalone"].contains(name))
-        .collect();
-    Ok(features.join(","))
+        .find_map(|line| line.strip_prefix("stat::number_of_executed_units:"))
+        .and_then(|count| count.trim().parse().ok())
+        .unwrap_or(0);
+    let regression = if out.status.success() {
+        None
+    } else {
+        // libFuzzer's account of it: the panic, the input, the stack.
+        eprintln!("{log}");
+        let new = files_in(&artifacts)?
+            .into_iter()
+            .find(|path| !known.contains(path));
+        let Some(new) = new else {
+            anyhow::bail!("fuzz target {target} failed without keeping an input");
+        };
+        let name = new.file_name().unwrap().to_string_lossy().into_owned();
+        std::fs::create_dir_all(fuzz.join(&regressions))?;
+        std::fs::copy(&new, fuzz.join(&regressions).join(&name))?;
+        Some(name)
+    };
+    // The fewest inputs that reach all the code the corpus reaches.
+    let status = fuzz_command(&["cmin", target]).arg(&corpus).status()?;
+    if !status.success() {
+        anyhow::bail!("`cargo fuzz cmin {target}` failed ({status})");
+    }
+    let files = files_in(&fuzz.join(&corpus))?;
+    let mut corpus_bytes = 0;
+    for file in &files {
+        corpus_bytes += std::fs::metadata(file)?.len();
+    }
+    Ok(FuzzRun {
+        target: target.to_owned(),
+        seconds,
+        executions,
+        corpus_files: files.len(),
+        corpus_bytes,
+        regression,
+    })
+}
+
+/// `cargo fuzz <args>` in the fuzz crate: stable Rust accepts cargo-fuzz's unstable flags with
+/// `RUSTC_BOOTSTRAP=1`; no address sanitizer (the targets are Rust, and it makes them about five
+/// times slower); builds beside the workspace's, in their own target triple's folder.
+fn fuzz_command(args: &[&str]) -> Command {
+    let mut command = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    command
+        .current_dir(FUZZ_DIR)
+        .env("RUSTC_BOOTSTRAP", "1")
+        .arg("fuzz")
+        .args(args);
+    if matches!(args.first(), Some(&("build" | "run" | "cmin"))) {
+        let target_dir = std::path::absolute(target_dir()).unwrap_or_else(|_| target_dir());
+        command
+            .args(["--sanitizer", "none", "--target-dir"])
+            .arg(target_dir);
+    }
+    command
+}
+
+/// The files in `folder`, sorted.
+fn files_in(folder: &Path) -> nice_plug_xtask::Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(folder)? {
+        files.push(entry?.path());
+    }
+    files.sort();
+    Ok(files)
 }
 
 /// Replaces the text between `<!-- generated:NAME:begin -->` and `<!-- generated:NAME:end -->`.

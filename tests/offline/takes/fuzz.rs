@@ -189,8 +189,8 @@ proptest! {
     }
 }
 
-// The targets of `cargo xtask fuzz` (a million cases each there, proptest's default here): the
-// properties above, over every kind of input at once.
+// The properties above, over every kind of input at once (the libFuzzer targets `midi_take` and
+// `csv_lane`, fuzz/, search further with coverage guidance).
 
 #[test]
 fn fuzz_midi_take_files() {
