@@ -18,4 +18,4 @@ pub use render::{render_scene, render_scene_to_vec, RenderError, RenderObserver,
 pub use scene::{
     InputFile, InputFileError, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S,
 };
-pub use sinks::{OutputError, OutputFormat, OutputOptions, SampleFormat, WavError};
+pub use sinks::{Output, OutputError, OutputFormat, OutputOptions, SampleFormat, WavError};

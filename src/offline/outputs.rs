@@ -12,7 +12,7 @@ use super::memory::available_bytes;
 use super::render::{render_scene, RenderError, RenderObserver, RenderSummary};
 use super::scene::Scene;
 use super::sinks::{
-    remove_stale_temps, OutputError, OutputFormat, OutputOptions, PendingFile, Sink, SinkContext,
+    remove_stale_temps, Output, OutputError, OutputOptions, PendingFile, Sink, SinkContext,
 };
 use crate::engine::UnitOnset;
 
@@ -28,32 +28,26 @@ pub struct RenderReport {
     pub leftovers: Vec<PathBuf>,
 }
 
-/// Renders `scene` once and writes every file of `outputs` from that pass, each in the format
-/// its extension names. `scene_name` goes into the clips' metadata; `observer` hears what the
+/// Renders `scene` once and writes every file of `outputs` from that pass, each in its format. `scene_name` goes into the clips' metadata; `observer` hears what the
 /// render reports (a closure: the samples rendered so far), and is asked after every block
 /// whether to stop (then nothing is written).
 pub fn render_to_files(
     scene: &Scene,
     scene_name: &str,
-    outputs: &[PathBuf],
+    outputs: &[Output],
     options: &OutputOptions,
     observer: impl RenderObserver,
 ) -> Result<RenderReport, OutputError> {
-    let formats = outputs
-        .iter()
-        .map(|path| OutputFormat::of_path(path))
-        .collect::<Result<Vec<_>, _>>()?;
     let leftovers = outputs
         .iter()
-        .flat_map(|path| remove_stale_temps(path))
+        .flat_map(|output| remove_stale_temps(&output.path))
         .collect();
     // Each sink refuses here, before the render starts, what it knows it cannot write.
     let sinks = outputs
         .iter()
-        .zip(formats)
-        .map(|(path, format)| {
-            format.open(SinkContext {
-                path,
+        .map(|output| {
+            output.format.open(SinkContext {
+                path: &output.path,
                 scene,
                 scene_name,
                 options,
@@ -102,13 +96,13 @@ pub fn render_to_files(
 
 /// Refuses a render whose sinks may together keep more memory than the machine has available.
 fn refuse_what_cannot_fit(
-    outputs: &[PathBuf],
+    outputs: &[Output],
     sinks: &[Box<dyn Sink + '_>],
 ) -> Result<(), OutputError> {
     let files: Vec<(PathBuf, u64)> = outputs
         .iter()
         .zip(sinks)
-        .map(|(path, sink)| (path.clone(), sink.memory_bytes()))
+        .map(|(output, sink)| (output.path.clone(), sink.memory_bytes()))
         .filter(|&(_, bytes)| bytes > 0)
         .collect();
     let needed = files

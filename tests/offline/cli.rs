@@ -261,3 +261,30 @@ fn accuracy_refuses_lengths_and_rates_it_cannot_render() {
         );
     }
 }
+
+#[test]
+fn an_output_can_name_its_format_before_its_file() {
+    let directory = tempfile::tempdir().unwrap();
+    // The name picks the format whatever the extension says; a prefix that names no format is
+    // part of the file's name.
+    let output = sake_glug(
+        directory.path(),
+        &["render", "-o", "wav:pour.bin", "-o", "take:2.wav"],
+    );
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert_eq!(files_in(directory.path()), ["pour.bin", "take:2.wav"]);
+    let a = std::fs::read(directory.path().join("pour.bin")).unwrap();
+    let b = std::fs::read(directory.path().join("take:2.wav")).unwrap();
+    assert_eq!(a, b);
+    let missing = sake_glug(directory.path(), &["render", "-o", "wav:"]);
+    assert_eq!(missing.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&missing.stderr);
+    assert!(
+        stderr.contains("a file is missing after the format"),
+        "{stderr}"
+    );
+}

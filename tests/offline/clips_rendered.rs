@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use sake_glug::engine::UnitOnset;
 use sake_glug::offline::{
-    render_scene, render_to_files, OutputError, OutputOptions, RenderError, RenderObserver, Scene,
-    WavError,
+    render_scene, render_to_files, Output, OutputError, OutputOptions, RenderError, RenderObserver,
+    Scene, WavError,
 };
 
 use crate::clip_rules::{ahap, haptic};
@@ -53,7 +53,11 @@ fn render_all(directory: &Path) -> (Scene, Vec<PathBuf>) {
         .iter()
         .map(|name| directory.join(name))
         .collect();
-    render_to_files(&scene, "test", &outputs, &OutputOptions::default(), |_| {}).unwrap();
+    let files: Vec<Output> = outputs
+        .iter()
+        .map(|path| Output::of_path(path).unwrap())
+        .collect();
+    render_to_files(&scene, "test", &files, &OutputOptions::default(), |_| {}).unwrap();
     (scene, outputs)
 }
 
@@ -146,7 +150,7 @@ fn a_render_too_long_for_a_wav_is_refused_before_a_byte_is_written() {
     let directory = tempfile::tempdir().unwrap();
     // A day at 768 kHz in f32: about 250 GiB.
     let scene = Scene::parse("duration_s = 86400.0\nsample_rate = 768000\n").unwrap();
-    let output = directory.path().join("day.wav");
+    let output = Output::of_path(directory.path().join("day.wav")).unwrap();
     let error =
         render_to_files(&scene, "day", &[output], &OutputOptions::default(), |_| {}).unwrap_err();
     assert!(

@@ -7,7 +7,9 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use sake_glug::offline::{render_to_files, OutputError, OutputOptions, RenderObserver, Scene};
+use sake_glug::offline::{
+    render_to_files, Output, OutputError, OutputOptions, RenderObserver, Scene,
+};
 
 use crate::command::{files_in, sake_glug};
 
@@ -123,7 +125,8 @@ fn a_folder_among_the_targets_is_refused_before_the_render_and_changes_nothing()
     assert_eq!(files_in(dir), ["isdir.haptic", "keep.wav"]);
     // Before a single block is rendered.
     let mut blocks = 0;
-    let targets = [dir.join("keep.wav"), dir.join("isdir.haptic")];
+    let targets =
+        [dir.join("keep.wav"), dir.join("isdir.haptic")].map(|path| Output::of_path(path).unwrap());
     let scene = Scene::default();
     let options = OutputOptions::default();
     let result = render_to_files(&scene, "default", &targets, &options, |_| blocks += 1);
@@ -152,7 +155,10 @@ fn a_target_that_becomes_a_folder_during_the_render_changes_no_target() {
     let error = render_to_files(
         &scene,
         "late",
-        &[kept.clone(), folder.clone()],
+        &[
+            Output::of_path(&kept).unwrap(),
+            Output::of_path(&folder).unwrap(),
+        ],
         &OutputOptions::default(),
         AfterFirstBlock(Some(|| fs::create_dir(&folder).unwrap())),
     )

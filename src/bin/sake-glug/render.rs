@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sake_glug::engine::Preset;
 use sake_glug::offline::clips::HapticBand;
 use sake_glug::offline::{
-    human_bytes, render_to_files, OutputError, OutputFormat, OutputOptions, RenderError,
+    human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions, RenderError,
     RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
 };
 use sake_glug::text::printable;
@@ -22,12 +22,13 @@ use sake_glug::text::printable;
 pub struct RenderArgs {
     /// Scene files (TOML, see MODEL.md §10); without any, the built-in default pour.
     scenes: Vec<PathBuf>,
-    #[arg(short, long = "output", value_name = "FILE", help = format!(
-        "A file to write; its extension picks the format: {}. Repeat for several files from the \
-         same render. Default: pour.wav",
-        OutputFormat::extensions()
+    #[arg(short, long = "output", value_name = "FILE", value_parser = output, help = format!(
+        "A file to write; its extension picks the format ({}), or NAME:FILE names it ({}). \
+         Repeat for several files from the same render. Default: pour.wav",
+        OutputFormat::extensions(),
+        OutputFormat::names()
     ))]
-    outputs: Vec<PathBuf>,
+    outputs: Vec<Output>,
     /// Writes DIR/<scene name>.<extension> for every scene and every one of --formats.
     #[arg(long, value_name = "DIR", conflicts_with = "outputs")]
     out_dir: Option<PathBuf>,
@@ -76,7 +77,7 @@ struct Job {
     /// The scene file, or `None` for the built-in pour.
     scene: Option<PathBuf>,
     name: String,
-    outputs: Vec<PathBuf>,
+    outputs: Vec<Output>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -109,7 +110,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
         haptic_band: args.haptic_band,
     };
     let stop = Stop::on_signals();
-    let mut out = Output::new(jobs.len());
+    let mut out = Console::new(jobs.len());
     let mut failed = 0;
     for (index, job) in jobs.iter().enumerate() {
         let progress = |fraction| out.progress.set(index, fraction);
@@ -264,7 +265,10 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
             let name = name_of(&scene);
             let outputs = formats
                 .iter()
-                .map(|format| directory.join(format!("{name}.{}", format.extension())))
+                .map(|&format| Output {
+                    format,
+                    path: directory.join(format.file_name(&name)),
+                })
                 .collect();
             jobs.push(Job {
                 scene,
@@ -287,9 +291,22 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
         }
         let mut outputs = args.outputs.clone();
         if outputs.is_empty() {
-            outputs.push(PathBuf::from("pour.wav"));
+            outputs.push(Output {
+                format: OutputFormat::WAV,
+                path: PathBuf::from("pour.wav"),
+            });
         }
-        outputs.extend(args.plot.iter().cloned());
+        if let Some(plot) = &args.plot {
+            match Output::of_path(plot) {
+                Ok(output) if output.format == OutputFormat::PLOT => outputs.push(output),
+                _ => {
+                    return Err(format!(
+                        "--plot {}: the plot is a .png file",
+                        plot.display()
+                    ))
+                }
+            }
+        }
         let scene = scenes.into_iter().next().flatten();
         jobs.push(Job {
             name: name_of(&scene),
@@ -297,20 +314,12 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
             outputs,
         });
     }
-    for job in &jobs {
-        for output in &job.outputs {
-            OutputFormat::of_path(output).map_err(|error| error.to_string())?;
-        }
-        if let Some(plot) = &args.plot {
-            if !matches!(OutputFormat::of_path(plot), Ok(format) if format == OutputFormat::PLOT) {
-                return Err(format!(
-                    "--plot {}: the plot is a .png file",
-                    plot.display()
-                ));
-            }
-        }
-    }
     Ok(jobs)
+}
+
+/// `-o`'s value parser: `NAME:FILE` or a file its extension names.
+fn output(argument: &str) -> Result<Output, String> {
+    Output::parse(argument).map_err(|error| error.to_string())
 }
 
 fn render_job(
@@ -407,7 +416,7 @@ fn outside_note(outside: &[PathBuf]) -> String {
 /// progress bar (on a terminal only) on stderr. Output that cannot be written ends the printing,
 /// never the batch: a reader that has gone (`| head -1`) is no error, any other (a full disk)
 /// fails the command once every scene is written.
-struct Output {
+struct Console {
     progress: BatchProgress,
     /// Stdout can no longer be written.
     stdout_closed: bool,
@@ -415,7 +424,7 @@ struct Output {
     stdout_error: Option<io::Error>,
 }
 
-impl Output {
+impl Console {
     fn new(scenes: usize) -> Self {
         Self {
             progress: BatchProgress::new(scenes),

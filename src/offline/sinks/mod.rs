@@ -81,12 +81,15 @@ pub(crate) struct SinkContext<'a> {
 /// Opens the sink of one format, refusing up front what it knows it cannot write.
 type OpenSink = for<'a> fn(SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError>;
 
-/// A kind of file a render writes: its name in `--formats`, the extension of its files, and how
-/// its sink is opened.
+/// A kind of file a render writes: its name in `--formats` and `-o NAME:PATH`, the extension of
+/// its files, whether that extension alone picks it, and how its sink is opened.
 #[derive(Clone, Copy)]
 pub struct OutputFormat {
     name: &'static str,
     extension: &'static str,
+    /// Picked by its extension: false for a format that shares its extension with another (a
+    /// table in `.csv`, a 4-channel `.wav`), which is picked only by its name.
+    by_extension: bool,
     open: OpenSink,
 }
 
@@ -105,17 +108,46 @@ impl OutputFormat {
     /// Every format, in the order a file's extension is looked up.
     pub const ALL: &'static [Self] = &[Self::WAV, Self::HAPTIC, Self::AHAP, Self::CSV, Self::PLOT];
 
+    /// A format its extension picks.
     const fn new(name: &'static str, extension: &'static str, open: OpenSink) -> Self {
         Self {
             name,
             extension,
+            by_extension: true,
             open,
         }
+    }
+
+    /// A format that shares its extension with another: picked only by its name.
+    #[allow(dead_code)] // the first such formats are being added on their own branches
+    const fn named(name: &'static str, extension: &'static str, open: OpenSink) -> Self {
+        Self {
+            name,
+            extension,
+            by_extension: false,
+            open,
+        }
+    }
+
+    /// Its name, as `--formats` and `-o NAME:PATH` take it.
+    pub fn name(self) -> &'static str {
+        self.name
     }
 
     /// The extension (without the dot) its files get.
     pub fn extension(self) -> &'static str {
         self.extension
+    }
+
+    /// The name of its file for a scene called `stem` in `--out-dir`: `stem.ext`, or
+    /// `stem.name.ext` for a format its extension does not pick (so `.csv` samples and a
+    /// `.units.csv` table of the same scene sit side by side).
+    pub fn file_name(self, stem: &str) -> String {
+        if self.by_extension {
+            format!("{stem}.{}", self.extension)
+        } else {
+            format!("{stem}.{}.{}", self.name, self.extension)
+        }
     }
 
     /// The format of a name (any case).
@@ -126,12 +158,12 @@ impl OutputFormat {
             .find(|format| format.name.eq_ignore_ascii_case(name))
     }
 
-    /// The first format of [`OutputFormat::ALL`] with an extension (without the dot, any case).
+    /// The format an extension (without the dot, any case) picks.
     fn of_extension(extension: &str) -> Option<Self> {
         Self::ALL
             .iter()
             .copied()
-            .find(|format| format.extension.eq_ignore_ascii_case(extension))
+            .find(|format| format.by_extension && format.extension.eq_ignore_ascii_case(extension))
     }
 
     /// The format of a file, by its extension; an unknown or missing one is refused.
@@ -149,11 +181,13 @@ impl OutputFormat {
         one_of(Self::ALL.iter().map(|format| format.name.to_owned()))
     }
 
-    /// Every extension, as a list a message can end with: ".wav, .haptic, … or .png".
+    /// Every extension that picks a format, as a list a message can end with: ".wav, .haptic,
+    /// … or .png".
     pub fn extensions() -> String {
         one_of(
             Self::ALL
                 .iter()
+                .filter(|format| format.by_extension)
                 .map(|format| format!(".{}", format.extension)),
         )
     }
@@ -164,6 +198,44 @@ impl OutputFormat {
         context: SinkContext<'a>,
     ) -> Result<Box<dyn Sink + 'a>, OutputError> {
         (self.open)(context)
+    }
+}
+
+/// A file a render writes, and its format.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Output {
+    /// The format it is written in.
+    pub format: OutputFormat,
+    /// The file.
+    pub path: PathBuf,
+}
+
+impl Output {
+    /// The output a file names by its extension.
+    pub fn of_path(path: impl Into<PathBuf>) -> Result<Self, OutputError> {
+        let path = path.into();
+        Ok(Self {
+            format: OutputFormat::of_path(&path)?,
+            path,
+        })
+    }
+
+    /// `-o`'s argument: `NAME:PATH` (a format by name, e.g. `units:glugs.csv`), or a path whose
+    /// extension picks the format. A prefix before `:` that names no format is part of the path.
+    pub fn parse(argument: &str) -> Result<Self, OutputError> {
+        match argument
+            .split_once(':')
+            .and_then(|(name, path)| Some((OutputFormat::of_name(name)?, path)))
+        {
+            Some((_, "")) => Err(OutputError::NoPath {
+                argument: argument.to_owned(),
+            }),
+            Some((format, path)) => Ok(Self {
+                format,
+                path: PathBuf::from(path),
+            }),
+            None => Self::of_path(argument),
+        }
     }
 }
 
@@ -214,13 +286,21 @@ pub struct OutputOptions {
 pub enum OutputError {
     /// An output's extension names no format the renderer writes.
     #[error(
-        "{}: unknown output format; the extension must be {}",
+        "{}: unknown output format; the extension must be {}, or name the format as NAME:PATH \
+         ({})",
         path.display(),
-        OutputFormat::extensions()
+        OutputFormat::extensions(),
+        OutputFormat::names()
     )]
     UnknownFormat {
         /// The output asked for.
         path: PathBuf,
+    },
+    /// `-o NAME:` without a file.
+    #[error("-o {argument}: a file is missing after the format's name")]
+    NoPath {
+        /// The argument as given.
+        argument: String,
     },
     /// The render itself failed.
     #[error(transparent)]
