@@ -8,7 +8,8 @@
 //!   stops at once, naming the `apt-get install`.
 //! - `cargo xtask docs [--bench]`: regenerates every table and picture of docs/ from the current
 //!   code (the accuracy table and plot, the stability report, the pour plot, the presets as
-//!   scene files and VST3 preset files), stamped with the commit and the machine, and the cost
+//!   scene files and VST3 preset files, a VST3 ramp measured in Ardour when it is installed),
+//!   stamped with the commit and the machine, and the cost
 //!   figures of docs/scaling.md (callgrind, when valgrind is installed; the render benchmark's
 //!   last report, or a new one with `--bench`).
 //! - `cargo xtask screenshots`: the editor in a real window (the standalone app under Xvfb), idle
@@ -265,7 +266,35 @@ fn docs() -> nice_plug_xtask::Result<()> {
             "--plot",
             "docs/pour-plot.png",
         ],
-    )
+    )?;
+    vst3_ramp_figures()
+}
+
+/// The README's figures of a ramp in a VST3 host, measured by the Ardour host test (which
+/// rewrites them when asked to); skipped, with a line saying so, where Ardour is not installed.
+fn vst3_ramp_figures() -> nice_plug_xtask::Result<()> {
+    let has_ardour = Command::new("ardour7-lua")
+        .arg("--version")
+        .output()
+        .is_ok();
+    let python = ".venv/bin/python";
+    if !has_ardour || !Path::new(python).exists() {
+        println!(
+            "README.md: vst3-ramps kept: it needs Ardour 7 (`sudo apt-get install ardour`) and \
+             the host tests' .venv (`cargo xtask test` makes it)"
+        );
+        return Ok(());
+    }
+    build_bundles_and_cli()?;
+    let status = Command::new(python)
+        .args(["-m", "pytest", "-q", "tests/host/test_ardour.py"])
+        .env("SAKE_GLUG_WRITE_DOCS", "1")
+        .status()?;
+    if !status.success() {
+        anyhow::bail!("measuring the VST3 ramp in Ardour failed ({status})");
+    }
+    println!("README.md: vst3-ramps regenerated");
+    Ok(())
 }
 
 /// Seconds of the two renders whose difference gives the cost of a minute of pouring: start-up,
