@@ -109,7 +109,7 @@ enum Refused {
 }
 
 /// How often a render looks for Ctrl-C (it runs without the GIL, so Python cannot see it).
-const SIGNAL_CHECK_EVERY: Duration = Duration::from_millis(100);
+const SIGNAL_CHECK_EVERY: Duration = Duration::from_millis(20);
 
 /// Stops a render when Python has a signal to raise (KeyboardInterrupt), keeping the exception.
 struct PythonSignals {
