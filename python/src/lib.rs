@@ -77,13 +77,7 @@ impl SceneSource {
         let scene = match (self, preset) {
             (Self::BuiltIn, None) => Scene::default(),
             (Self::BuiltIn, Some(preset)) => Scene::parse(&Scene::preset_toml(preset))?,
-            (_, Some(_)) => {
-                return Err(Refused::Message(
-                    "give a scene or a preset, not both: a preset is the default pour with its \
-                     liquid and bottle"
-                        .into(),
-                ))
-            }
+            (_, Some(_)) => return Err(Refused::Message(NOT_BOTH.into())),
             (Self::File(path), None) => Scene::load(&path)?,
             (Self::Toml(text), None) => Scene::parse(&text)?,
         };
@@ -93,6 +87,10 @@ impl SceneSource {
         })
     }
 }
+
+/// A scene and a preset given together (`sake-glug render` refuses `--preset` with a scene).
+const NOT_BOTH: &str =
+    "give a scene or a preset, not both: a preset is the default pour with its liquid and bottle";
 
 /// Why a render gave no samples.
 #[derive(Debug, thiserror::Error)]
