@@ -6,7 +6,7 @@ import numpy.typing as npt
 
 __all__ = ["Preset", "SakeGlugError", "presets", "render"]
 
-Scene = Union[str, "os.PathLike[str]", Mapping[str, Any], None]
+_Scene = Union[str, "os.PathLike[str]", Mapping[str, Any], None]
 
 class SakeGlugError(ValueError):
     """A scene, preset or sample rate that Sake Glug refuses, with the command line's message."""
@@ -20,7 +20,7 @@ class Preset(NamedTuple):
     scene: str
 
 def render(
-    scene: Scene = None,
+    scene: _Scene = None,
     *,
     sample_rate: Optional[float] = None,
     preset: Optional[str] = None,
