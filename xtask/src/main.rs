@@ -4,7 +4,8 @@
 //!   built-in scene to `pour.wav`. Without the app's libraries (pkg-config's `alsa` and `jack`) it
 //!   skips the app and ends with one line naming the `apt-get install` that adds them.
 //! - `cargo xtask test`: every test: formatting and lints, the Rust suites, then the bundles in a
-//!   real VST3 host and the standalone app under a JACK server. Without the app's libraries it
+//!   real VST3 host and the standalone app under a JACK server, then the Python package installed
+//!   into the virtual environment and its pytest suite. Without the app's libraries it
 //!   stops at once, naming the `apt-get install`.
 //! - `cargo xtask docs [--bench]`: regenerates every table and picture of docs/ from the current
 //!   code (the accuracy table and plot, the stability report, the pour plot, the presets as
@@ -18,6 +19,8 @@
 //! - `cargo xtask fuzz`: every libFuzzer target of fuzz/ (`cargo install cargo-fuzz`) for
 //!   `FUZZ_SECONDS` each (60 by default), keeping their minimised corpora and any failing input
 //!   as a regression the ordinary tests replay; summarised in docs/fuzzing.md.
+//! - `cargo xtask wheel`: the Python package (python/) as a wheel in target/wheels/, built by
+//!   maturin from the virtual environment.
 //!
 //! Each product is built with only its features: the bundles with `editor` (which brings
 //! `plugin`), the command line with `cli`, the standalone app with `standalone`, so none compiles
@@ -79,7 +82,17 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             cargo(&["test", "--workspace", "--no-fail-fast", "--all-features"])?;
             build_bundles_and_cli()?;
             build_standalone()?;
-            host_tests()
+            host_tests()?;
+            python_tests()
+        }
+        Some("wheel") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            let python = venv(PYTHON_REQUIREMENTS)?;
+            // maturin puts the wheel in <target dir>/wheels.
+            run_in_venv(
+                &maturin_of(&python),
+                &["build", "--release", "-m", "python/Cargo.toml"],
+            )
         }
         Some("docs") => {
             nice_plug_xtask::chdir_workspace_root()?;
@@ -691,22 +704,74 @@ fn output(program: &str, args: &[&str]) -> nice_plug_xtask::Result<String> {
 /// The bundles loaded in pedalboard and the standalone app under JACK, in a virtual environment
 /// made on first use.
 fn host_tests() -> nice_plug_xtask::Result<()> {
+    let python = venv("tests/host/requirements.txt")?;
+    run(&python, &["-m", "pytest", "tests/host", "-q"])
+}
+
+/// What building the Python package needs besides pip (maturin).
+const PYTHON_REQUIREMENTS: &str = "python/requirements.txt";
+
+/// The Python package built (one release build, in the workspace's target directory) and
+/// installed into the virtual environment, then its tests, which compare it with the release CLI
+/// (pytest and NumPy come with the host tests' requirements).
+fn python_tests() -> nice_plug_xtask::Result<()> {
+    let python = venv(PYTHON_REQUIREMENTS)?;
+    // Without pip's build isolation: maturin comes from the requirements, not from the network.
+    run_in_venv(
+        &python,
+        &[
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--no-build-isolation",
+            "--force-reinstall",
+            "--no-deps",
+            "./python",
+        ],
+    )?;
+    run_in_venv(&python, &["-m", "pytest", "python/tests", "-q"])
+}
+
+/// The virtual environment's Python (.venv, made on first use) with `requirements` installed.
+fn venv(requirements: &str) -> nice_plug_xtask::Result<String> {
     let python = ".venv/bin/python";
     if !Path::new(python).exists() {
         run("python3", &["-m", "venv", ".venv"])?;
     }
     run(
         python,
-        &[
-            "-m",
-            "pip",
-            "install",
-            "--quiet",
-            "-r",
-            "tests/host/requirements.txt",
-        ],
+        &["-m", "pip", "install", "--quiet", "-r", requirements],
     )?;
-    run(python, &["-m", "pytest", "tests/host", "-q"])
+    Ok(python.into())
+}
+
+/// The maturin that `venv` installed beside `python`.
+fn maturin_of(python: &str) -> String {
+    Path::new(python)
+        .with_file_name("maturin")
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// Runs `program` as the activated virtual environment would (its bin/ first on PATH, where the
+/// build backend looks for maturin), building in the xtask's target directory (nice-plug's
+/// bundler clears cargo's variables), which the tests also read to find the CLI.
+fn run_in_venv(program: &str, args: &[&str]) -> nice_plug_xtask::Result<()> {
+    let bin = std::path::absolute(".venv/bin")?;
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    let path = std::env::join_paths(std::iter::once(bin).chain(std::env::split_paths(&path)))?;
+    let target_dir = std::path::absolute(target_dir())?;
+    let status = Command::new(program)
+        .args(args)
+        .env("PATH", path)
+        .env("CARGO_TARGET_DIR", target_dir)
+        .status()?;
+    if status.success() {
+        Ok(())
+    } else {
+        anyhow::bail!("`{program} {}` failed ({status})", args.join(" "))
+    }
 }
 
 fn cargo(args: &[&str]) -> nice_plug_xtask::Result<()> {

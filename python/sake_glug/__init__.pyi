@@ -1,0 +1,36 @@
+import os
+from typing import Any, List, Mapping, NamedTuple, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["Preset", "SakeGlugError", "presets", "render"]
+
+_Scene = Union[str, "os.PathLike[str]", Mapping[str, Any], None]
+
+class SakeGlugError(ValueError):
+    """A scene, preset or sample rate that Sake Glug refuses, with the command line's message."""
+
+class Preset(NamedTuple):
+    """A starting point of the plugin's preset menu."""
+
+    id: str
+    name: str
+    description: str
+    scene: str
+
+def render(
+    scene: _Scene = None,
+    *,
+    sample_rate: Optional[float] = None,
+    preset: Optional[str] = None,
+) -> npt.NDArray[np.float32]:
+    """Renders a scene and returns its samples (mono, float32), bit for bit those of
+    `sake-glug render` of the same scene.
+
+    scene: a scene file's path, scene TOML text (a str with a newline or `=`), a dict of the
+    same keys, or None for the built-in pour. sample_rate overrides the scene's (Hz); preset
+    renders a preset instead of a scene. Raises SakeGlugError for what it refuses."""
+
+def presets() -> List[Preset]:
+    """Every preset, in the order of the plugin's menu."""
