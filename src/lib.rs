@@ -20,6 +20,8 @@
 
 pub mod device;
 pub mod engine;
+#[cfg(feature = "fit")]
+pub mod fit;
 #[cfg(feature = "offline")]
 mod files;
 #[cfg(feature = "offline")]
