@@ -9,6 +9,8 @@ mod audio;
 mod error;
 mod estimate;
 mod onsets;
+#[cfg(feature = "plot")]
+mod plot;
 mod report;
 mod session;
 mod spectrum;
@@ -23,6 +25,8 @@ pub use estimate::{
     SessionFit,
 };
 pub use onsets::detect_onsets;
+#[cfg(feature = "plot")]
+pub use plot::draw_fit_plot;
 pub use report::report_markdown;
 pub use session::{RecordingSpec, Session, WeightSpec, DEFAULT_LIQUID};
 pub use spectrum::Spectrum;

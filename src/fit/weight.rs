@@ -103,12 +103,16 @@ impl WeightLog {
 }
 
 /// Refuses a log whose weight rises above its lowest weight so far by more than the scale's
-/// noise: by more than 6 times the noise (the median absolute step, a robust scale of its
-/// jitter) and more than 0.5 % of the heaviest reading. Gives the line and why.
+/// noise: by more than 6 times the noise and more than 0.5 % of the heaviest reading. The noise
+/// is the median absolute second difference (zero on a straight drain, so the drain itself does
+/// not count), scaled to a standard deviation. Gives the line and why.
 fn refuse_rising(rows: &[(u64, f64, f64)]) -> Result<(), (u64, String)> {
-    let mut steps: Vec<f64> = rows.windows(2).map(|pair| (pair[1].2 - pair[0].2).abs()).collect();
-    steps.sort_by(f64::total_cmp);
-    let noise = 1.4826 * steps[steps.len() / 2];
+    let mut curvature: Vec<f64> = rows
+        .windows(3)
+        .map(|three| (three[2].2 - 2.0 * three[1].2 + three[0].2).abs())
+        .collect();
+    curvature.sort_by(f64::total_cmp);
+    let noise = 1.4826 * curvature[curvature.len() / 2] / 6f64.sqrt();
     let heaviest = rows.iter().map(|row| row.2.abs()).fold(0.0, f64::max);
     let tolerance = (6.0 * noise).max(0.005 * heaviest);
     let (mut lowest, mut lowest_line) = (rows[0].2, rows[0].0);

@@ -59,8 +59,18 @@ pub fn write_fit(fit: &SessionFit, outputs: &FitOutputs) -> Result<Vec<(PathBuf,
         written.map_err(|error| write_error(&path, error))?;
         files.push(file);
     }
+    #[cfg(feature = "plot")]
+    if let Some(path) = &outputs.plot {
+        let file = pending(path, ".png")?;
+        super::draw_fit_plot(fit, file.temp_path()).map_err(|message| FitError::Write {
+            path: path.clone(),
+            message,
+        })?;
+        files.push(file);
+    }
+    #[cfg(not(feature = "plot"))]
     if outputs.plot.is_some() {
-        return Err(FitError::Outputs("the fit plot is not drawn yet".into()));
+        return Err(FitError::Outputs("this build draws no plots (feature `plot`)".into()));
     }
     PendingFile::commit_all(files).map_err(|error| FitError::Write {
         path: PathBuf::from("the fit's files"),
