@@ -20,10 +20,10 @@
 
 pub mod device;
 pub mod engine;
-#[cfg(feature = "fit")]
-pub mod fit;
 #[cfg(feature = "offline")]
 mod files;
+#[cfg(feature = "fit")]
+pub mod fit;
 #[cfg(feature = "offline")]
 pub mod offline;
 #[cfg(feature = "plugin")]

@@ -68,7 +68,10 @@ pub enum FitError {
         min: u32,
     },
     /// A recording with nothing in it.
-    #[error("`{key}`: {} is silent (peak {peak:e} after its offset is removed)", shown(path))]
+    #[error(
+        "`{key}`: {} is silent (peak {peak:e} after its offset is removed)",
+        shown(path)
+    )]
     Silent {
         /// The key naming it.
         key: String,
@@ -92,7 +95,9 @@ pub enum FitError {
         what: String,
     },
     /// A recording with neither a start volume nor a weight log: its volumes are unknown.
-    #[error("`{key}`: give `start_ml` or a `weight` log, so that the volume at each glug is known")]
+    #[error(
+        "`{key}`: give `start_ml` or a `weight` log, so that the volume at each glug is known"
+    )]
     NoVolume {
         /// The recording (`recording[1]`).
         key: String,

@@ -168,8 +168,10 @@ pub fn fit_session(session: &Session) -> Result<SessionFit, FitError> {
     }
     let (curves, rate_at_135) = fit_curves(session, &recordings, &rates, &mut warnings);
     for liquid in session.liquids() {
-        let members: Vec<&RecordingFit> =
-            recordings.iter().filter(|r| r.spec.liquid == liquid).collect();
+        let members: Vec<&RecordingFit> = recordings
+            .iter()
+            .filter(|r| r.spec.liquid == liquid)
+            .collect();
         liquids.push(fit_liquid(
             liquid,
             &members,
@@ -352,9 +354,14 @@ fn tilt_rates(recordings: &[RecordingFit], members: &[usize]) -> Vec<(f64, f64)>
     let mut groups: Vec<(f64, Vec<f64>)> = Vec::new();
     for &i in members {
         let recording = &recordings[i];
-        let Some(drain) = recording.drain else { continue };
+        let Some(drain) = recording.drain else {
+            continue;
+        };
         let tilt = recording.spec.tilt_deg;
-        match groups.iter_mut().find(|g| (g.0 - tilt).abs() < SAME_TILT_DEG) {
+        match groups
+            .iter_mut()
+            .find(|g| (g.0 - tilt).abs() < SAME_TILT_DEG)
+        {
             Some(group) => group.1.push(drain.rate_ml_per_s()),
             None => groups.push((tilt, vec![drain.rate_ml_per_s()])),
         }
@@ -369,8 +376,14 @@ fn tilt_rates(recordings: &[RecordingFit], members: &[usize]) -> Vec<(f64, f64)>
 
 /// The rate at 135° from measured `rates`: measured there, else linear between the tilts around
 /// it, else the nearest tilt's through the default h.
-fn rate_at_reference(rates: &[(f64, f64)], default_h: &crate::engine::pour::TiltCurve) -> Option<f64> {
-    if let Some(&(_, k)) = rates.iter().find(|r| (r.0 - REFERENCE_TILT_DEG).abs() < SAME_TILT_DEG) {
+fn rate_at_reference(
+    rates: &[(f64, f64)],
+    default_h: &crate::engine::pour::TiltCurve,
+) -> Option<f64> {
+    if let Some(&(_, k)) = rates
+        .iter()
+        .find(|r| (r.0 - REFERENCE_TILT_DEG).abs() < SAME_TILT_DEG)
+    {
         return Some(k);
     }
     let below = rates.iter().rev().find(|r| r.0 < REFERENCE_TILT_DEG);
@@ -403,7 +416,10 @@ fn fit_curves(
         at_135.insert(liquid.clone(), reference);
         let Some(reference) = reference else { continue };
         for &(tilt, k) in tilts {
-            match relative.iter_mut().find(|g| (g.0 - tilt).abs() < SAME_TILT_DEG) {
+            match relative
+                .iter_mut()
+                .find(|g| (g.0 - tilt).abs() < SAME_TILT_DEG)
+            {
                 Some(group) => group.1.push(k / reference),
                 None => relative.push((tilt, vec![k / reference])),
             }
@@ -413,7 +429,11 @@ fn fit_curves(
         .iter()
         .map(|(tilt, hs)| (*tilt, hs.iter().sum::<f64>() / hs.len() as f64))
         .collect();
-    if !drain.iter().any(|p| (p.0 - REFERENCE_TILT_DEG).abs() < SAME_TILT_DEG) && !drain.is_empty() {
+    if !drain
+        .iter()
+        .any(|p| (p.0 - REFERENCE_TILT_DEG).abs() < SAME_TILT_DEG)
+        && !drain.is_empty()
+    {
         drain.push((REFERENCE_TILT_DEG, 1.0));
     }
     for point in &mut drain {
@@ -431,10 +451,15 @@ fn fit_curves(
 
     let mut rests: Vec<(f64, Vec<f64>)> = Vec::new();
     for recording in recordings {
-        let Some(rest_ml) = recording.rest_ml else { continue };
+        let Some(rest_ml) = recording.rest_ml else {
+            continue;
+        };
         let tilt = recording.spec.tilt_deg;
         let share = (rest_ml / session.capacity_ml).clamp(0.0, 1.0);
-        match rests.iter_mut().find(|g| (g.0 - tilt).abs() < SAME_TILT_DEG) {
+        match rests
+            .iter_mut()
+            .find(|g| (g.0 - tilt).abs() < SAME_TILT_DEG)
+        {
             Some(group) => group.1.push(share),
             None => rests.push((tilt, vec![share])),
         }
@@ -474,11 +499,16 @@ fn curve_or_default(
         .filter(|p| p.0 < low - SAME_TILT_DEG || p.0 > high + SAME_TILT_DEG);
     measured.extend(outside);
     measured.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let measured: Vec<(f64, f64)> = measured.iter().map(|&(t, v)| (round(t), round(v))).collect();
+    let measured: Vec<(f64, f64)> = measured
+        .iter()
+        .map(|&(t, v)| (round(t), round(v)))
+        .collect();
     match curve.from_points(&measured) {
         Ok(_) => Some(measured),
         Err(error) => {
-            warnings.push(format!("`{key}` as fitted is no curve ({error}): kept at its default"));
+            warnings.push(format!(
+                "`{key}` as fitted is no curve ({error}): kept at its default"
+            ));
             None
         }
     }
@@ -490,9 +520,8 @@ fn unit_estimates(units: &[FittedUnit], capacity_ml: f64) -> Vec<f64> {
     let f = [of(&|u| u.frequency_hz[0]), of(&|u| u.frequency_hz[1])];
     let b = [of(&|u| u.decay_per_s[0]), of(&|u| u.decay_per_s[1])];
     let spread = |values: &[f64]| iqr(values) / median(values);
-    let log_sigma = |values: &[f64]| {
-        iqr(&values.iter().map(|v| v.ln()).collect::<Vec<_>>()) / NORMAL_IQR
-    };
+    let log_sigma =
+        |values: &[f64]| iqr(&values.iter().map(|v| v.ln()).collect::<Vec<_>>()) / NORMAL_IQR;
     let law = amplitude_law(units);
     let (silent_below, gain_db, amplitude_spread, r_squared) = match law {
         Some(line) if line.slope > 0.0 => {
@@ -564,7 +593,10 @@ fn fit_liquid(
     rates: &[(f64, f64)],
     warnings: &mut Vec<String>,
 ) -> LiquidFit {
-    let units: Vec<FittedUnit> = recordings.iter().flat_map(|r| r.units.iter().copied()).collect();
+    let units: Vec<FittedUnit> = recordings
+        .iter()
+        .flat_map(|r| r.units.iter().copied())
+        .collect();
     let values = unit_estimates(&units, capacity_ml);
     let intervals = bootstrap(&units, |sample| unit_estimates(sample, capacity_ml));
     let mut estimates: Vec<Estimate> = unit_keys()
@@ -578,8 +610,11 @@ fn fit_liquid(
         })
         .collect();
     // The pocket and its spread, from the intervals.
-    let with_weight: Vec<&RecordingFit> =
-        recordings.iter().copied().filter(|r| r.drain.is_some_and(|d| d.from_weight)).collect();
+    let with_weight: Vec<&RecordingFit> = recordings
+        .iter()
+        .copied()
+        .filter(|r| r.drain.is_some_and(|d| d.from_weight))
+        .collect();
     let pockets: Vec<f64> = with_weight
         .iter()
         .flat_map(|r| {
@@ -663,16 +698,31 @@ fn fit_liquid(
         }
     }
     let silent_key = Constant::SilentBelow.quantity().scene_key;
-    if let Some(estimate) = estimates.iter_mut().find(|e| e.key == silent_key && e.in_model) {
+    if let Some(estimate) = estimates
+        .iter_mut()
+        .find(|e| e.key == silent_key && e.in_model)
+    {
         if estimate.value >= capacity_ml {
-            kept_default.push((silent_key.to_owned(), "the fitted zero lies above the capacity".into()));
+            kept_default.push((
+                silent_key.to_owned(),
+                "the fitted zero lies above the capacity".into(),
+            ));
             estimate.in_model = false;
         }
     }
     for (key, why) in [
-        (Constant::Pocket.quantity().scene_key, "no weight log gave the outflow"),
-        (Constant::TimingJitter.quantity().scene_key, "too few intervals between units"),
-        (Control::PourTime.quantity().scene_key, "no drain rate was measured"),
+        (
+            Constant::Pocket.quantity().scene_key,
+            "no weight log gave the outflow",
+        ),
+        (
+            Constant::TimingJitter.quantity().scene_key,
+            "too few intervals between units",
+        ),
+        (
+            Control::PourTime.quantity().scene_key,
+            "no drain rate was measured",
+        ),
     ] {
         if !estimates.iter().any(|e| e.key == key) {
             kept_default.push((key.to_owned(), why.to_owned()));
@@ -686,8 +736,10 @@ fn fit_liquid(
         };
         if !fitted {
             let why = match curve {
-                Curve::Submerged => "the last glug shows where the mouth surfaces only above the \
-                                     silent volume; not estimated",
+                Curve::Submerged => {
+                    "the last glug shows where the mouth surfaces only above the \
+                                     silent volume; not estimated"
+                }
                 _ => "needs several tilts",
             };
             kept_default.push((curve.scene_key().to_owned(), why.to_owned()));
@@ -746,7 +798,8 @@ fn model_toml(
     curves: &FittedCurves,
     kept_default: &[(String, String)],
 ) -> String {
-    let mut table: toml::Table = toml::from_str(DEFAULT_SCENE).expect("the built-in scene is valid TOML");
+    let mut table: toml::Table =
+        toml::from_str(DEFAULT_SCENE).expect("the built-in scene is valid TOML");
     let mut set = |key: &str, value: toml::Value| match key.split_once('.') {
         Some((section, name)) => {
             table
@@ -767,7 +820,9 @@ fn model_toml(
         if let Some(points) = points {
             let points = points
                 .iter()
-                .map(|&(t, v)| toml::Value::Array(vec![toml::Value::Float(t), toml::Value::Float(v)]))
+                .map(|&(t, v)| {
+                    toml::Value::Array(vec![toml::Value::Float(t), toml::Value::Float(v)])
+                })
                 .collect();
             set(curve.scene_key(), toml::Value::Array(points));
         }

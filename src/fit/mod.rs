@@ -21,8 +21,7 @@ mod write;
 pub use audio::{Audio, MIN_SAMPLE_RATE_HZ};
 pub use error::FitError;
 pub use estimate::{
-    fit_session, DrainLine, Estimate, FittedCurves, FittedUnit, LiquidFit, RecordingFit,
-    SessionFit,
+    fit_session, DrainLine, Estimate, FittedCurves, FittedUnit, LiquidFit, RecordingFit, SessionFit,
 };
 pub use onsets::detect_onsets;
 #[cfg(feature = "plot")]

@@ -33,7 +33,9 @@ pub fn detect_onsets(samples: &[f64], sample_rate: f64, low_hz: f64) -> Vec<usiz
     }
     let mean = |from: usize, len: usize| (energy[from + len] - energy[from]) / len as f64;
     // The noise: the quietest tenth of the windows; the loudest window.
-    let mut windows: Vec<f64> = (0..samples.len() / after).map(|i| mean(i * after, after)).collect();
+    let mut windows: Vec<f64> = (0..samples.len() / after)
+        .map(|i| mean(i * after, after))
+        .collect();
     windows.sort_by(f64::total_cmp);
     let noise = windows[windows.len() / 10];
     let loudest = windows[windows.len() - 1];

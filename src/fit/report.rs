@@ -30,7 +30,11 @@ pub fn report_markdown(fit: &SessionFit) -> String {
         let (rate, from) = match recording.drain {
             Some(drain) => (
                 format!("{:.2}", drain.rate_ml_per_s()),
-                if drain.from_weight { "weight log" } else { "glug count × pocket" },
+                if drain.from_weight {
+                    "weight log"
+                } else {
+                    "glug count × pocket"
+                },
             ),
             None => ("—".into(), "—"),
         };
@@ -47,18 +51,26 @@ pub fn report_markdown(fit: &SessionFit) -> String {
             recording.rejected,
             rate,
             from,
-            recording.rest_ml.map_or("—".into(), |ml| format!("{ml:.1}")),
+            recording
+                .rest_ml
+                .map_or("—".into(), |ml| format!("{ml:.1}")),
         );
     }
     for liquid in &fit.liquids {
-        let _ = writeln!(out, "\n## Liquid `{}` ({} units)\n", liquid.liquid, liquid.units);
+        let _ = writeln!(
+            out,
+            "\n## Liquid `{}` ({} units)\n",
+            liquid.liquid, liquid.units
+        );
         let _ = writeln!(out, "| estimate | value | 95 % interval | in the model |");
         let _ = writeln!(out, "|---|---|---|---|");
         for estimate in &liquid.estimates {
             let interval = estimate
                 .interval
                 .filter(|(low, high)| low.is_finite() && high.is_finite())
-                .map_or("—".into(), |(low, high)| format!("{} … {}", sig(low), sig(high)));
+                .map_or("—".into(), |(low, high)| {
+                    format!("{} … {}", sig(low), sig(high))
+                });
             let _ = writeln!(
                 out,
                 "| `{}` | {} | {} | {} |",

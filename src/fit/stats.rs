@@ -54,7 +54,7 @@ impl Line {
         let sxx: f64 = points.iter().map(|p| (p.0 - mean_x).powi(2)).sum();
         let sxy: f64 = points.iter().map(|p| (p.0 - mean_x) * (p.1 - mean_y)).sum();
         let syy: f64 = points.iter().map(|p| (p.1 - mean_y).powi(2)).sum();
-        if !(sxx > 0.0) {
+        if sxx.is_nan() || sxx <= 0.0 {
             return None;
         }
         let slope = sxy / sxx;

@@ -125,7 +125,8 @@ pub fn fit_units(samples: &[f64], sample_rate: u32) -> RecordingUnits {
     let mut residual = samples.to_vec();
     let mut units = Vec::with_capacity(onsets.len());
     let mut rejected = 0;
-    let step = ((fs / (PENCIL_SAMPLES_PER_PERIOD * start_hz[1] * POLE_MATCH_RATIO)) as usize).max(1);
+    let step =
+        ((fs / (PENCIL_SAMPLES_PER_PERIOD * start_hz[1] * POLE_MATCH_RATIO)) as usize).max(1);
     for (index, &onset) in onsets.iter().enumerate() {
         let first = onset.saturating_sub((BEFORE_ONSET_S * fs) as usize);
         let next = onsets.get(index + 1).copied().unwrap_or(samples.len());
@@ -176,7 +177,12 @@ fn fit_unit(
                     && *decay > 0.5
                     && *decay < MAX_DECAY_PER_S
             })
-            .min_by(|a, b| (a.0 / start_hz[k]).ln().abs().total_cmp(&(b.0 / start_hz[k]).ln().abs()));
+            .min_by(|a, b| {
+                (a.0 / start_hz[k])
+                    .ln()
+                    .abs()
+                    .total_cmp(&(b.0 / start_hz[k]).ln().abs())
+            });
         if let Some(&(hz, decay)) = near {
             frequency_hz[k] = hz;
             decay_per_s[k] = decay;
@@ -224,8 +230,14 @@ fn fit_unit(
     let plausible = p.iter().all(|value| value.is_finite())
         && total > 0.0
         && unit.amplitude.iter().all(|&a| a >= -0.02 * total)
-        && unit.frequency_hz.iter().all(|&hz| hz > 0.0 && hz < fs / 2.0)
-        && unit.decay_per_s.iter().all(|&b| b > 0.0 && b < MAX_DECAY_PER_S)
+        && unit
+            .frequency_hz
+            .iter()
+            .all(|&hz| hz > 0.0 && hz < fs / 2.0)
+        && unit
+            .decay_per_s
+            .iter()
+            .all(|&b| b > 0.0 && b < MAX_DECAY_PER_S)
         && unit.r_squared >= MIN_R_SQUARED
         && (unit.onset_s - detected_s).abs() <= MAX_ONSET_SHIFT_S;
     for amplitude in &mut unit.amplitude {
@@ -261,12 +273,7 @@ fn pencil_poles(segment: &[f64], step: usize, fs: f64) -> Vec<(f64, f64)> {
         .complex_eigenvalues()
         .iter()
         .filter(|z| z.im > 0.0 && z.norm() > 0.0)
-        .map(|z| {
-            (
-                z.arg() * decimated_fs / TAU,
-                -z.norm().ln() * decimated_fs,
-            )
-        })
+        .map(|z| (z.arg() * decimated_fs / TAU, -z.norm().ln() * decimated_fs))
         .collect()
 }
 
@@ -287,7 +294,15 @@ fn onset_grid(
     for step in 0..=steps {
         let onset_s = detected_s + from + by * step as f64;
         for (k, column) in columns.iter_mut().enumerate() {
-            oscillate(column, first, fs, onset_s, frequency_hz[k], decay_per_s[k], |z, _| z.im);
+            oscillate(
+                column,
+                first,
+                fs,
+                onset_s,
+                frequency_hz[k],
+                decay_per_s[k],
+                |z, _| z.im,
+            );
         }
         let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
         let (g00, g01, g11) = (
@@ -297,7 +312,7 @@ fn onset_grid(
         );
         let (b0, b1) = (dot(&columns[0], data), dot(&columns[1], data));
         let det = g00 * g11 - g01 * g01;
-        if !(det.abs() > 1e-300) {
+        if det.is_nan() || det.abs() <= 1e-300 {
             continue;
         }
         let amplitude = [(g11 * b0 - g01 * b1) / det, (g00 * b1 - g01 * b0) / det];
@@ -314,7 +329,9 @@ fn onset_grid(
             best = Some((positive, explained, onset_s, amplitude));
         }
     }
-    best.map_or((detected_s, [0.0; 2]), |(_, _, onset_s, amplitude)| (onset_s, amplitude))
+    best.map_or((detected_s, [0.0; 2]), |(_, _, onset_s, amplitude)| {
+        (onset_s, amplitude)
+    })
 }
 
 /// Writes `value(z, τ)` to `out[n]` for z = e^((−B + i2πf)τ), τ = (first + n)/fs − onset_s, by
@@ -353,10 +370,21 @@ fn subtract(signal: &mut [f64], unit: &UnitFit, fs: f64) {
     for k in 0..2 {
         let amplitude = unit.amplitude[k];
         let mut component = vec![0.0; end - first];
-        oscillate(&mut component, first, fs, unit.onset_s, unit.frequency_hz[k], unit.decay_per_s[k], |z, _| amplitude * z.im);
+        oscillate(
+            &mut component,
+            first,
+            fs,
+            unit.onset_s,
+            unit.frequency_hz[k],
+            unit.decay_per_s[k],
+            |z, _| amplitude * z.im,
+        );
         model.iter_mut().zip(&component).for_each(|(m, c)| *m += c);
     }
-    signal[first..end].iter_mut().zip(&model).for_each(|(y, m)| *y -= m);
+    signal[first..end]
+        .iter_mut()
+        .zip(&model)
+        .for_each(|(y, m)| *y -= m);
 }
 
 /// Eq. 1 in one window, its parameters `[onset shift (ms), A1, A2, f1, f2, B1, B2]`.

@@ -25,7 +25,8 @@ impl WeightLog {
             column: column.map(str::to_owned),
             what,
         };
-        let text = std::fs::read_to_string(&spec.csv).map_err(|error| fail(0, None, error.to_string()))?;
+        let text =
+            std::fs::read_to_string(&spec.csv).map_err(|error| fail(0, None, error.to_string()))?;
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(true)
             .trim(csv::Trim::All)
@@ -52,7 +53,11 @@ impl WeightLog {
                 let field = record.get(index).unwrap_or("");
                 match field.parse::<f64>() {
                     Ok(value) if value.is_finite() => Ok(value),
-                    _ => Err(fail(line, Some(name), format!("{field:?} is not a finite number"))),
+                    _ => Err(fail(
+                        line,
+                        Some(name),
+                        format!("{field:?} is not a finite number"),
+                    )),
                 }
             };
             let time_s = number(time_index, &spec.time)?;
@@ -62,14 +67,20 @@ impl WeightLog {
                     return Err(fail(
                         line,
                         Some(&spec.time),
-                        format!("the time {time_s} s is not after the {previous} s of the row before"),
+                        format!(
+                            "the time {time_s} s is not after the {previous} s of the row before"
+                        ),
                     ));
                 }
             }
             rows.push((line, time_s, grams));
         }
         if rows.len() < 3 {
-            return Err(fail(0, None, format!("{} data rows: a drain line needs at least 3", rows.len())));
+            return Err(fail(
+                0,
+                None,
+                format!("{} data rows: a drain line needs at least 3", rows.len()),
+            ));
         }
         refuse_rising(&rows).map_err(|(line, what)| fail(line, Some(&spec.column), what))?;
         let density = spec.density_g_per_ml;

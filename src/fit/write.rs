@@ -27,7 +27,9 @@ pub fn write_fit(fit: &SessionFit, outputs: &FitOutputs) -> Result<Vec<(PathBuf,
     let mut texts: Vec<(PathBuf, String)> = Vec::new();
     match (&outputs.model, &outputs.out_dir) {
         (Some(_), Some(_)) => {
-            return Err(FitError::Outputs("give either -o MODEL.toml or --out-dir DIR, not both".into()))
+            return Err(FitError::Outputs(
+                "give either -o MODEL.toml or --out-dir DIR, not both".into(),
+            ))
         }
         (Some(path), None) => match fit.liquids.as_slice() {
             [liquid] => texts.push((path.clone(), liquid.model_toml.clone())),
@@ -35,13 +37,20 @@ pub fn write_fit(fit: &SessionFit, outputs: &FitOutputs) -> Result<Vec<(PathBuf,
                 return Err(FitError::Outputs(format!(
                     "the session has {} liquids ({}): write one model each with --out-dir DIR",
                     liquids.len(),
-                    liquids.iter().map(|l| l.liquid.as_str()).collect::<Vec<_>>().join(", ")
+                    liquids
+                        .iter()
+                        .map(|l| l.liquid.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 )))
             }
         },
         (None, Some(folder)) => {
             for liquid in &fit.liquids {
-                texts.push((folder.join(format!("{}.toml", liquid.liquid)), liquid.model_toml.clone()));
+                texts.push((
+                    folder.join(format!("{}.toml", liquid.liquid)),
+                    liquid.model_toml.clone(),
+                ));
             }
         }
         (None, None) => {}
@@ -70,7 +79,9 @@ pub fn write_fit(fit: &SessionFit, outputs: &FitOutputs) -> Result<Vec<(PathBuf,
     }
     #[cfg(not(feature = "plot"))]
     if outputs.plot.is_some() {
-        return Err(FitError::Outputs("this build draws no plots (feature `plot`)".into()));
+        return Err(FitError::Outputs(
+            "this build draws no plots (feature `plot`)".into(),
+        ));
     }
     PendingFile::commit_all(files).map_err(|error| FitError::Write {
         path: PathBuf::from("the fit's files"),

@@ -33,7 +33,8 @@ impl RenderObserver for Recorder {
         Some((self.sample_rate / 5.0) as usize)
     }
     fn bottle(&mut self, position: u64, volume_ml: f64) {
-        self.volume.push((position as f64 / self.sample_rate, volume_ml));
+        self.volume
+            .push((position as f64 / self.sample_rate, volume_ml));
     }
 }
 
@@ -43,7 +44,10 @@ pub fn render(text: &str) -> Rendered {
     let mut recorder = Recorder {
         sample_rate: scene.sample_rate as f64,
         onsets: Vec::new(),
-        volume: vec![(0.0, scene.config.capacity_ml * scene.lanes.fill_percent.value_at(0.0) / 100.0)],
+        volume: vec![(
+            0.0,
+            scene.config.capacity_ml * scene.lanes.fill_percent.value_at(0.0) / 100.0,
+        )],
     };
     let mut samples = Vec::new();
     render_scene(
@@ -65,9 +69,13 @@ pub fn render(text: &str) -> Rendered {
 
 /// Gaussian-like noise (a sum of uniforms from a fixed LCG) of standard deviation `sigma`.
 pub fn add_noise(samples: &mut [f32], sigma: f64, seed: u64) {
-    let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
     let mut uniform = || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
     };
     for sample in samples {

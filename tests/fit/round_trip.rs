@@ -23,22 +23,43 @@ fn relative(what: &str, value: f64, truth: f64, share: f64) {
 fn the_default_render_gives_back_the_papers_figures() {
     let rendered = render("sample_rate = 25000\ntilt_deg = 135.0\nseed = 7\n");
     let folder = tempfile::tempdir().unwrap();
-    let take = Take { name: "pour135", rendered: &rendered, tilt_deg: 135.0, liquid: None, weight: true, noise_db: Some(-30.0) };
+    let take = Take {
+        name: "pour135",
+        rendered: &rendered,
+        tilt_deg: 135.0,
+        liquid: None,
+        weight: true,
+        noise_db: Some(-30.0),
+    };
     let fit = fit(&write_session(folder.path(), 300.0, &[take]));
     relative("f1", estimate(&fit, 0, "glug.f1_hz"), 80.0, 0.02);
     relative("f2", estimate(&fit, 0, "glug.f2_hz"), 300.0, 0.02);
     relative("B1", estimate(&fit, 0, "glug.b1_per_s"), 45.0, 0.15);
     relative("B2", estimate(&fit, 0, "glug.b2_per_s"), 40.0, 0.15);
     close("c", estimate(&fit, 0, "viscosity_c"), 0.33, 0.02);
-    close("V0", estimate(&fit, 0, "amplitude.silent_below_ml"), 84.333, 5.0);
+    close(
+        "V0",
+        estimate(&fit, 0, "amplitude.silent_below_ml"),
+        84.333,
+        5.0,
+    );
     close("gain", estimate(&fit, 0, "output.gain_db"), -6.0206, 0.2);
-    relative("rate", estimate(&fit, 0, "outflow rate at 135° (ml/s)"), 60.0, 0.02);
+    relative(
+        "rate",
+        estimate(&fit, 0, "outflow rate at 135° (ml/s)"),
+        60.0,
+        0.02,
+    );
     relative("pour time", estimate(&fit, 0, "pour_time_s"), 5.0, 0.02);
     relative("pocket", estimate(&fit, 0, "bottle.pocket_ml"), 5.0, 0.1);
     // Every audible unit found (those above the noise gate), each onset within a millisecond.
     let units = &fit.recordings[0].units;
     let audible = rendered.onsets.iter().filter(|o| o.amplitude > 0.1).count();
-    assert!(units.len() >= audible, "{} units fitted of {audible} clearly audible", units.len());
+    assert!(
+        units.len() >= audible,
+        "{} units fitted of {audible} clearly audible",
+        units.len()
+    );
     for unit in units {
         let nearest = rendered
             .onsets
@@ -49,7 +70,10 @@ fn the_default_render_gives_back_the_papers_figures() {
     }
     let model = Scene::parse(&fit.liquids[0].model_toml).expect("the model is a scene");
     relative("model's f1", model.config.frequency_hz[0], 80.0, 0.02);
-    assert!(fit.liquids[0].kept_default.iter().any(|(key, _)| key == "curves.drain"));
+    assert!(fit.liquids[0]
+        .kept_default
+        .iter()
+        .any(|(key, _)| key == "curves.drain"));
 }
 
 /// Another bottle at 48 kHz, at two tilts with its own drain curve and an amplitude spread, noise
@@ -67,8 +91,22 @@ fn a_known_model_at_two_tilts_comes_back() {
         folder.path(),
         300.0,
         &[
-            Take { name: "steep", rendered: &steep, tilt_deg: 135.0, liquid: None, weight: true, noise_db: Some(-30.0) },
-            Take { name: "shallow", rendered: &shallow, tilt_deg: 100.0, liquid: None, weight: true, noise_db: Some(-30.0) },
+            Take {
+                name: "steep",
+                rendered: &steep,
+                tilt_deg: 135.0,
+                liquid: None,
+                weight: true,
+                noise_db: Some(-30.0),
+            },
+            Take {
+                name: "shallow",
+                rendered: &shallow,
+                tilt_deg: 100.0,
+                liquid: None,
+                weight: true,
+                noise_db: Some(-30.0),
+            },
         ],
     ));
     relative("f1", estimate(&fit, 0, "glug.f1_hz"), 110.0, 0.02);
@@ -76,10 +114,25 @@ fn a_known_model_at_two_tilts_comes_back() {
     relative("B1", estimate(&fit, 0, "glug.b1_per_s"), 30.0, 0.15);
     relative("B2", estimate(&fit, 0, "glug.b2_per_s"), 60.0, 0.15);
     close("c", estimate(&fit, 0, "viscosity_c"), 0.6, 0.02);
-    close("V0", estimate(&fit, 0, "amplitude.silent_below_ml"), 60.0, 5.0);
+    close(
+        "V0",
+        estimate(&fit, 0, "amplitude.silent_below_ml"),
+        60.0,
+        5.0,
+    );
     close("spread", estimate(&fit, 0, "amplitude.spread"), 0.2, 0.06);
-    relative("rate at 135°", estimate(&fit, 0, "outflow rate at 135° (ml/s)"), 60.0, 0.02);
-    relative("rate at 100°", estimate(&fit, 0, "outflow rate at 100° (ml/s)"), 30.0, 0.02);
+    relative(
+        "rate at 135°",
+        estimate(&fit, 0, "outflow rate at 135° (ml/s)"),
+        60.0,
+        0.02,
+    );
+    relative(
+        "rate at 100°",
+        estimate(&fit, 0, "outflow rate at 100° (ml/s)"),
+        30.0,
+        0.02,
+    );
     relative("pocket", estimate(&fit, 0, "bottle.pocket_ml"), 7.0, 0.1);
     let model = Scene::parse(&fit.liquids[0].model_toml).expect("the model is a scene");
     let h = sake_glug::engine::Curve::Drain.of(&model.config.curves);
@@ -100,18 +153,38 @@ fn two_liquids_give_two_models() {
         folder.path(),
         300.0,
         &[
-            Take { name: "thin", rendered: &thin, tilt_deg: 135.0, liquid: Some("water"), weight: true, noise_db: None },
-            Take { name: "thick", rendered: &thick, tilt_deg: 135.0, liquid: Some("honey"), weight: true, noise_db: None },
+            Take {
+                name: "thin",
+                rendered: &thin,
+                tilt_deg: 135.0,
+                liquid: Some("water"),
+                weight: true,
+                noise_db: None,
+            },
+            Take {
+                name: "thick",
+                rendered: &thick,
+                tilt_deg: 135.0,
+                liquid: Some("honey"),
+                weight: true,
+                noise_db: None,
+            },
         ],
     ));
     let out_dir = folder.path().join("models");
-    let outputs = FitOutputs { out_dir: Some(out_dir.clone()), ..FitOutputs::default() };
+    let outputs = FitOutputs {
+        out_dir: Some(out_dir.clone()),
+        ..FitOutputs::default()
+    };
     write_fit(&fit, &outputs).unwrap();
     for (liquid, c) in [("water", 0.2), ("honey", 0.7)] {
         let scene = Scene::load(&out_dir.join(format!("{liquid}.toml"))).unwrap();
         close(liquid, scene.lanes.viscosity.value_at(0.0), c, 0.02);
     }
-    let one_model = FitOutputs { model: Some(folder.path().join("m.toml")), ..FitOutputs::default() };
+    let one_model = FitOutputs {
+        model: Some(folder.path().join("m.toml")),
+        ..FitOutputs::default()
+    };
     let error = write_fit(&fit, &one_model).unwrap_err().to_string();
     assert!(error.contains("--out-dir"), "{error}");
 }

@@ -12,7 +12,12 @@ pub struct FitArgs {
     /// The session file (TOML): capacity_ml and the [[recording]]s (MODEL.md §13).
     session: PathBuf,
     /// The model of a session of one liquid: a scene file `sake-glug render` plays.
-    #[arg(short, long = "output", value_name = "MODEL.toml", conflicts_with = "out_dir")]
+    #[arg(
+        short,
+        long = "output",
+        value_name = "MODEL.toml",
+        conflicts_with = "out_dir"
+    )]
     output: Option<PathBuf>,
     /// Writes DIR/<liquid>.toml for every liquid of the session.
     #[arg(long, value_name = "DIR")]
