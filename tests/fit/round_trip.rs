@@ -172,11 +172,20 @@ fn two_liquids_give_two_models() {
         ],
     ));
     let out_dir = folder.path().join("models");
+    let (report, plot) = (folder.path().join("fit.md"), folder.path().join("fit.png"));
     let outputs = FitOutputs {
         out_dir: Some(out_dir.clone()),
+        report: Some(report.clone()),
+        plot: Some(plot.clone()),
         ..FitOutputs::default()
     };
     write_fit(&fit, &outputs).unwrap();
+    let report = std::fs::read_to_string(report).unwrap();
+    assert!(report.contains("## Liquid `honey`"), "{report}");
+    assert!(std::fs::read(&plot).unwrap().starts_with(b"\x89PNG"));
+    if let Ok(keep) = std::env::var("SAKE_GLUG_KEEP_FIT_PLOT") {
+        std::fs::copy(&plot, keep).unwrap();
+    }
     for (liquid, c) in [("water", 0.2), ("honey", 0.7)] {
         let scene = Scene::load(&out_dir.join(format!("{liquid}.toml"))).unwrap();
         close(liquid, scene.lanes.viscosity.value_at(0.0), c, 0.02);
