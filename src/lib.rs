@@ -22,6 +22,8 @@ pub mod device;
 pub mod engine;
 #[cfg(feature = "offline")]
 mod files;
+#[cfg(feature = "fit")]
+pub mod fit;
 #[cfg(feature = "offline")]
 pub mod offline;
 #[cfg(feature = "plugin")]

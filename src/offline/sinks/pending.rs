@@ -26,7 +26,7 @@ impl PendingFile {
     /// An empty temporary file in the target's folder (so that the rename is atomic), its name
     /// ending in `suffix` where a library infers the format from the name. A target that is a
     /// folder is refused here, before anything is rendered.
-    pub(super) fn beside(path: &Path, suffix: &str) -> io::Result<Self> {
+    pub(crate) fn beside(path: &Path, suffix: &str) -> io::Result<Self> {
         if is_folder(path) {
             return Err(folder_error());
         }
@@ -43,12 +43,12 @@ impl PendingFile {
 
     /// The temporary file, for a library that writes to a path (plotters).
     #[cfg(feature = "plot")]
-    pub(super) fn temp_path(&self) -> &Path {
+    pub(crate) fn temp_path(&self) -> &Path {
         self.temp.path()
     }
 
     /// A buffered writer at the start of the temporary file.
-    pub(super) fn writer(&self) -> io::Result<BufWriter<File>> {
+    pub(crate) fn writer(&self) -> io::Result<BufWriter<File>> {
         Ok(BufWriter::new(self.temp.reopen()?))
     }
 

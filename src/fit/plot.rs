@@ -1,0 +1,215 @@
+//! The fit plot: (a) the first units of the first recording with their fits, (b) its spectrum
+//! with f1 and f2, (c) Asum against V with the amplitude law (fig. 7), (d) V(t) per recording
+//! with its drain line (fig. 6).
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use super::estimate::SessionFit;
+
+const SIZE_PX: (u32, u32) = (1600, 1100);
+/// The span of panel (a) (s).
+const UNITS_SPAN_S: f64 = 0.4;
+
+/// Draws the plot of `fit` as a PNG at `path`; the error is plotters' message.
+pub fn draw_fit_plot(fit: &SessionFit, path: &Path) -> Result<(), String> {
+    let e = |error: &dyn std::fmt::Display| error.to_string();
+    plotters::style::register_font(
+        "sans-serif",
+        FontStyle::Normal,
+        epaint_default_fonts::UBUNTU_LIGHT,
+    )
+    .map_err(|_| "the embedded font did not load".to_string())?;
+    let root = BitMapBackend::new(path, SIZE_PX).into_drawing_area();
+    root.fill(&WHITE).map_err(|x| e(&x))?;
+    let panels = root.split_evenly((2, 2));
+    let colours = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
+
+    // (a) The recording and the fitted units over its first glugs.
+    if let Some(recording) = fit.recordings.iter().find(|r| !r.units.is_empty()) {
+        let fs = recording.audio.sample_rate as f64;
+        let from_s = (recording.units[0].fit.onset_s - 0.01).max(0.0);
+        let to_s = from_s + UNITS_SPAN_S;
+        let samples = &recording.audio.samples;
+        let range = (from_s * fs) as usize..((to_s * fs) as usize).min(samples.len());
+        let peak = samples[range.clone()]
+            .iter()
+            .fold(1e-9f64, |p, y| p.max(y.abs()))
+            * 1.1;
+        let mut chart = ChartBuilder::on(&panels[0])
+            .margin(12)
+            .caption(
+                format!("(a) {} and its unit fits", recording.spec.key),
+                ("sans-serif", 22),
+            )
+            .x_label_area_size(35)
+            .y_label_area_size(70)
+            .build_cartesian_2d(from_s..to_s, -peak..peak)
+            .map_err(|x| e(&x))?;
+        chart
+            .configure_mesh()
+            .x_desc("time (s)")
+            .draw()
+            .map_err(|x| e(&x))?;
+        chart
+            .draw_series(LineSeries::new(
+                range.clone().map(|n| (n as f64 / fs, samples[n])),
+                BLUE.mix(0.6),
+            ))
+            .map_err(|x| e(&x))?;
+        let model = range.map(|n| {
+            let t = n as f64 / fs;
+            (
+                t,
+                recording
+                    .units
+                    .iter()
+                    .map(|u| u.fit.value_at(t))
+                    .sum::<f64>(),
+            )
+        });
+        chart
+            .draw_series(LineSeries::new(model, RED))
+            .map_err(|x| e(&x))?;
+    }
+
+    // (b) The spectrum with f1 and f2.
+    if let Some(recording) = fit.recordings.first() {
+        let spectrum = &recording.spectrum;
+        let top_hz =
+            (3.0 * recording.start_hz[1]).min(spectrum.bin_hz * spectrum.power.len() as f64);
+        let points: Vec<(f64, f64)> = spectrum
+            .power
+            .iter()
+            .enumerate()
+            .map(|(bin, &p)| (bin as f64 * spectrum.bin_hz, 10.0 * p.max(1e-30).log10()))
+            .take_while(|p| p.0 <= top_hz)
+            .collect();
+        let high = points.iter().map(|p| p.1).fold(f64::MIN, f64::max);
+        let mut chart = ChartBuilder::on(&panels[1])
+            .margin(12)
+            .caption("(b) spectrum, f1 and f2", ("sans-serif", 22))
+            .x_label_area_size(35)
+            .y_label_area_size(70)
+            .build_cartesian_2d(0.0..top_hz, (high - 70.0)..(high + 3.0))
+            .map_err(|x| e(&x))?;
+        chart
+            .configure_mesh()
+            .x_desc("frequency (Hz)")
+            .y_desc("power (dB)")
+            .draw()
+            .map_err(|x| e(&x))?;
+        chart
+            .draw_series(LineSeries::new(points, BLUE))
+            .map_err(|x| e(&x))?;
+        if let Some(liquid) = fit.liquids.first() {
+            for key in ["glug.f1_hz", "glug.f2_hz"] {
+                if let Some(estimate) = liquid.estimates.iter().find(|x| x.key == key) {
+                    let f = estimate.value;
+                    chart
+                        .draw_series(std::iter::once(PathElement::new(
+                            vec![(f, high - 70.0), (f, high + 3.0)],
+                            RED,
+                        )))
+                        .map_err(|x| e(&x))?;
+                }
+            }
+        }
+    }
+
+    // (c) Asum against V, each liquid with its line.
+    let capacity = fit.session.capacity_ml;
+    let top = fit
+        .recordings
+        .iter()
+        .flat_map(|r| r.units.iter().map(|u| u.fit.amplitude_sum()))
+        .fold(1e-9, f64::max)
+        * 1.1;
+    let mut chart = ChartBuilder::on(&panels[2])
+        .margin(12)
+        .caption("(c) Asum against V (fig. 7)", ("sans-serif", 22))
+        .x_label_area_size(35)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..capacity, 0.0..top)
+        .map_err(|x| e(&x))?;
+    chart
+        .configure_mesh()
+        .x_desc("volume V (ml)")
+        .y_desc("Asum")
+        .draw()
+        .map_err(|x| e(&x))?;
+    for (index, liquid) in fit.liquids.iter().enumerate() {
+        let colour = colours[index % colours.len()];
+        let points = fit
+            .recordings
+            .iter()
+            .filter(|r| r.spec.liquid == liquid.liquid)
+            .flat_map(|r| r.units.iter())
+            .filter(|u| u.volume_ml.is_finite())
+            .map(|u| Circle::new((u.volume_ml, u.fit.amplitude_sum()), 2, colour.filled()));
+        chart.draw_series(points).map_err(|x| e(&x))?;
+        if let Some(line) = liquid.amplitude_law {
+            let zero = (-line.intercept / line.slope).clamp(0.0, capacity);
+            chart
+                .draw_series(LineSeries::new(
+                    [(zero, line.at(zero)), (capacity, line.at(capacity))],
+                    colour.stroke_width(2),
+                ))
+                .map_err(|x| e(&x))?;
+        }
+    }
+
+    // (d) V(t) per recording with its drain line.
+    let end_s = fit
+        .recordings
+        .iter()
+        .map(|r| r.audio.duration_s())
+        .fold(0.1, f64::max);
+    let mut chart = ChartBuilder::on(&panels[3])
+        .margin(12)
+        .caption(
+            "(d) V(t) per recording and its line (fig. 6)",
+            ("sans-serif", 22),
+        )
+        .x_label_area_size(35)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..end_s, 0.0..capacity)
+        .map_err(|x| e(&x))?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc("V (ml)")
+        .draw()
+        .map_err(|x| e(&x))?;
+    for (index, recording) in fit.recordings.iter().enumerate() {
+        let colour = colours[index % colours.len()];
+        if let Some(log) = &recording.weight {
+            chart
+                .draw_series(
+                    log.points
+                        .iter()
+                        .map(|&p| Circle::new(p, 2, colour.filled())),
+                )
+                .map_err(|x| e(&x))?;
+        }
+        if let Some(drain) = recording.drain {
+            let (from, to) = drain.span_s;
+            chart
+                .draw_series(LineSeries::new(
+                    [(from, drain.line.at(from)), (to, drain.line.at(to))],
+                    colour.stroke_width(2),
+                ))
+                .map_err(|x| e(&x))?
+                .label(format!("{}°", recording.spec.tilt_deg))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|x| e(&x))?;
+    root.present().map_err(|x| e(&x))
+}

@@ -1,0 +1,99 @@
+//! The recording's power spectrum (Welch's method, rustfft) and its two strongest peaks: the
+//! starting guess of f1 and f2 for every unit, and panel (b) of the plot.
+
+use rustfft::num_complex::Complex;
+use rustfft::FftPlanner;
+
+/// Segment length (s) of Welch's average: fine enough to part 80 Hz from its neighbours (a
+/// decaying component's peak is B/π wide, about 14 Hz at 45 /s).
+const SEGMENT_S: f64 = 0.16;
+
+/// Lowest frequency searched for a peak (Hz): below it lie drift and handling noise.
+const LOWEST_PEAK_HZ: f64 = 20.0;
+
+/// A peak weaker than this fraction of the strongest (in power) is no component: 30 dB.
+const WEAKEST_PEAK: f64 = 1e-3;
+
+/// Two peaks closer than this ratio of frequencies are one component.
+const PEAK_SEPARATION: f64 = 1.4;
+
+/// The averaged power spectrum of a recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spectrum {
+    /// Spacing of the bins (Hz).
+    pub bin_hz: f64,
+    /// Power per bin, from 0 Hz to Nyquist.
+    pub power: Vec<f64>,
+}
+
+impl Spectrum {
+    /// Welch's estimate of the power spectrum of `samples` at `sample_rate` (Hann windows, half
+    /// overlapping, a power of two long).
+    pub fn of(samples: &[f64], sample_rate: f64) -> Self {
+        let len = ((SEGMENT_S * sample_rate) as usize)
+            .next_power_of_two()
+            .min(samples.len().next_power_of_two().max(16));
+        let fft = FftPlanner::new().plan_fft_forward(len);
+        let window: Vec<f64> = (0..len)
+            .map(|n| 0.5 - 0.5 * (std::f64::consts::TAU * n as f64 / len as f64).cos())
+            .collect();
+        let mut power = vec![0.0; len / 2 + 1];
+        let mut buffer = vec![Complex::new(0.0, 0.0); len];
+        let mut start = 0;
+        loop {
+            for (n, slot) in buffer.iter_mut().enumerate() {
+                let sample = samples.get(start + n).copied().unwrap_or(0.0);
+                *slot = Complex::new(sample * window[n], 0.0);
+            }
+            fft.process(&mut buffer);
+            for (bin, slot) in power.iter_mut().enumerate() {
+                *slot += buffer[bin].norm_sqr();
+            }
+            start += len / 2;
+            if start + len > samples.len() {
+                break;
+            }
+        }
+        Self {
+            bin_hz: sample_rate / len as f64,
+            power,
+        }
+    }
+
+    /// The frequencies (Hz, ascending) of the one or two strongest peaks at least
+    /// [`PEAK_SEPARATION`] apart, a peak's frequency refined by a parabola through its bin and
+    /// its neighbours' log powers.
+    pub fn peaks(&self) -> Vec<f64> {
+        let first_bin = ((LOWEST_PEAK_HZ / self.bin_hz).ceil() as usize).max(1);
+        let mut maxima: Vec<(f64, f64)> = (first_bin..self.power.len().saturating_sub(1))
+            .filter(|&bin| {
+                self.power[bin] > self.power[bin - 1] && self.power[bin] >= self.power[bin + 1]
+            })
+            .map(|bin| (self.refined_hz(bin), self.power[bin]))
+            .collect();
+        maxima.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let Some(&(strongest_hz, strongest)) = maxima.first() else {
+            return Vec::new();
+        };
+        let second = maxima.iter().find(|&&(hz, power)| {
+            power >= WEAKEST_PEAK * strongest
+                && (hz / strongest_hz).max(strongest_hz / hz) >= PEAK_SEPARATION
+        });
+        let mut peaks = vec![strongest_hz];
+        peaks.extend(second.map(|&(hz, _)| hz));
+        peaks.sort_by(f64::total_cmp);
+        peaks
+    }
+
+    fn refined_hz(&self, bin: usize) -> f64 {
+        let log = |bin: usize| self.power[bin].max(1e-300).ln();
+        let (left, centre, right) = (log(bin - 1), log(bin), log(bin + 1));
+        let curvature = left - 2.0 * centre + right;
+        let offset = if curvature < 0.0 {
+            (0.5 * (left - right) / curvature).clamp(-0.5, 0.5)
+        } else {
+            0.0
+        };
+        (bin as f64 + offset) * self.bin_hz
+    }
+}
