@@ -19,9 +19,21 @@ pub use controls::{
     Control, ControlSource, ControlSpec, ControlValues, Controls, DeviceInput, Lane, PerControl,
 };
 use output::OutputStage;
-pub use pour::{Pour, PourStats, UnitOnset};
+pub use pour::{Outflow, Pour, PourStats, UnitOnset};
 pub use presets::{Preset, PresetValue, PRESETS};
 pub use synthesis::{AnchoredF32, RecursiveF32, RecursiveF64, Synthesis, GRID};
+
+/// How the engine voiced a unit as it started: what a table of units or a clip needs to know
+/// beyond its [`UnitOnset`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Voicing {
+    /// The output gain G (linear, on its ramp: MODEL.md §6) at the unit's first sounding sample.
+    pub output_gain: f64,
+    /// Whether any of its components sounds: false for a unit given up by the start budget or
+    /// the component cap (§11), or whose components are all omitted (§6: a(V_i) = 0 below the
+    /// amplitude law's zero, a frequency of 0 or at/above Nyquist, −240 dB or weaker).
+    pub audible: bool,
+}
 
 /// Renders the model into caller-provided buffers; allocation-free after construction.
 ///
@@ -40,6 +52,8 @@ pub struct Engine<S: Synthesis = AnchoredF32> {
     last_unit: Option<UnitOnset>,
     /// The sample after the last one during which liquid flowed or a component sounded.
     active_until: u64,
+    /// What the last sample rendered poured.
+    last_outflow: Outflow,
 }
 
 impl Engine {
@@ -62,6 +76,7 @@ impl<S: Synthesis> Engine<S> {
             output: OutputStage::new(sample_rate),
             last_unit: None,
             active_until: 0,
+            last_outflow: Outflow::NONE,
         };
         engine.reset();
         engine
@@ -91,6 +106,10 @@ impl<S: Synthesis> Engine<S> {
         self.resting_under = None;
         self.last_unit = None;
         self.active_until = 0;
+        self.last_outflow = Outflow {
+            volume_before_ml: self.pour.volume_ml(),
+            ..Outflow::NONE
+        };
         self.output.reset();
     }
 
@@ -103,6 +122,13 @@ impl<S: Synthesis> Engine<S> {
     /// The residual volume V (ml).
     pub fn volume_ml(&self) -> f64 {
         self.pour.volume_ml()
+    }
+
+    /// What the last sample rendered poured: V at its start, its outflow, whether the mouth was
+    /// submerged (MODEL.md §3, §4). A sample of a block in which the pour rested is the same as
+    /// the step it rested after (no outflow, the same V).
+    pub fn last_outflow(&self) -> Outflow {
+        self.last_outflow
     }
 
     /// Units started and skipped since the reset.
@@ -182,14 +208,14 @@ impl<S: Synthesis> Engine<S> {
         self.process_observed(controls, out, &mut |_, _| {});
     }
 
-    /// [`Engine::process`], telling `on_unit` of every unit that starts, in order, with the output
-    /// gain (linear) at its first sample: what the clip writers need to know of the glugs.
-    /// Watching changes no sample.
+    /// [`Engine::process`], telling `on_unit` of every unit that starts, in order, with how it
+    /// was voiced (the output gain at its first sample, whether it sounds): what the clip and
+    /// table writers need to know of the glugs. Watching changes no sample.
     pub fn process_observed(
         &mut self,
         controls: &Controls,
         out: &mut [f32],
-        on_unit: &mut impl FnMut(&UnitOnset, f64),
+        on_unit: &mut impl FnMut(&UnitOnset, Voicing),
     ) {
         if self.synthesis.is_empty() && self.rests_under(controls) {
             // Settled under the same controls: the block is silence, so it costs a fill and not
@@ -219,7 +245,7 @@ impl<S: Synthesis> Engine<S> {
         &mut self,
         controls: &Controls,
         out: &mut [f32],
-        on_unit: &mut impl FnMut(&UnitOnset, f64),
+        on_unit: &mut impl FnMut(&UnitOnset, Voicing),
     ) {
         out.fill(0.0);
         self.step_pour(controls, out.len(), on_unit);
@@ -240,7 +266,7 @@ impl<S: Synthesis> Engine<S> {
         &mut self,
         controls: &Controls,
         len: usize,
-        on_unit: &mut impl FnMut(&UnitOnset, f64),
+        on_unit: &mut impl FnMut(&UnitOnset, Voicing),
     ) {
         if self.rests_under(controls) {
             return;
@@ -255,11 +281,18 @@ impl<S: Synthesis> Engine<S> {
         } = self;
         let span_start = *span_start;
         let mut start_unit = |onset: &UnitOnset| {
-            synthesis.start_unit(onset);
+            let audible = synthesis.start_unit(onset);
             *last_unit = Some(*onset);
             // Heard from the sample after the one it starts in (MODEL.md §6: t_i ≤ t_n).
             let first_heard = (onset.sample + 1 - span_start) as usize;
-            on_unit(onset, output.gain_ahead(&controls.gain_db, first_heard));
+            let output_gain = output.gain_ahead(&controls.gain_db, first_heard);
+            on_unit(
+                onset,
+                Voicing {
+                    output_gain,
+                    audible,
+                },
+            );
         };
         // Constant over the span, as constants or as samples that do not change (a ramp's end
         // inside the block).
@@ -283,6 +316,9 @@ impl<S: Synthesis> Engine<S> {
             self.active_until = until;
         }
         let last_step = (len > 0).then_some(advanced.last);
+        if let Some(step) = last_step {
+            self.last_outflow = step;
+        }
         self.resting_under = match last_step {
             Some(step) if step.amount_ml == 0.0 && !step.refilled => constant,
             _ => None,

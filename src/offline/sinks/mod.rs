@@ -22,9 +22,9 @@ use std::path::{Path, PathBuf};
 
 use super::clips::HapticBand;
 use super::memory::human_bytes;
-use super::render::{RenderError, RenderSummary};
+use super::render::{BottleReport, RenderError, RenderSummary};
 use super::scene::Scene;
-use crate::engine::UnitOnset;
+use crate::engine::{UnitOnset, Voicing};
 use clip::ClipSink;
 pub(crate) use pending::{remove_stale_temps, PendingFile};
 #[cfg(feature = "plot")]
@@ -44,17 +44,18 @@ pub(crate) trait Sink {
     fn samples(&mut self, _block: &[f32]) -> Result<(), OutputError> {
         Ok(())
     }
-    /// A unit started (at `(onset.sample + onset.fraction) / fs`), heard at the output gain
-    /// `output_gain` (linear, on its ramp: MODEL.md §6).
-    fn unit_started(&mut self, _onset: &UnitOnset, _output_gain: f64) {}
-    /// The most samples this sink lets pass between two [`Sink::bottle`] reports, or `None` for
-    /// none. The render then cuts time at least this finely (which changes no sample), and
-    /// reports after every block: as often as the most demanding sink asked.
-    fn bottle_every(&self) -> Option<usize> {
+    /// A unit started (at `(onset.sample + onset.fraction) / fs`), voiced as `voicing` says (its
+    /// output gain, linear, on its ramp: MODEL.md §6, and whether it sounds).
+    fn unit_started(&mut self, _onset: &UnitOnset, _voicing: Voicing) {}
+    /// The next position after `position` (samples rendered) at which this sink wants a
+    /// [`Sink::bottle`] report, or `None` for none. The render then ends a block there (which
+    /// changes no sample), and reports after every block: as often as the most demanding sink
+    /// asked.
+    fn next_bottle_report(&self, _position: u64) -> Option<u64> {
         None
     }
-    /// The residual volume (ml) after `position` samples.
-    fn bottle(&mut self, _position: u64, _volume_ml: f64) {}
+    /// The bottle after a block.
+    fn bottle(&mut self, _report: &BottleReport) {}
     /// The most memory (bytes) the sink may keep, as far as it can tell before the render: a
     /// render whose sinks may need more than the machine has is refused before it starts.
     fn memory_bytes(&self) -> u64 {
