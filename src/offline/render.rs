@@ -6,7 +6,7 @@ use super::scene::{LaneBuffers, Scene, MAX_DURATION_S};
 use crate::device::midi::{CcDecoder, DeviceAction};
 use crate::device::midi_take::TimedInput;
 use crate::engine::synthesis::SILENT_DECAY_EXPONENT;
-use crate::engine::{Controls, Outflow, DrainMode, Engine, Lane, PerControl, UnitOnset, Voicing};
+use crate::engine::{Controls, DrainMode, Engine, Lane, Outflow, PerControl, UnitOnset, Voicing};
 
 /// Samples per engine call offline; any size gives the same samples.
 const BLOCK_SIZE: usize = 4096;
@@ -153,7 +153,9 @@ pub fn render_scene<E: From<RenderError>>(
         let report_at = observer.next_bottle_report(position);
         // A report asked for at or before `position` (which no observer should) ends the block
         // after one sample, never at once.
-        let len = report_at.map_or(len, |next| len.min(next.saturating_sub(position).max(1) as usize));
+        let len = report_at.map_or(len, |next| {
+            len.min(next.saturating_sub(position).max(1) as usize)
+        });
         let mut controls = scene.controls(position, &mut lanes, len);
         take.override_lanes(&mut controls);
         let block = &mut block[..len];

@@ -16,6 +16,8 @@ mod haptic;
 mod pending;
 #[cfg(feature = "plot")]
 mod plot;
+mod state;
+mod units;
 mod wav;
 
 use std::path::{Path, PathBuf};
@@ -24,6 +26,7 @@ use super::clips::HapticBand;
 use super::memory::human_bytes;
 use super::render::{BottleReport, RenderError, RenderSummary};
 use super::scene::Scene;
+use super::tables::{StateRate, StateRateError};
 use crate::engine::{UnitOnset, Voicing};
 use clip::ClipSink;
 pub(crate) use pending::{remove_stale_temps, PendingFile};
@@ -31,7 +34,7 @@ pub(crate) use pending::{remove_stale_temps, PendingFile};
 use plot::open as open_plot;
 
 pub use ahap::ahap_json;
-pub use csv::write_csv_samples;
+pub use csv::{write_csv_samples, TIMED_SAMPLE_COLUMNS};
 pub use haptic::haptic_json;
 #[cfg(feature = "plot")]
 pub use plot::{draw_pour_plot, PlotData, PlotError, Waveform};
@@ -105,9 +108,21 @@ impl OutputFormat {
     pub const CSV: Self = Self::new("csv", "csv", csv::open);
     /// `.png`: the pour plot (feature `plot`; a build without it refuses a plot by name).
     pub const PLOT: Self = Self::new("png", "png", open_plot);
+    /// `units` (`.csv`): one row per glug unit (MODEL.md §13).
+    pub const UNITS: Self = Self::named("units", "csv", units::open);
+    /// `state` (`.csv`): the bottle at the state rate (MODEL.md §13).
+    pub const STATE: Self = Self::named("state", "csv", state::open);
 
     /// Every format, in the order a file's extension is looked up.
-    pub const ALL: &'static [Self] = &[Self::WAV, Self::HAPTIC, Self::AHAP, Self::CSV, Self::PLOT];
+    pub const ALL: &'static [Self] = &[
+        Self::WAV,
+        Self::HAPTIC,
+        Self::AHAP,
+        Self::CSV,
+        Self::PLOT,
+        Self::UNITS,
+        Self::STATE,
+    ];
 
     /// A format its extension picks.
     const fn new(name: &'static str, extension: &'static str, open: OpenSink) -> Self {
@@ -120,7 +135,6 @@ impl OutputFormat {
     }
 
     /// A format that shares its extension with another: picked only by its name.
-    #[allow(dead_code)] // the first such formats are being added on their own branches
     const fn named(name: &'static str, extension: &'static str, open: OpenSink) -> Self {
         Self {
             name,
@@ -280,6 +294,10 @@ pub struct OutputOptions {
     pub sample_format: SampleFormat,
     /// The actuator band the `.haptic` frequencies map to.
     pub haptic_band: HapticBand,
+    /// A `.csv` of samples gets a header and a time column (Syntacts' form has neither).
+    pub csv_time: bool,
+    /// Rows per second of a `state` table.
+    pub state_rate: StateRate,
 }
 
 /// Why the files of a render could not be written.
@@ -331,6 +349,9 @@ pub enum OutputError {
     /// A WAV file could not be written.
     #[error(transparent)]
     Wav(#[from] WavError),
+    /// A `state` table's rate does not fit the render.
+    #[error(transparent)]
+    StateRate(#[from] StateRateError),
     /// Another file could not be written.
     #[error("cannot write {}: {source}", path.display())]
     Io {
