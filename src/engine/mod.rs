@@ -19,6 +19,7 @@ pub use controls::{
     Control, ControlSource, ControlSpec, ControlValues, Controls, DeviceInput, Lane, PerControl,
 };
 use output::OutputStage;
+use pour::MAX_ONSETS_PER_SAMPLE;
 pub use pour::{Outflow, Pour, PourStats, UnitOnset};
 pub use presets::{Preset, PresetValue, PRESETS};
 pub use synthesis::{AnchoredF32, RecursiveF32, RecursiveF64, Synthesis, GRID};
@@ -54,6 +55,12 @@ pub struct Engine<S: Synthesis = AnchoredF32> {
     active_until: u64,
     /// What the last sample rendered poured.
     last_outflow: Outflow,
+    /// The sample after the block being rendered.
+    block_end: u64,
+    /// Units that started in the last sample of the last block, with their voicing: they are
+    /// first heard in the next block, whose gain is only known when it comes, and are reported
+    /// at its start (so that what a unit is heard at never depends on where a block ends).
+    deferred: [Option<(UnitOnset, Voicing)>; MAX_ONSETS_PER_SAMPLE as usize],
 }
 
 impl Engine {
@@ -77,6 +84,8 @@ impl<S: Synthesis> Engine<S> {
             last_unit: None,
             active_until: 0,
             last_outflow: Outflow::NONE,
+            block_end: 0,
+            deferred: [None; MAX_ONSETS_PER_SAMPLE as usize],
         };
         engine.reset();
         engine
@@ -110,6 +119,7 @@ impl<S: Synthesis> Engine<S> {
             volume_before_ml: self.pour.volume_ml(),
             ..Outflow::NONE
         };
+        self.deferred = [None; MAX_ONSETS_PER_SAMPLE as usize];
         self.output.reset();
     }
 
@@ -210,13 +220,31 @@ impl<S: Synthesis> Engine<S> {
 
     /// [`Engine::process`], telling `on_unit` of every unit that starts, in order, with how it
     /// was voiced (the output gain at its first sample, whether it sounds): what the clip and
-    /// table writers need to know of the glugs. Watching changes no sample.
+    /// table writers need to know of the glugs. Watching changes no sample. A unit that starts
+    /// in a block's last sample is told of at the start of the next block, whose gain it is
+    /// first heard at; after the last block, [`Engine::report_deferred_units`] tells of it.
     pub fn process_observed(
         &mut self,
         controls: &Controls,
         out: &mut [f32],
         on_unit: &mut impl FnMut(&UnitOnset, Voicing),
     ) {
+        if out.is_empty() {
+            return;
+        }
+        for deferred in &mut self.deferred {
+            if let Some((onset, voicing)) = deferred.take() {
+                let output_gain = self.output.gain_ahead(&controls.gain_db, 0);
+                on_unit(
+                    &onset,
+                    Voicing {
+                        output_gain,
+                        ..voicing
+                    },
+                );
+            }
+        }
+        self.block_end = self.sample + out.len() as u64;
         if self.synthesis.is_empty() && self.rests_under(controls) {
             // Settled under the same controls: the block is silence, so it costs a fill and not
             // a walk over its grid periods. An empty bank only needs the last period start.
@@ -237,6 +265,15 @@ impl<S: Synthesis> Engine<S> {
             let span = (out.len() - done).min((period_end - self.sample) as usize);
             self.process_span(&controls.offset(done), &mut out[done..done + span], on_unit);
             done += span;
+        }
+    }
+
+    /// Tells `on_unit` of the units that started in the last sample rendered, heard at the gain
+    /// as it would hold on (there is no next block to say otherwise): called after the last
+    /// block of a render.
+    pub fn report_deferred_units(&mut self, on_unit: &mut impl FnMut(&UnitOnset, Voicing)) {
+        for (onset, voicing) in self.deferred.iter_mut().filter_map(Option::take) {
+            on_unit(&onset, voicing);
         }
     }
 
@@ -277,22 +314,26 @@ impl<S: Synthesis> Engine<S> {
             last_unit,
             output,
             sample: span_start,
+            block_end,
+            deferred,
             ..
         } = self;
-        let span_start = *span_start;
+        let (span_start, block_end) = (*span_start, *block_end);
         let mut start_unit = |onset: &UnitOnset| {
             let audible = synthesis.start_unit(onset);
             *last_unit = Some(*onset);
             // Heard from the sample after the one it starts in (MODEL.md §6: t_i ≤ t_n).
             let first_heard = (onset.sample + 1 - span_start) as usize;
-            let output_gain = output.gain_ahead(&controls.gain_db, first_heard);
-            on_unit(
-                onset,
-                Voicing {
-                    output_gain,
-                    audible,
-                },
-            );
+            // The gain as it would hold on past the block: final unless another block follows.
+            let voicing = Voicing {
+                output_gain: output.gain_ahead(&controls.gain_db, first_heard),
+                audible,
+            };
+            if onset.sample + 1 < block_end {
+                on_unit(onset, voicing);
+            } else if let Some(free) = deferred.iter_mut().find(|slot| slot.is_none()) {
+                *free = Some((*onset, voicing));
+            }
         };
         // Constant over the span, as constants or as samples that do not change (a ramp's end
         // inside the block).

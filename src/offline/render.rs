@@ -195,6 +195,7 @@ pub fn render_scene<E: From<RenderError>>(
             }
         }
     }
+    engine.report_deferred_units(&mut |onset, voicing| observer.unit_started(onset, voicing));
     let end = total.unwrap_or_else(|| engine.active_until().max(written));
     write_zeros(&mut sink, end - written)?;
     Ok(RenderSummary {

@@ -50,7 +50,7 @@ pub struct RenderArgs {
     /// state:FILE.csv).
     #[arg(long, value_name = "FILE.csv", conflicts_with = "out_dir")]
     state: Option<PathBuf>,
-    #[arg(long, value_name = "HZ", value_parser = state_rate, help = format!(
+    #[arg(long, value_name = "HZ", value_parser = state_rate, allow_negative_numbers = true, help = format!(
         "Rows per second of the state table: above 0, at most the sample rate. Default: {}",
         StateRate::DEFAULT_HZ
     ))]
