@@ -1,10 +1,11 @@
 //! Sinks: one per kind of file a render writes, all fed by the same single pass.
 //!
 //! A `Sink` hears the render as it runs (its samples block by block, each unit as it starts,
-//! the bottle's volume if it asks for it) and, once the render has ended, completes its file in
+//! the bottle at the samples it asks for) and, once the render has ended, completes its file in
 //! a temporary file beside the target (a `PendingFile`); [`super::render_to_files`] replaces
 //! the targets only once every sink has finished. What a sink needs to keep it keeps itself: a
-//! WAV or CSV streams its samples to disk and keeps no units; the clips keep the glugs.
+//! WAV or CSV streams its samples to disk and keeps no units, the tables stream their rows; the
+//! clips keep the glugs.
 //!
 //! Every format is one entry of [`OutputFormat::ALL`]: adding one is a file here with its sink
 //! and an `open` function, and an entry in that table.

@@ -24,6 +24,7 @@ pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, O
         writer,
         schedule,
         bytes: head.len() as u64,
+        end_unknown: context.scene.duration_samples().is_none(),
         samples_seen: 0,
         unconfirmed: VecDeque::new(),
         line: String::new(),
@@ -37,11 +38,14 @@ struct StateFile {
     schedule: StateSchedule,
     /// Bytes written so far.
     bytes: u64,
+    /// The scene has no duration: its render may run past its end.
+    end_unknown: bool,
     /// Samples of the output so far.
     samples_seen: u64,
     /// `(sample, where its row starts in the file)` of the rows whose sample the output has not
-    /// reached yet: a render without a duration runs on past its end until it sees it, and the
-    /// rows past the end are cut off when it is known.
+    /// reached yet, while the end is unknown: a render without a duration runs on past its end
+    /// until it sees it, and the rows past the end are cut off when it is known (16 bytes a
+    /// row of silence, until the next sound).
     unconfirmed: VecDeque<(u64, u64)>,
     /// The row being written, reused.
     line: String,
@@ -74,7 +78,7 @@ impl Sink for StateFile {
         }
         self.line.clear();
         write_row(StateRow::COLUMNS, &row, &mut self.line);
-        if sample >= self.samples_seen {
+        if self.end_unknown && sample >= self.samples_seen {
             self.unconfirmed.push_back((sample, self.bytes));
         }
         self.bytes += self.line.len() as u64;
