@@ -24,5 +24,5 @@ pub use scene::{
 };
 pub use sinks::{Output, OutputError, OutputFormat, OutputOptions, SampleFormat, WavError};
 pub use tables::{
-    header, render_tables, Column, StateRate, StateRateError, StateRow, Tables, UnitRow,
+    csv_header, render_tables, Column, StateRate, StateRateError, StateRow, Tables, UnitRow,
 };

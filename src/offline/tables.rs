@@ -22,7 +22,7 @@ pub struct Column<R> {
 }
 
 /// The header line of a table (without its line end): the columns' names, comma-separated.
-pub fn header<R>(columns: &[Column<R>]) -> String {
+pub fn csv_header<R>(columns: &[Column<R>]) -> String {
     columns
         .iter()
         .map(|column| column.name)

@@ -9,7 +9,7 @@ use std::path::Path;
 use sake_glug::engine::synthesis::reference;
 use sake_glug::engine::{Pour, UnitOnset, Voicing};
 use sake_glug::offline::{
-    header, render_scene, render_tables, render_to_files, Output, OutputFormat, OutputOptions,
+    csv_header, render_scene, render_tables, render_to_files, Output, OutputFormat, OutputOptions,
     RenderError, RenderObserver, Scene, StateRate, StateRow, UnitRow,
 };
 
@@ -266,8 +266,8 @@ fn the_files_hold_the_same_rows_as_memory_also_past_an_unknown_end() {
 
 #[test]
 fn headers_are_derived_from_the_columns() {
-    assert_eq!(header(UnitRow::COLUMNS), UNITS_HEADER);
-    assert_eq!(header(StateRow::COLUMNS), STATE_HEADER);
+    assert_eq!(csv_header(UnitRow::COLUMNS), UNITS_HEADER);
+    assert_eq!(csv_header(StateRow::COLUMNS), STATE_HEADER);
 }
 
 #[test]

@@ -7,7 +7,7 @@ use std::io::{self, BufWriter, Write};
 
 use super::{OutputError, PendingFile, Sink, SinkContext};
 use crate::offline::render::BottleReport;
-use crate::offline::tables::{header, write_row, StateRow, StateSchedule};
+use crate::offline::tables::{csv_header, write_row, StateRow, StateSchedule};
 use crate::offline::RenderSummary;
 
 /// The sink of a `state` output; a rate above the scene's sample rate is refused here.
@@ -15,7 +15,7 @@ pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, O
     let schedule = StateSchedule::new(context.scene, context.options.state_rate)?;
     let file = PendingFile::beside(context.path, ".csv").map_err(OutputError::io(context.path))?;
     let mut writer = file.writer().map_err(OutputError::io(context.path))?;
-    let head = format!("{}\n", header(StateRow::COLUMNS));
+    let head = format!("{}\n", csv_header(StateRow::COLUMNS));
     writer
         .write_all(head.as_bytes())
         .map_err(OutputError::io(context.path))?;

@@ -6,14 +6,14 @@ use std::io::{self, BufWriter, Write};
 
 use super::{OutputError, PendingFile, Sink, SinkContext};
 use crate::engine::{UnitOnset, Voicing};
-use crate::offline::tables::{header, write_row, UnitRow};
+use crate::offline::tables::{csv_header, write_row, UnitRow};
 use crate::offline::RenderSummary;
 
 /// The sink of a `units` output.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
     let file = PendingFile::beside(context.path, ".csv").map_err(OutputError::io(context.path))?;
     let mut writer = file.writer().map_err(OutputError::io(context.path))?;
-    writeln!(writer, "{}", header(UnitRow::COLUMNS)).map_err(OutputError::io(context.path))?;
+    writeln!(writer, "{}", csv_header(UnitRow::COLUMNS)).map_err(OutputError::io(context.path))?;
     Ok(Box::new(UnitsFile {
         file,
         writer,
