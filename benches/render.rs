@@ -15,7 +15,7 @@ use std::process::Command;
 use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use sake_glug::engine::UnitOnset;
+use sake_glug::engine::{UnitOnset, Voicing};
 use sake_glug::offline::{render_scene, RenderError, RenderObserver, Scene};
 
 /// One hour of repeated pours at 48 kHz: every 10 s tilt up and pour 6 s, put the bottle
@@ -73,7 +73,7 @@ fn render_into(scene: &Scene, out: &mut Vec<f32>) -> usize {
 struct Units(Vec<UnitOnset>);
 
 impl RenderObserver for Units {
-    fn unit_started(&mut self, onset: &UnitOnset, _output_gain: f64) {
+    fn unit_started(&mut self, onset: &UnitOnset, _voicing: Voicing) {
         self.0.push(*onset);
     }
 }

@@ -19,9 +19,22 @@ pub use controls::{
     Control, ControlSource, ControlSpec, ControlValues, Controls, DeviceInput, Lane, PerControl,
 };
 use output::OutputStage;
-pub use pour::{Pour, PourStats, UnitOnset};
+use pour::MAX_ONSETS_PER_SAMPLE;
+pub use pour::{Outflow, Pour, PourStats, UnitOnset};
 pub use presets::{Preset, PresetValue, PRESETS};
 pub use synthesis::{AnchoredF32, RecursiveF32, RecursiveF64, Synthesis, GRID};
+
+/// How the engine voiced a unit as it started: what a table of units or a clip needs to know
+/// beyond its [`UnitOnset`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Voicing {
+    /// The output gain G (linear, on its ramp: MODEL.md §6) at the unit's first sounding sample.
+    pub output_gain: f64,
+    /// Whether any of its components sounds: false for a unit given up by the start budget or
+    /// the component cap (§11), or whose components are all omitted (§6: a(V_i) = 0 below the
+    /// amplitude law's zero, a frequency of 0 or at/above Nyquist, −240 dB or weaker).
+    pub audible: bool,
+}
 
 /// Renders the model into caller-provided buffers; allocation-free after construction.
 ///
@@ -40,6 +53,14 @@ pub struct Engine<S: Synthesis = AnchoredF32> {
     last_unit: Option<UnitOnset>,
     /// The sample after the last one during which liquid flowed or a component sounded.
     active_until: u64,
+    /// What the last sample rendered poured.
+    last_outflow: Outflow,
+    /// The sample after the block being rendered.
+    block_end: u64,
+    /// Units that started in the last sample of the last block, with their voicing: they are
+    /// first heard in the next block, whose gain is only known when it comes, and are reported
+    /// at its start (so that what a unit is heard at never depends on where a block ends).
+    deferred: [Option<(UnitOnset, Voicing)>; MAX_ONSETS_PER_SAMPLE as usize],
 }
 
 impl Engine {
@@ -62,6 +83,9 @@ impl<S: Synthesis> Engine<S> {
             output: OutputStage::new(sample_rate),
             last_unit: None,
             active_until: 0,
+            last_outflow: Outflow::NONE,
+            block_end: 0,
+            deferred: [None; MAX_ONSETS_PER_SAMPLE as usize],
         };
         engine.reset();
         engine
@@ -91,6 +115,11 @@ impl<S: Synthesis> Engine<S> {
         self.resting_under = None;
         self.last_unit = None;
         self.active_until = 0;
+        self.last_outflow = Outflow {
+            volume_before_ml: self.pour.volume_ml(),
+            ..Outflow::NONE
+        };
+        self.deferred = [None; MAX_ONSETS_PER_SAMPLE as usize];
         self.output.reset();
     }
 
@@ -103,6 +132,13 @@ impl<S: Synthesis> Engine<S> {
     /// The residual volume V (ml).
     pub fn volume_ml(&self) -> f64 {
         self.pour.volume_ml()
+    }
+
+    /// What the last sample rendered poured: V at its start, its outflow, whether the mouth was
+    /// submerged (MODEL.md §3, §4). A sample of a block in which the pour rested is the same as
+    /// the step it rested after (no outflow, the same V).
+    pub fn last_outflow(&self) -> Outflow {
+        self.last_outflow
     }
 
     /// Units started and skipped since the reset.
@@ -182,15 +218,33 @@ impl<S: Synthesis> Engine<S> {
         self.process_observed(controls, out, &mut |_, _| {});
     }
 
-    /// [`Engine::process`], telling `on_unit` of every unit that starts, in order, with the output
-    /// gain (linear) at its first sample: what the clip writers need to know of the glugs.
-    /// Watching changes no sample.
+    /// [`Engine::process`], telling `on_unit` of every unit that starts, in order, with how it
+    /// was voiced (the output gain at its first sample, whether it sounds): what the clip and
+    /// table writers need to know of the glugs. Watching changes no sample. A unit that starts
+    /// in a block's last sample is told of at the start of the next block, whose gain it is
+    /// first heard at; after the last block, [`Engine::report_deferred_units`] tells of it.
     pub fn process_observed(
         &mut self,
         controls: &Controls,
         out: &mut [f32],
-        on_unit: &mut impl FnMut(&UnitOnset, f64),
+        on_unit: &mut impl FnMut(&UnitOnset, Voicing),
     ) {
+        if out.is_empty() {
+            return;
+        }
+        for deferred in &mut self.deferred {
+            if let Some((onset, voicing)) = deferred.take() {
+                let output_gain = self.output.gain_ahead(&controls.gain_db, 0);
+                on_unit(
+                    &onset,
+                    Voicing {
+                        output_gain,
+                        ..voicing
+                    },
+                );
+            }
+        }
+        self.block_end = self.sample + out.len() as u64;
         if self.synthesis.is_empty() && self.rests_under(controls) {
             // Settled under the same controls: the block is silence, so it costs a fill and not
             // a walk over its grid periods. An empty bank only needs the last period start.
@@ -214,12 +268,21 @@ impl<S: Synthesis> Engine<S> {
         }
     }
 
+    /// Tells `on_unit` of the units that started in the last sample rendered, heard at the gain
+    /// as it would hold on (there is no next block to say otherwise): called after the last
+    /// block of a render.
+    pub fn report_deferred_units(&mut self, on_unit: &mut impl FnMut(&UnitOnset, Voicing)) {
+        for (onset, voicing) in self.deferred.iter_mut().filter_map(Option::take) {
+            on_unit(&onset, voicing);
+        }
+    }
+
     /// Renders a span that lies within one grid period.
     fn process_span(
         &mut self,
         controls: &Controls,
         out: &mut [f32],
-        on_unit: &mut impl FnMut(&UnitOnset, f64),
+        on_unit: &mut impl FnMut(&UnitOnset, Voicing),
     ) {
         out.fill(0.0);
         self.step_pour(controls, out.len(), on_unit);
@@ -240,7 +303,7 @@ impl<S: Synthesis> Engine<S> {
         &mut self,
         controls: &Controls,
         len: usize,
-        on_unit: &mut impl FnMut(&UnitOnset, f64),
+        on_unit: &mut impl FnMut(&UnitOnset, Voicing),
     ) {
         if self.rests_under(controls) {
             return;
@@ -251,15 +314,26 @@ impl<S: Synthesis> Engine<S> {
             last_unit,
             output,
             sample: span_start,
+            block_end,
+            deferred,
             ..
         } = self;
-        let span_start = *span_start;
+        let (span_start, block_end) = (*span_start, *block_end);
         let mut start_unit = |onset: &UnitOnset| {
-            synthesis.start_unit(onset);
+            let audible = synthesis.start_unit(onset);
             *last_unit = Some(*onset);
             // Heard from the sample after the one it starts in (MODEL.md §6: t_i ≤ t_n).
             let first_heard = (onset.sample + 1 - span_start) as usize;
-            on_unit(onset, output.gain_ahead(&controls.gain_db, first_heard));
+            // The gain as it would hold on past the block: final unless another block follows.
+            let voicing = Voicing {
+                output_gain: output.gain_ahead(&controls.gain_db, first_heard),
+                audible,
+            };
+            if onset.sample + 1 < block_end {
+                on_unit(onset, voicing);
+            } else if let Some(free) = deferred.iter_mut().find(|slot| slot.is_none()) {
+                *free = Some((*onset, voicing));
+            }
         };
         // Constant over the span, as constants or as samples that do not change (a ramp's end
         // inside the block).
@@ -283,6 +357,9 @@ impl<S: Synthesis> Engine<S> {
             self.active_until = until;
         }
         let last_step = (len > 0).then_some(advanced.last);
+        if let Some(step) = last_step {
+            self.last_outflow = step;
+        }
         self.resting_under = match last_step {
             Some(step) if step.amount_ml == 0.0 && !step.refilled => constant,
             _ => None,

@@ -1,7 +1,8 @@
 //! The offline renderer: scene files ([`Scene`]) with their automation lanes ([`Automation`]),
 //! rendered by [`render_scene`] through the engine; [`render_to_files`] feeds one render to the
 //! [`sinks`] of every file asked for (WAV, CSV, the haptic clips written from the glugs of
-//! [`clips`], the pour plot), all or nothing, refused up front if it cannot fit in memory.
+//! [`clips`], the pour plot, the tables of units and of the bottle's state), all or nothing,
+//! refused up front if it cannot fit in memory; [`render_tables`] gives the tables in memory.
 
 mod automation;
 pub mod clips;
@@ -10,12 +11,18 @@ mod outputs;
 mod render;
 mod scene;
 pub mod sinks;
+mod tables;
 
 pub use automation::Automation;
 pub use memory::human_bytes;
 pub use outputs::{render_to_files, RenderReport};
-pub use render::{render_scene, render_scene_to_vec, RenderError, RenderObserver, RenderSummary};
+pub use render::{
+    render_scene, render_scene_to_vec, BottleReport, RenderError, RenderObserver, RenderSummary,
+};
 pub use scene::{
     InputFile, InputFileError, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S,
 };
 pub use sinks::{Output, OutputError, OutputFormat, OutputOptions, SampleFormat, WavError};
+pub use tables::{
+    csv_header, render_tables, Column, StateRate, StateRateError, StateRow, Tables, UnitRow,
+};

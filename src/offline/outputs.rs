@@ -9,12 +9,12 @@ use std::cell::RefCell;
 use std::path::PathBuf;
 
 use super::memory::available_bytes;
-use super::render::{render_scene, RenderError, RenderObserver, RenderSummary};
+use super::render::{render_scene, BottleReport, RenderError, RenderObserver, RenderSummary};
 use super::scene::Scene;
 use super::sinks::{
     remove_stale_temps, Output, OutputError, OutputOptions, PendingFile, Sink, SinkContext,
 };
-use crate::engine::UnitOnset;
+use crate::engine::{UnitOnset, Voicing};
 
 /// What a render wrote.
 #[derive(Debug, Clone)]
@@ -55,15 +55,9 @@ pub fn render_to_files(
         })
         .collect::<Result<Vec<_>, _>>()?;
     refuse_what_cannot_fit(outputs, &sinks)?;
-    let bottle_every = sinks
-        .iter()
-        .filter_map(|sink| sink.bottle_every())
-        .chain(observer.bottle_every())
-        .min();
     let sinks = RefCell::new(sinks);
     let mut fanout = Fanout {
         sinks: &sinks,
-        bottle_every,
         observer,
     };
     let summary = render_scene(
@@ -122,8 +116,6 @@ fn refuse_what_cannot_fit(
 /// (which the render hands to its sample closure, hence the shared cell).
 struct Fanout<'s, 'a, O> {
     sinks: &'s RefCell<Vec<Box<dyn Sink + 'a>>>,
-    /// The finest any sink or the observer asked for.
-    bottle_every: Option<usize>,
     observer: O,
 }
 
@@ -132,22 +124,28 @@ impl<O: RenderObserver> RenderObserver for Fanout<'_, '_, O> {
         self.observer.progress(rendered)
     }
 
-    fn unit_started(&mut self, onset: &UnitOnset, output_gain: f64) {
+    fn unit_started(&mut self, onset: &UnitOnset, voicing: Voicing) {
         for sink in self.sinks.borrow_mut().iter_mut() {
-            sink.unit_started(onset, output_gain);
+            sink.unit_started(onset, voicing);
         }
-        self.observer.unit_started(onset, output_gain);
+        self.observer.unit_started(onset, voicing);
     }
 
-    fn bottle_every(&self) -> Option<usize> {
-        self.bottle_every
+    /// The soonest any sink or the observer asked for.
+    fn next_bottle_report(&self, position: u64) -> Option<u64> {
+        self.sinks
+            .borrow()
+            .iter()
+            .filter_map(|sink| sink.next_bottle_report(position))
+            .chain(self.observer.next_bottle_report(position))
+            .min()
     }
 
-    fn bottle(&mut self, position: u64, volume_ml: f64) {
+    fn bottle(&mut self, report: &BottleReport) {
         for sink in self.sinks.borrow_mut().iter_mut() {
-            sink.bottle(position, volume_ml);
+            sink.bottle(report);
         }
-        self.observer.bottle(position, volume_ml);
+        self.observer.bottle(report);
     }
 
     fn interrupted(&self) -> bool {

@@ -6,7 +6,7 @@ use super::scene::{LaneBuffers, Scene, MAX_DURATION_S};
 use crate::device::midi::{CcDecoder, DeviceAction};
 use crate::device::midi_take::TimedInput;
 use crate::engine::synthesis::SILENT_DECAY_EXPONENT;
-use crate::engine::{Controls, DrainMode, Engine, Lane, PerControl, UnitOnset};
+use crate::engine::{Controls, DrainMode, Engine, Lane, Outflow, PerControl, UnitOnset, Voicing};
 
 /// Samples per engine call offline; any size gives the same samples.
 const BLOCK_SIZE: usize = 4096;
@@ -69,21 +69,39 @@ impl RenderSummary {
     }
 }
 
+/// The bottle as a block left it: what the render reports to an observer that asks for it
+/// ([`RenderObserver::next_bottle_report`]), the engine's own values.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BottleReport {
+    /// Samples rendered: the block's last sample is `position − 1`.
+    pub position: u64,
+    /// The residual volume after them (ml): V at the start of sample `position`.
+    pub volume_ml: f64,
+    /// What the last sample (`position − 1`) poured: V at its start, its outflow, whether the
+    /// mouth was submerged.
+    pub last_sample: Outflow,
+    /// θ of the last sample, brought into range (°).
+    pub tilt_deg: f64,
+    /// The output gain G of the last sample (linear, on its ramp: MODEL.md §6).
+    pub output_gain: f64,
+}
+
 /// What a render tells besides its samples; every method has a default that ignores it. A
 /// closure `FnMut(u64)` is an observer of progress alone.
 pub trait RenderObserver {
     /// `rendered` samples are done.
     fn progress(&mut self, _rendered: u64) {}
-    /// A unit started (its onset is `(onset.sample + onset.fraction) / fs`), heard at the output
-    /// gain `output_gain` (linear, on its ramp: MODEL.md §6).
-    fn unit_started(&mut self, _onset: &UnitOnset, _output_gain: f64) {}
-    /// Samples between two [`RenderObserver::bottle`] reports, or `None` for none: the render
-    /// then cuts time at least this finely, which changes no sample.
-    fn bottle_every(&self) -> Option<usize> {
+    /// A unit started (its onset is `(onset.sample + onset.fraction) / fs`), voiced as `voicing`
+    /// says (its output gain, on its ramp: MODEL.md §6, and whether it sounds).
+    fn unit_started(&mut self, _onset: &UnitOnset, _voicing: Voicing) {}
+    /// The next position after `position` (samples rendered) at which a
+    /// [`RenderObserver::bottle`] report is wanted, or `None` for none: the render then ends a
+    /// block there, which changes no sample, and reports after every block.
+    fn next_bottle_report(&self, _position: u64) -> Option<u64> {
         None
     }
-    /// The residual volume (ml) after `position` samples.
-    fn bottle(&mut self, _position: u64, _volume_ml: f64) {}
+    /// The bottle after a block.
+    fn bottle(&mut self, _report: &BottleReport) {}
     /// Whether the render is to stop (its user interrupted it), asked after every block: the
     /// render then ends with [`RenderError::Interrupted`].
     fn interrupted(&self) -> bool {
@@ -113,10 +131,7 @@ pub fn render_scene<E: From<RenderError>>(
     let sample_rate = scene.sample_rate as f64;
     let mut engine = Engine::new(sample_rate, scene.config);
     let mut lanes = LaneBuffers::default();
-    let block_size = observer
-        .bottle_every()
-        .map_or(BLOCK_SIZE, |every| every.clamp(1, BLOCK_SIZE));
-    let mut block = vec![0.0f32; block_size];
+    let mut block = vec![0.0f32; BLOCK_SIZE];
     let total = scene.duration_samples();
     let settle_from = (scene.last_automation_s() * sample_rate).ceil() as u64;
     let give_up_at = (MAX_DURATION_S * sample_rate) as u64;
@@ -127,23 +142,35 @@ pub fn render_scene<E: From<RenderError>>(
     loop {
         let position = engine.position();
         let len = match total {
-            Some(total) => block_size.min((total - position) as usize),
-            None => block_size,
+            Some(total) => BLOCK_SIZE.min((total - position) as usize),
+            None => BLOCK_SIZE,
         };
         if len == 0 {
             break;
         }
         take.act_at(position, &mut engine);
         let len = take.until_next(position).map_or(len, |next| len.min(next));
+        let report_at = observer.next_bottle_report(position);
+        // A report asked for at or before `position` (which no observer should) ends the block
+        // after one sample, never at once.
+        let len = report_at.map_or(len, |next| {
+            len.min(next.saturating_sub(position).max(1) as usize)
+        });
         let mut controls = scene.controls(position, &mut lanes, len);
         take.override_lanes(&mut controls);
         let block = &mut block[..len];
-        engine.process_observed(&controls, block, &mut |onset, gain| {
-            observer.unit_started(onset, gain)
+        engine.process_observed(&controls, block, &mut |onset, voicing| {
+            observer.unit_started(onset, voicing)
         });
         observer.progress(engine.position());
-        if observer.bottle_every().is_some() {
-            observer.bottle(engine.position(), engine.volume_ml());
+        if report_at.is_some() {
+            observer.bottle(&BottleReport {
+                position: engine.position(),
+                volume_ml: engine.volume_ml(),
+                last_sample: engine.last_outflow(),
+                tilt_deg: controls.values_at(len - 1).sanitized().tilt_deg,
+                output_gain: engine.gain_now(),
+            });
         }
         if observer.interrupted() {
             return Err(RenderError::Interrupted.into());
@@ -168,6 +195,7 @@ pub fn render_scene<E: From<RenderError>>(
             }
         }
     }
+    engine.report_deferred_units(&mut |onset, voicing| observer.unit_started(onset, voicing));
     let end = total.unwrap_or_else(|| engine.active_until().max(written));
     write_zeros(&mut sink, end - written)?;
     Ok(RenderSummary {

@@ -76,6 +76,7 @@ fn engine_onsets(scene: &Scene, len: u64, sizes: &[usize]) -> Vec<UnitOnset> {
         });
         done += size as u64;
     }
+    engine.report_deferred_units(&mut |onset, _| onsets.push(*onset));
     onsets
 }
 

@@ -27,6 +27,8 @@ fn unit(viscosity: f64, decay_per_s: [f64; 2]) -> UnitOnset {
         sample: 0,
         fraction: 0.25,
         volume_ml: 300.0,
+        tilt_deg: 135.0,
+        pocket_ml: 5.0,
         amplitude: 1.0,
         viscosity,
         shape: UnitShape {

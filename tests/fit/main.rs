@@ -7,9 +7,9 @@ mod round_trip;
 
 use std::path::{Path, PathBuf};
 
-use sake_glug::engine::UnitOnset;
+use sake_glug::engine::{UnitOnset, Voicing};
 use sake_glug::fit::{fit_session, Session, SessionFit};
-use sake_glug::offline::{render_scene, RenderError, RenderObserver, Scene};
+use sake_glug::offline::{render_scene, BottleReport, RenderError, RenderObserver, Scene};
 
 /// A render's samples, the engine's units and its volume 5 times a second (a scale's log).
 pub struct Rendered {
@@ -25,16 +25,26 @@ struct Recorder {
     volume: Vec<(f64, f64)>,
 }
 
+impl Recorder {
+    /// Samples between two readings of the scale: 5 a second.
+    fn log_every(&self) -> u64 {
+        (self.sample_rate / 5.0) as u64
+    }
+}
+
 impl RenderObserver for Recorder {
-    fn unit_started(&mut self, onset: &UnitOnset, _gain: f64) {
+    fn unit_started(&mut self, onset: &UnitOnset, _voicing: Voicing) {
         self.onsets.push(*onset);
     }
-    fn bottle_every(&self) -> Option<usize> {
-        Some((self.sample_rate / 5.0) as usize)
+    fn next_bottle_report(&self, position: u64) -> Option<u64> {
+        Some((position / self.log_every() + 1) * self.log_every())
     }
-    fn bottle(&mut self, position: u64, volume_ml: f64) {
-        self.volume
-            .push((position as f64 / self.sample_rate, volume_ml));
+    fn bottle(&mut self, report: &BottleReport) {
+        // The render reports after every block; the scale reads only on its own clock.
+        if report.position % self.log_every() == 0 {
+            self.volume
+                .push((report.position as f64 / self.sample_rate, report.volume_ml));
+        }
     }
 }
 

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use sake_glug::engine::UnitOnset;
+use sake_glug::engine::{UnitOnset, Voicing};
 use sake_glug::offline::{
     render_scene, render_to_files, Output, OutputError, OutputOptions, RenderError, RenderObserver,
     Scene, WavError,
@@ -26,7 +26,7 @@ gain_db = [[0.0, -3.0], [2.5, -9.0]]
 fn engine_units(scene: &Scene) -> Vec<UnitOnset> {
     struct Units(Vec<UnitOnset>);
     impl RenderObserver for Units {
-        fn unit_started(&mut self, onset: &UnitOnset, _output_gain: f64) {
+        fn unit_started(&mut self, onset: &UnitOnset, _voicing: Voicing) {
             self.0.push(*onset);
         }
     }

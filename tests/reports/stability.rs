@@ -89,14 +89,15 @@ impl<S: Synthesis> Synthesis for NanInFirstUnit<S> {
         self.path.take_peak_len()
     }
 
-    fn start_unit(&mut self, onset: &UnitOnset) {
+    fn start_unit(&mut self, onset: &UnitOnset) -> bool {
         let sounding = self.path.len();
-        self.path.start_unit(onset);
+        let sounds = self.path.start_unit(onset);
         if self.armed && self.path.len() > sounding {
             self.armed = false;
             // A unit is heard from the sample after the one it starts in.
             self.nan_at = Some(onset.sample + 1);
         }
+        sounds
     }
 
     fn synthesize(&mut self, span_start: u64, out: &mut [f32]) {

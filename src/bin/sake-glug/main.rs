@@ -28,7 +28,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Renders a scene file (or the built-in pour) to a mono WAV file.
-    Render(render::RenderArgs),
+    Render(Box<render::RenderArgs>),
     /// Error against run time of every synthesis path (MODEL.md §9); see docs/accuracy.md.
     Accuracy(accuracy::AccuracyArgs),
     /// Stiff and extreme cases: finite, bounded, no slow-down; see docs/stability.md.
@@ -56,7 +56,7 @@ fn sample_rate_hz(text: &str) -> Result<f64, String> {
 
 fn main() -> ExitCode {
     match Cli::parse().command {
-        Command::Render(args) => render::run(args),
+        Command::Render(args) => render::run(*args),
         Command::Accuracy(args) => accuracy::run(args),
         Command::Stability(args) => stability::run(args),
         Command::Presets(args) => presets::run(args),

@@ -14,7 +14,7 @@ use sake_glug::engine::Preset;
 use sake_glug::offline::clips::HapticBand;
 use sake_glug::offline::{
     human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions, RenderError,
-    RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
+    RenderObserver, RenderReport, SampleFormat, Scene, SceneError, StateRate,
 };
 use sake_glug::text::printable;
 
@@ -43,6 +43,22 @@ pub struct RenderArgs {
     /// Also draws the pour plot (waveform, clip envelope and onsets, V(t), tilt(t)) to this PNG.
     #[arg(long, value_name = "FILE.png")]
     plot: Option<PathBuf>,
+    /// Also writes one row per glug unit to this CSV (the same as -o units:FILE.csv).
+    #[arg(long, value_name = "FILE.csv", conflicts_with = "out_dir")]
+    units: Option<PathBuf>,
+    /// Also writes the bottle's state at --state-rate to this CSV (the same as -o
+    /// state:FILE.csv).
+    #[arg(long, value_name = "FILE.csv", conflicts_with = "out_dir")]
+    state: Option<PathBuf>,
+    #[arg(long, value_name = "HZ", value_parser = state_rate, allow_negative_numbers = true, help = format!(
+        "Rows per second of the state table: above 0, at most the sample rate. Default: {}",
+        StateRate::DEFAULT_HZ
+    ))]
+    state_rate: Option<StateRate>,
+    /// A .csv of samples gets a header line and a time_s column (default: Syntacts' form, one
+    /// sample per line).
+    #[arg(long)]
+    csv_time: bool,
     /// The actuator band (Hz) that .haptic frequencies 0..1 map to, as LOW..HIGH.
     #[arg(long, value_name = "LOW..HIGH", default_value_t = HapticBand::default())]
     haptic_band: HapticBand,
@@ -108,6 +124,8 @@ pub fn run(args: RenderArgs) -> ExitCode {
     let options = OutputOptions {
         sample_format: args.sample_format,
         haptic_band: args.haptic_band,
+        csv_time: args.csv_time,
+        state_rate: args.state_rate.unwrap_or_default(),
     };
     let stop = Stop::on_signals();
     let mut out = Console::new(jobs.len());
@@ -216,6 +234,14 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
                 .into(),
         );
     }
+    if let (Some(rate), Some(sample_rate)) = (args.state_rate, args.sample_rate) {
+        if rate.hz() > sample_rate {
+            return Err(format!(
+                "--state-rate {}: above --sample-rate {sample_rate}; a state row is one sample",
+                rate.hz()
+            ));
+        }
+    }
     if let Some(name) = &args.preset {
         if Preset::find(name).is_none() {
             return Err(format!(
@@ -296,6 +322,18 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
                 path: PathBuf::from("pour.wav"),
             });
         }
+        let tables = [
+            (OutputFormat::UNITS, &args.units),
+            (OutputFormat::STATE, &args.state),
+        ];
+        for (format, path) in tables {
+            if let Some(path) = path {
+                outputs.push(Output {
+                    format,
+                    path: path.clone(),
+                });
+            }
+        }
         if let Some(plot) = &args.plot {
             match Output::of_path(plot) {
                 Ok(output) if output.format == OutputFormat::PLOT => outputs.push(output),
@@ -315,6 +353,15 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
         });
     }
     Ok(jobs)
+}
+
+/// `--state-rate`'s value parser: a finite number of Hz above 0.
+fn state_rate(text: &str) -> Result<StateRate, String> {
+    let hz: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number of Hz"))?;
+    StateRate::new(hz).map_err(|error| error.to_string())
 }
 
 /// `-o`'s value parser: `NAME:FILE` or a file its extension names.

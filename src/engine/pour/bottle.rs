@@ -17,6 +17,16 @@ pub struct Outflow {
     pub refilled: bool,
 }
 
+impl Outflow {
+    /// Nothing poured from an empty bottle.
+    pub const NONE: Self = Self {
+        volume_before_ml: 0.0,
+        amount_ml: 0.0,
+        submerged: false,
+        refilled: false,
+    };
+}
+
 /// The levels of one sample, set by its tilt, pour time and capacity (MODEL.md §2, §3).
 #[derive(Debug, Clone, Copy)]
 pub struct Levels {

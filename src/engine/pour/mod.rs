@@ -71,6 +71,10 @@ pub struct UnitOnset {
     pub fraction: f64,
     /// V_i.
     pub volume_ml: f64,
+    /// θ_n: the tilt of the onset's sample, brought into range (°).
+    pub tilt_deg: f64,
+    /// b_i: the pocket volume whose filling started the unit (ml, §4, §7).
+    pub pocket_ml: f64,
     /// Asum_i = a(V_i)·exp(σ_A·z_i) (§5, §12), before the output gain.
     pub amplitude: f64,
     /// c_i, clamped to [0, 1].
@@ -223,7 +227,7 @@ impl Pour {
         if outflow.refilled {
             self.onsets.clear();
         }
-        self.count_onsets(sample, controls.viscosity, outflow, emit)
+        self.count_onsets(sample, controls.tilt_deg, controls.viscosity, outflow, emit)
     }
 
     /// `count` samples from `first_sample` under the same `controls` (already brought into
@@ -280,7 +284,7 @@ impl Pour {
                 }
                 None => {
                     self.plan_backoff = self.plan_backoff.saturating_sub(1);
-                    advanced.last = self.step_steady(sample, controls.viscosity, &mut emit);
+                    advanced.last = self.step_steady(sample, controls, &mut emit);
                     if advanced.last.amount_ml > 0.0 {
                         advanced.flowed_until = Some(sample + 1);
                     }
@@ -337,8 +341,13 @@ impl Pour {
                     if outflow.refilled {
                         self.onsets.clear();
                     }
-                    let outflow =
-                        self.count_onsets(sample, inputs.viscosity[index], outflow, &mut emit);
+                    let outflow = self.count_onsets(
+                        sample,
+                        inputs.tilt_deg[index],
+                        inputs.viscosity[index],
+                        outflow,
+                        &mut emit,
+                    );
                     if outflow.amount_ml > 0.0 {
                         advanced.flowed_until = Some(sample + 1);
                     }
@@ -378,7 +387,13 @@ impl Pour {
                     let sum = accumulated + outflow.amount_ml;
                     if sum >= pocket {
                         self.onsets.set_accumulated_ml(accumulated);
-                        self.count_onsets(sample, inputs.viscosity[index], outflow, &mut *emit);
+                        self.count_onsets(
+                            sample,
+                            inputs.tilt_deg[index],
+                            inputs.viscosity[index],
+                            outflow,
+                            &mut *emit,
+                        );
                         accumulated = self.onsets.accumulated_ml();
                         pocket = self.draws.next_pocket_ml(&self.config);
                     } else {
@@ -429,24 +444,27 @@ impl Pour {
         }
     }
 
-    /// [`Pour::step_sanitized`] under the same controls as the previous step and with no refill
-    /// asked for since: the bottle skips its checks for changes.
+    /// [`Pour::step_sanitized`] under the same `controls` (brought into range) as the previous
+    /// step and with no refill asked for since: the bottle skips its checks for changes.
     #[inline]
     pub fn step_steady(
         &mut self,
         sample: u64,
-        viscosity: f64,
+        controls: &ControlValues,
         emit: impl FnMut(&UnitOnset),
     ) -> Outflow {
         self.plain = None;
         let outflow = self.bottle.step_steady(self.config.drain);
-        self.count_onsets(sample, viscosity, outflow, emit)
+        self.count_onsets(sample, controls.tilt_deg, controls.viscosity, outflow, emit)
     }
 
+    /// Counts the onsets of one sample whose tilt and viscosity (brought into range) the units
+    /// take.
     #[inline]
     fn count_onsets(
         &mut self,
         sample: u64,
+        tilt_deg: f64,
         viscosity: f64,
         outflow: Outflow,
         mut emit: impl FnMut(&UnitOnset),
@@ -463,6 +481,8 @@ impl Pour {
                     sample,
                     fraction: crossing.fraction,
                     volume_ml: crossing.volume_ml,
+                    tilt_deg,
+                    pocket_ml: crossing.pocket_ml,
                     amplitude: silent_below.amplitude(crossing.volume_ml, capacity_ml)
                         * shape.amplitude_factor,
                     viscosity,

@@ -15,6 +15,8 @@ pub struct Crossing {
     /// x of §4, in [0, 1]: the onset is at t_n + x / fs.
     pub fraction: f64,
     pub volume_ml: f64,
+    /// b_i: the pocket volume whose filling started the unit.
+    pub pocket_ml: f64,
 }
 
 #[derive(Default)]
@@ -70,6 +72,7 @@ impl OnsetDetector {
             let crossing = Crossing {
                 fraction,
                 volume_ml: outflow.volume_before_ml - fraction * amount,
+                pocket_ml,
             };
             let shape = draws.next_unit(config);
             emit(crossing, shape);

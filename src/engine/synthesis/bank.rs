@@ -111,17 +111,19 @@ impl<C: BankComponent> Synthesis for Bank<C> {
 
     /// Starts the audible components of `onset` if the start budget admits the unit; a refused
     /// unit is given up whole.
-    fn start_unit(&mut self, onset: &UnitOnset) {
+    fn start_unit(&mut self, onset: &UnitOnset) -> bool {
         let time_s = (onset.sample as f64 + onset.fraction) / self.sample_rate;
         if !self.budget.admit(time_s) {
             self.given_up += 2;
-            return;
+            return false;
         }
+        let mut sounds = false;
         for index in 0..2 {
             if let Some(component) = Component::of(onset, index, self.sample_rate) {
-                self.insert(C::start(component));
+                sounds |= self.insert(C::start(component));
             }
         }
+        sounds
     }
 
     #[inline]
@@ -136,11 +138,13 @@ impl<C: BankComponent> Synthesis for Bank<C> {
 }
 
 impl<C: BankComponent> Bank<C> {
-    fn insert(&mut self, new: C) {
+    /// Lets `new` in; returns whether it sounds (it is given up if the bank is full of louder
+    /// components).
+    fn insert(&mut self, new: C) -> bool {
         if self.sounding.len() < MAX_COMPONENTS {
             self.sounding.push(new);
             self.peak_len = self.peak_len.max(self.sounding.len());
-            return;
+            return true;
         }
         self.given_up += 1;
         let weakest = self
@@ -148,9 +152,11 @@ impl<C: BankComponent> Bank<C> {
             .iter_mut()
             .min_by(|a, b| a.level().total_cmp(&b.level()))
             .expect("a full bank is not empty");
-        if weakest.level() < new.level() {
+        let louder = weakest.level() < new.level();
+        if louder {
             *weakest = new;
         }
+        louder
     }
 }
 

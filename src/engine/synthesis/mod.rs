@@ -38,8 +38,10 @@ pub trait Synthesis {
     /// The most components that sounded at once since the last call; the count then starts
     /// again from those sounding now.
     fn take_peak_len(&mut self) -> usize;
-    /// Starts the components of a unit that starts during sample `onset.sample`.
-    fn start_unit(&mut self, onset: &UnitOnset);
+    /// Starts the components of a unit that starts during sample `onset.sample`; returns whether
+    /// any of them sounds (MODEL.md §6, §11: none does for a unit given up, or whose components
+    /// are all omitted).
+    fn start_unit(&mut self, onset: &UnitOnset) -> bool;
     /// Adds every component into `out`, which starts at absolute sample `span_start` and lies
     /// within one grid period.
     fn synthesize(&mut self, span_start: u64, out: &mut [f32]);

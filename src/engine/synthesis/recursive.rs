@@ -134,6 +134,8 @@ mod tests {
             sample: 10,
             fraction: 0.25,
             volume_ml: 300.0,
+            tilt_deg: 135.0,
+            pocket_ml: 5.0,
             amplitude: 1.0,
             viscosity: 0.5,
             shape: UnitShape {

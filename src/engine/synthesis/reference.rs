@@ -144,6 +144,20 @@ pub struct ReferenceWindow {
     pub samples: Vec<f64>,
     /// Every unit that started from sample 0 to the window's end.
     pub onsets: Vec<UnitOnset>,
+    /// Every unit the reference voiced (the caps of §11 passed, its sample glugging), in order,
+    /// as it computed it.
+    pub units: Vec<ReferenceUnit>,
+}
+
+/// A unit as the reference computes it from the contract.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReferenceUnit {
+    /// t_i (s).
+    pub onset_s: f64,
+    /// V_i from its own drain (ml).
+    pub volume_ml: f64,
+    /// A1 = c·Asum_i and A2 = (1 − c)·Asum_i, before the output gain.
+    pub amplitudes: [f64; 2],
 }
 
 /// MODEL.md §2, §12: a curve of tilt at `tilt_deg`: linear between its points, constant outside
@@ -223,6 +237,8 @@ impl Drain {
 struct Unit {
     /// t_i in samples: n + x.
     onset: f64,
+    onset_s: f64,
+    volume_ml: f64,
     first_sample: u64,
     /// A1 = c·Asum_i, A2 = (1 − c)·Asum_i, Asum_i = a(V_i)·exp(σ_A·z_i); the gain G is applied
     /// per sample, on its ramp.
@@ -283,6 +299,8 @@ pub fn evaluate(
                 * onset.shape.amplitude_factor;
             units.push(Unit {
                 onset: onset.sample as f64 + onset.fraction,
+                onset_s,
+                volume_ml,
                 first_sample: onset.sample + 1,
                 amplitudes: [viscosity * amplitude, (1.0 - viscosity) * amplitude],
                 frequency_hz: onset.shape.frequency_hz,
@@ -302,7 +320,19 @@ pub fn evaluate(
     for (y, gain) in samples.iter_mut().zip(&gains) {
         *y = (*y * gain).max(-ceiling).min(ceiling);
     }
-    ReferenceWindow { samples, onsets }
+    let units = units
+        .iter()
+        .map(|unit| ReferenceUnit {
+            onset_s: unit.onset_s,
+            volume_ml: unit.volume_ml,
+            amplitudes: unit.amplitudes,
+        })
+        .collect();
+    ReferenceWindow {
+        samples,
+        onsets,
+        units,
+    }
 }
 
 /// a(V) of MODEL.md §5 and §12: max(0, (V − V0)/(C − V0)). V0 is brought into 0 ≤ V0 < C (a NaN

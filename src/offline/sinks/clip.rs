@@ -4,7 +4,7 @@
 use std::io::Write;
 
 use super::{OutputError, OutputOptions, PendingFile, Sink, SinkContext};
-use crate::engine::UnitOnset;
+use crate::engine::{UnitOnset, Voicing};
 use crate::offline::clips::{ClipSource, Glug};
 use crate::offline::memory::max_units;
 use crate::offline::RenderSummary;
@@ -41,10 +41,10 @@ impl Sink for ClipSink<'_> {
         max_units(self.context.scene).saturating_mul(self.bytes_per_glug)
     }
 
-    fn unit_started(&mut self, onset: &UnitOnset, output_gain: f64) {
+    fn unit_started(&mut self, onset: &UnitOnset, voicing: Voicing) {
         let sample_rate = self.context.scene.sample_rate;
         self.glugs
-            .push(Glug::of_unit(onset, output_gain, sample_rate));
+            .push(Glug::of_unit(onset, voicing.output_gain, sample_rate));
     }
 
     fn finish(self: Box<Self>, summary: &RenderSummary) -> Result<PendingFile, OutputError> {

@@ -1,4 +1,5 @@
-//! Samples as CSV in Syntacts' format: one sample per line, no header, no time column; streamed
+//! Samples as CSV in Syntacts' format: one sample per line, no header, no time column; or, with
+//! [`OutputOptions::csv_time`](super::OutputOptions), a header and each sample's time. Streamed
 //! to the file as they are rendered.
 
 use std::fmt::Write as _;
@@ -28,22 +29,69 @@ pub fn write_csv_samples(samples: &[f32], out: &mut impl io::Write) -> io::Resul
     out.flush()
 }
 
+/// The columns of a CSV of samples with its time column: t_n = n / fs (s), and the sample.
+pub const TIMED_SAMPLE_COLUMNS: [&str; 2] = ["time_s", "sample"];
+
+/// Writes `samples`, the first being sample `first` at `sample_rate` (Hz), one per line after
+/// its time (as [`write_csv_samples`], each value the shortest text that reads back the same).
+fn write_timed_samples(
+    samples: &[f32],
+    first: u64,
+    sample_rate: f64,
+    out: &mut impl io::Write,
+) -> io::Result<()> {
+    let mut block = String::with_capacity(BLOCK_BYTES + 64);
+    for (n, sample) in (first..).zip(samples) {
+        writeln!(block, "{},{sample}", n as f64 / sample_rate)
+            .expect("writing to a String cannot fail");
+        if block.len() >= BLOCK_BYTES {
+            out.write_all(block.as_bytes())?;
+            block.clear();
+        }
+    }
+    out.write_all(block.as_bytes())
+}
+
 /// The sink of a `.csv` output.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
     let file = PendingFile::beside(context.path, ".csv").map_err(OutputError::io(context.path))?;
-    let writer = file.writer().map_err(OutputError::io(context.path))?;
-    Ok(Box::new(CsvFile { file, writer }))
+    let mut writer = file.writer().map_err(OutputError::io(context.path))?;
+    let timed = context
+        .options
+        .csv_time
+        .then_some(context.scene.sample_rate as f64);
+    if timed.is_some() {
+        writeln!(writer, "{}", TIMED_SAMPLE_COLUMNS.join(","))
+            .map_err(OutputError::io(context.path))?;
+    }
+    Ok(Box::new(CsvFile {
+        file,
+        writer,
+        timed,
+        written: 0,
+    }))
 }
 
 /// A CSV of samples being written to its temporary file.
 struct CsvFile {
     file: PendingFile,
     writer: BufWriter<File>,
+    /// With a time column: the sample rate (Hz).
+    timed: Option<f64>,
+    /// Samples written so far.
+    written: u64,
 }
 
 impl Sink for CsvFile {
     fn samples(&mut self, block: &[f32]) -> Result<(), OutputError> {
-        write_csv_samples(block, &mut self.writer).map_err(OutputError::io(self.file.path()))
+        let written = match self.timed {
+            None => write_csv_samples(block, &mut self.writer),
+            Some(sample_rate) => {
+                write_timed_samples(block, self.written, sample_rate, &mut self.writer)
+            }
+        };
+        self.written += block.len() as u64;
+        written.map_err(OutputError::io(self.file.path()))
     }
 
     fn finish(mut self: Box<Self>, _: &RenderSummary) -> Result<PendingFile, OutputError> {

@@ -1,10 +1,11 @@
 //! Sinks: one per kind of file a render writes, all fed by the same single pass.
 //!
 //! A `Sink` hears the render as it runs (its samples block by block, each unit as it starts,
-//! the bottle's volume if it asks for it) and, once the render has ended, completes its file in
+//! the bottle at the samples it asks for) and, once the render has ended, completes its file in
 //! a temporary file beside the target (a `PendingFile`); [`super::render_to_files`] replaces
 //! the targets only once every sink has finished. What a sink needs to keep it keeps itself: a
-//! WAV or CSV streams its samples to disk and keeps no units; the clips keep the glugs.
+//! WAV or CSV streams its samples to disk and keeps no units, the tables stream their rows; the
+//! clips keep the glugs.
 //!
 //! Every format is one entry of [`OutputFormat::ALL`]: adding one is a file here with its sink
 //! and an `open` function, and an entry in that table.
@@ -16,22 +17,25 @@ mod haptic;
 mod pending;
 #[cfg(feature = "plot")]
 mod plot;
+mod state;
+mod units;
 mod wav;
 
 use std::path::{Path, PathBuf};
 
 use super::clips::HapticBand;
 use super::memory::human_bytes;
-use super::render::{RenderError, RenderSummary};
+use super::render::{BottleReport, RenderError, RenderSummary};
 use super::scene::Scene;
-use crate::engine::UnitOnset;
+use super::tables::{StateRate, StateRateError};
+use crate::engine::{UnitOnset, Voicing};
 use clip::ClipSink;
 pub(crate) use pending::{remove_stale_temps, PendingFile};
 #[cfg(feature = "plot")]
 use plot::open as open_plot;
 
 pub use ahap::ahap_json;
-pub use csv::write_csv_samples;
+pub use csv::{write_csv_samples, TIMED_SAMPLE_COLUMNS};
 pub use haptic::haptic_json;
 #[cfg(feature = "plot")]
 pub use plot::{draw_pour_plot, PlotData, PlotError, Waveform};
@@ -44,17 +48,18 @@ pub(crate) trait Sink {
     fn samples(&mut self, _block: &[f32]) -> Result<(), OutputError> {
         Ok(())
     }
-    /// A unit started (at `(onset.sample + onset.fraction) / fs`), heard at the output gain
-    /// `output_gain` (linear, on its ramp: MODEL.md §6).
-    fn unit_started(&mut self, _onset: &UnitOnset, _output_gain: f64) {}
-    /// The most samples this sink lets pass between two [`Sink::bottle`] reports, or `None` for
-    /// none. The render then cuts time at least this finely (which changes no sample), and
-    /// reports after every block: as often as the most demanding sink asked.
-    fn bottle_every(&self) -> Option<usize> {
+    /// A unit started (at `(onset.sample + onset.fraction) / fs`), voiced as `voicing` says (its
+    /// output gain, linear, on its ramp: MODEL.md §6, and whether it sounds).
+    fn unit_started(&mut self, _onset: &UnitOnset, _voicing: Voicing) {}
+    /// The next position after `position` (samples rendered) at which this sink wants a
+    /// [`Sink::bottle`] report, or `None` for none. The render then ends a block there (which
+    /// changes no sample), and reports after every block: as often as the most demanding sink
+    /// asked.
+    fn next_bottle_report(&self, _position: u64) -> Option<u64> {
         None
     }
-    /// The residual volume (ml) after `position` samples.
-    fn bottle(&mut self, _position: u64, _volume_ml: f64) {}
+    /// The bottle after a block.
+    fn bottle(&mut self, _report: &BottleReport) {}
     /// The most memory (bytes) the sink may keep, as far as it can tell before the render: a
     /// render whose sinks may need more than the machine has is refused before it starts.
     fn memory_bytes(&self) -> u64 {
@@ -104,9 +109,21 @@ impl OutputFormat {
     pub const CSV: Self = Self::new("csv", "csv", csv::open);
     /// `.png`: the pour plot (feature `plot`; a build without it refuses a plot by name).
     pub const PLOT: Self = Self::new("png", "png", open_plot);
+    /// `units` (`.csv`): one row per glug unit (MODEL.md §14).
+    pub const UNITS: Self = Self::named("units", "csv", units::open);
+    /// `state` (`.csv`): the bottle at the state rate (MODEL.md §14).
+    pub const STATE: Self = Self::named("state", "csv", state::open);
 
     /// Every format, in the order a file's extension is looked up.
-    pub const ALL: &'static [Self] = &[Self::WAV, Self::HAPTIC, Self::AHAP, Self::CSV, Self::PLOT];
+    pub const ALL: &'static [Self] = &[
+        Self::WAV,
+        Self::HAPTIC,
+        Self::AHAP,
+        Self::CSV,
+        Self::PLOT,
+        Self::UNITS,
+        Self::STATE,
+    ];
 
     /// A format its extension picks.
     const fn new(name: &'static str, extension: &'static str, open: OpenSink) -> Self {
@@ -119,7 +136,6 @@ impl OutputFormat {
     }
 
     /// A format that shares its extension with another: picked only by its name.
-    #[allow(dead_code)] // the first such formats are being added on their own branches
     const fn named(name: &'static str, extension: &'static str, open: OpenSink) -> Self {
         Self {
             name,
@@ -279,6 +295,10 @@ pub struct OutputOptions {
     pub sample_format: SampleFormat,
     /// The actuator band the `.haptic` frequencies map to.
     pub haptic_band: HapticBand,
+    /// A `.csv` of samples gets a header and a time column (Syntacts' form has neither).
+    pub csv_time: bool,
+    /// Rows per second of a `state` table.
+    pub state_rate: StateRate,
 }
 
 /// Why the files of a render could not be written.
@@ -330,6 +350,9 @@ pub enum OutputError {
     /// A WAV file could not be written.
     #[error(transparent)]
     Wav(#[from] WavError),
+    /// A `state` table's rate does not fit the render.
+    #[error(transparent)]
+    StateRate(#[from] StateRateError),
     /// Another file could not be written.
     #[error("cannot write {}: {source}", path.display())]
     Io {

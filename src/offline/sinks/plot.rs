@@ -7,9 +7,10 @@ use plotters::prelude::*;
 
 use super::clip::clip_source;
 use super::{OutputError, PendingFile, Sink, SinkContext};
-use crate::engine::UnitOnset;
+use crate::engine::{UnitOnset, Voicing};
 use crate::offline::clips::{clip_onsets, envelope_breakpoints, Glug};
 use crate::offline::memory::max_units;
+use crate::offline::render::BottleReport;
 use crate::offline::RenderSummary;
 
 /// The sink of a `.png` output: it keeps the waveform decimated to a bounded size, every glug,
@@ -48,20 +49,21 @@ impl Sink for PlotSink<'_> {
         Ok(())
     }
 
-    fn unit_started(&mut self, onset: &UnitOnset, output_gain: f64) {
+    fn unit_started(&mut self, onset: &UnitOnset, voicing: Voicing) {
         let sample_rate = self.context.scene.sample_rate;
         self.glugs
-            .push(Glug::of_unit(onset, output_gain, sample_rate));
+            .push(Glug::of_unit(onset, voicing.output_gain, sample_rate));
     }
 
     /// A point of V(t) every 10 ms at least.
-    fn bottle_every(&self) -> Option<usize> {
-        Some((self.context.scene.sample_rate as usize / 100).max(1))
+    fn next_bottle_report(&self, position: u64) -> Option<u64> {
+        Some(position + (self.context.scene.sample_rate as u64 / 100).max(1))
     }
 
-    fn bottle(&mut self, position: u64, volume_ml: f64) {
+    fn bottle(&mut self, report: &BottleReport) {
         let fs = self.context.scene.sample_rate as f64;
-        self.volume_ml.push((position as f64 / fs, volume_ml));
+        self.volume_ml
+            .push((report.position as f64 / fs, report.volume_ml));
     }
 
     /// The waveform and the bottle at their bounds (the tilt as many points as the volume), the
