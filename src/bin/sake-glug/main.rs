@@ -2,6 +2,7 @@
 //! subcommand; the work is in the library, which knows nothing of `clap`.
 
 mod accuracy;
+mod analyze;
 mod parameters;
 mod presets;
 mod render;
@@ -36,6 +37,8 @@ enum Command {
     Presets(presets::PresetsArgs),
     /// Every control and model constant: parameter id, scene key, range and default.
     Parameters(parameters::ParametersArgs),
+    /// Analyses study logs: Thurstone scaling (paired) or a psychometric fit (constant).
+    Analyze(analyze::AnalyzeArgs),
 }
 
 /// A `--sample-rate` as a scene's `sample_rate` is checked (in range, whole), refused by the
@@ -58,5 +61,6 @@ fn main() -> ExitCode {
         Command::Stability(args) => stability::run(args),
         Command::Presets(args) => presets::run(args),
         Command::Parameters(args) => parameters::run(args),
+        Command::Analyze(args) => analyze::run(args),
     }
 }
