@@ -1,6 +1,6 @@
 //! The method of constant stimuli (the paper's §4.4): a standard against comparison levels of one
 //! control, the participant names the one that is more so. A logistic psychometric function
-//! fitted by maximum likelihood, its 25/50/75 % points with parametric-bootstrap intervals
+//! fitted by maximum likelihood, its 25/50/75 % points with parametric-bootstrap BCa intervals
 //! (docs/studies.md).
 
 use std::collections::BTreeMap;
@@ -9,6 +9,7 @@ use std::path::Path;
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use serde::Serialize;
+use statrs::distribution::{ContinuousCDF, Normal};
 
 use super::error::AnalysisError;
 use super::log::read_rows;
@@ -93,9 +94,9 @@ impl Logistic {
 pub struct PointEstimate {
     /// The level at the point.
     pub value: f64,
-    /// The 2.5 % quantile of the bootstrap values.
+    /// The lower end of the 95 % BCa interval.
     pub low: f64,
-    /// The 97.5 % quantile.
+    /// The upper end.
     pub high: f64,
 }
 
@@ -273,13 +274,20 @@ pub fn fit_psychometric(
             resamples: options.resamples,
         });
     }
+    let jackknife = jackknife_points(&levels, options.max_lapse);
     let points = std::array::from_fn(|index| {
         let values = &mut drawn[index];
         values.sort_by(f64::total_cmp);
+        let estimate = values_fitted[index];
+        let leave_one_out: Vec<(f64, f64)> = jackknife
+            .iter()
+            .map(|(points, weight)| (points[index], *weight))
+            .collect();
+        let (low, high) = bca_interval(values, estimate, &leave_one_out);
         PointEstimate {
-            value: values_fitted[index],
-            low: quantile(values, 0.025),
-            high: quantile(values, 0.975),
+            value: estimate,
+            low,
+            high,
         }
     });
     Ok(PsychometricFit {
@@ -289,6 +297,57 @@ pub fn fit_psychometric(
         resamples: options.resamples,
         failed_resamples,
     })
+}
+
+/// The 95 % bias-corrected and accelerated (BCa) interval of Efron (1987) from the sorted
+/// bootstrap `values` of a point `estimate`: the percentiles moved by the bias (how many
+/// resamples fall below the estimate) and the skewness (the acceleration, from the jackknife
+/// values `leave_one_out` with their weights). Plain percentiles cover the truth in only 92–94 %
+/// of simulated studies of the paper's size; BCa comes closer (docs/studies.md).
+fn bca_interval(values: &[f64], estimate: f64, leave_one_out: &[(f64, f64)]) -> (f64, f64) {
+    let normal = Normal::standard();
+    let below = values.iter().filter(|&&value| value < estimate).count() as f64;
+    let equal = values.iter().filter(|&&value| value == estimate).count() as f64;
+    let fraction = ((below + equal / 2.0) / values.len() as f64)
+        .clamp(0.5 / values.len() as f64, 1.0 - 0.5 / values.len() as f64);
+    let bias = normal.inverse_cdf(fraction);
+    let total: f64 = leave_one_out.iter().map(|(_, weight)| weight).sum();
+    let mean = leave_one_out.iter().map(|(value, weight)| value * weight).sum::<f64>() / total;
+    let (mut squares, mut cubes) = (0.0, 0.0);
+    for (value, weight) in leave_one_out {
+        let deviation = mean - value;
+        squares += weight * deviation * deviation;
+        cubes += weight * deviation * deviation * deviation;
+    }
+    let acceleration = if squares > 0.0 { cubes / (6.0 * squares.powf(1.5)) } else { 0.0 };
+    let adjusted = |q: f64| {
+        let z = normal.inverse_cdf(q);
+        normal.cdf(bias + (bias + z) / (1.0 - acceleration * (bias + z)))
+    };
+    (quantile(values, adjusted(0.025)), quantile(values, adjusted(0.975)))
+}
+
+/// The points fitted with each trial left out in turn, with how many trials give each (every
+/// trial of one level and answer gives the same); the fits that fail are left out.
+fn jackknife_points(levels: &[LevelCount], max_lapse: f64) -> Vec<([f64; 3], f64)> {
+    let mut points = Vec::new();
+    for (index, level) in levels.iter().enumerate() {
+        for chosen in [true, false] {
+            let weight = if chosen { level.chosen } else { level.trials - level.chosen };
+            if weight == 0 {
+                continue;
+            }
+            let mut left_out = levels.to_vec();
+            left_out[index].trials -= 1;
+            left_out[index].chosen -= u32::from(chosen);
+            let left_out: Vec<LevelCount> =
+                left_out.into_iter().filter(|level| level.trials > 0).collect();
+            if let Some(fit) = maximum_likelihood(&left_out, max_lapse).and_then(|c| points_of(&c)) {
+                points.push((fit, f64::from(weight)));
+            }
+        }
+    }
+    points
 }
 
 /// The `q` quantile of sorted `values` (not empty), linear between order statistics.
