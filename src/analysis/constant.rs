@@ -156,7 +156,9 @@ pub fn analyze_constant_logs(
         )));
     }
     if options.resamples == 0 {
-        return Err(AnalysisError::Option("at least one resample is needed".into()));
+        return Err(AnalysisError::Option(
+            "at least one resample is needed".into(),
+        ));
     }
     let rows = read_rows(files, CONSTANT_COLUMNS)?;
     let mut participants: Vec<(String, Vec<(f64, bool)>)> = Vec::new();
@@ -170,7 +172,10 @@ pub fn analyze_constant_logs(
             .ok()
             .filter(|level: &f64| level.is_finite())
             .ok_or_else(|| {
-                row.error(CONSTANT_COLUMNS[1], format!("{} is not a number", row.quoted(1)))
+                row.error(
+                    CONSTANT_COLUMNS[1],
+                    format!("{} is not a number", row.quoted(1)),
+                )
             })?;
         let chosen = match row.fields[2].as_str() {
             "1" => true,
@@ -186,7 +191,10 @@ pub fn analyze_constant_logs(
             }
         };
         pooled.push((level, chosen));
-        match participants.iter_mut().find(|(name, _)| *name == row.fields[0]) {
+        match participants
+            .iter_mut()
+            .find(|(name, _)| *name == row.fields[0])
+        {
             Some((_, answers)) => answers.push((level, chosen)),
             None => participants.push((row.fields[0].clone(), vec![(level, chosen)])),
         }
@@ -312,19 +320,30 @@ fn bca_interval(values: &[f64], estimate: f64, leave_one_out: &[(f64, f64)]) -> 
         .clamp(0.5 / values.len() as f64, 1.0 - 0.5 / values.len() as f64);
     let bias = normal.inverse_cdf(fraction);
     let total: f64 = leave_one_out.iter().map(|(_, weight)| weight).sum();
-    let mean = leave_one_out.iter().map(|(value, weight)| value * weight).sum::<f64>() / total;
+    let mean = leave_one_out
+        .iter()
+        .map(|(value, weight)| value * weight)
+        .sum::<f64>()
+        / total;
     let (mut squares, mut cubes) = (0.0, 0.0);
     for (value, weight) in leave_one_out {
         let deviation = mean - value;
         squares += weight * deviation * deviation;
         cubes += weight * deviation * deviation * deviation;
     }
-    let acceleration = if squares > 0.0 { cubes / (6.0 * squares.powf(1.5)) } else { 0.0 };
+    let acceleration = if squares > 0.0 {
+        cubes / (6.0 * squares.powf(1.5))
+    } else {
+        0.0
+    };
     let adjusted = |q: f64| {
         let z = normal.inverse_cdf(q);
         normal.cdf(bias + (bias + z) / (1.0 - acceleration * (bias + z)))
     };
-    (quantile(values, adjusted(0.025)), quantile(values, adjusted(0.975)))
+    (
+        quantile(values, adjusted(0.025)),
+        quantile(values, adjusted(0.975)),
+    )
 }
 
 /// The points fitted with each trial left out in turn, with how many trials give each (every
@@ -333,16 +352,23 @@ fn jackknife_points(levels: &[LevelCount], max_lapse: f64) -> Vec<([f64; 3], f64
     let mut points = Vec::new();
     for (index, level) in levels.iter().enumerate() {
         for chosen in [true, false] {
-            let weight = if chosen { level.chosen } else { level.trials - level.chosen };
+            let weight = if chosen {
+                level.chosen
+            } else {
+                level.trials - level.chosen
+            };
             if weight == 0 {
                 continue;
             }
             let mut left_out = levels.to_vec();
             left_out[index].trials -= 1;
             left_out[index].chosen -= u32::from(chosen);
-            let left_out: Vec<LevelCount> =
-                left_out.into_iter().filter(|level| level.trials > 0).collect();
-            if let Some(fit) = maximum_likelihood(&left_out, max_lapse).and_then(|c| points_of(&c)) {
+            let left_out: Vec<LevelCount> = left_out
+                .into_iter()
+                .filter(|level| level.trials > 0)
+                .collect();
+            if let Some(fit) = maximum_likelihood(&left_out, max_lapse).and_then(|c| points_of(&c))
+            {
                 points.push((fit, f64::from(weight)));
             }
         }
@@ -411,17 +437,29 @@ const MAX_SLOPE_PER_SPAN: f64 = 100.0;
 /// conditioned.
 fn fit_with_lapse(levels: &[LevelCount], lapse: f64) -> Option<(Logistic, f64)> {
     let total: f64 = levels.iter().map(|l| f64::from(l.trials)).sum();
-    let centre = levels.iter().map(|l| l.level * f64::from(l.trials)).sum::<f64>() / total;
-    let (min, max) = levels.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), l| {
-        (lo.min(l.level), hi.max(l.level))
-    });
+    let centre = levels
+        .iter()
+        .map(|l| l.level * f64::from(l.trials))
+        .sum::<f64>()
+        / total;
+    let (min, max) = levels
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), l| {
+            (lo.min(l.level), hi.max(l.level))
+        });
     let span = max - min;
     if span <= 0.0 || !span.is_finite() {
         return None;
     }
     let scaled: Vec<(f64, f64, f64)> = levels
         .iter()
-        .map(|l| ((l.level - centre) / span, f64::from(l.trials), f64::from(l.chosen)))
+        .map(|l| {
+            (
+                (l.level - centre) / span,
+                f64::from(l.trials),
+                f64::from(l.chosen),
+            )
+        })
         .collect();
     let log_likelihood = |a: f64, b: f64| -> f64 {
         scaled
@@ -442,7 +480,11 @@ fn fit_with_lapse(levels: &[LevelCount], lapse: f64) -> Option<(Logistic, f64)> 
             let psi = lapse + (1.0 - 2.0 * lapse) * sigma;
             let slope = (1.0 - 2.0 * lapse) * sigma * (1.0 - sigma);
             // dψ/dη over ψ(1 − ψ): exactly 1 without a lapse, where both may underflow.
-            let weight = if lapse == 0.0 { 1.0 } else { slope / (psi * (1.0 - psi)) };
+            let weight = if lapse == 0.0 {
+                1.0
+            } else {
+                slope / (psi * (1.0 - psi))
+            };
             let residual = (k - n * psi) * weight;
             score[0] += residual;
             score[1] += residual * u;
@@ -452,7 +494,7 @@ fn fit_with_lapse(levels: &[LevelCount], lapse: f64) -> Option<(Logistic, f64)> 
             info[1][1] += information * u * u;
         }
         let determinant = info[0][0] * info[1][1] - info[0][1] * info[0][1];
-        if !(determinant > 0.0) {
+        if determinant.is_nan() || determinant <= 0.0 {
             break;
         }
         let mut step = [
@@ -461,12 +503,12 @@ fn fit_with_lapse(levels: &[LevelCount], lapse: f64) -> Option<(Logistic, f64)> 
         ];
         let mut next = log_likelihood(a + step[0], b + step[1]);
         let mut halvings = 0;
-        while !(next >= current) && halvings < 40 {
+        while falls(next, current) && halvings < 40 {
             step = [step[0] / 2.0, step[1] / 2.0];
             next = log_likelihood(a + step[0], b + step[1]);
             halvings += 1;
         }
-        if !(next >= current) {
+        if falls(next, current) {
             converged = step[0].abs().max(step[1].abs()) < 1e-9;
             break;
         }
@@ -488,6 +530,11 @@ fn fit_with_lapse(levels: &[LevelCount], lapse: f64) -> Option<(Logistic, f64)> 
     };
     (converged && b.abs() <= MAX_SLOPE_PER_SPAN && b != 0.0 && current.is_finite())
         .then_some((curve, current))
+}
+
+/// Whether a step's log-likelihood `next` is below `current` (or not a number).
+fn falls(next: f64, current: f64) -> bool {
+    next.is_nan() || next < current
 }
 
 fn sigmoid(eta: f64) -> f64 {

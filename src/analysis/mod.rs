@@ -17,9 +17,9 @@ mod paired;
 mod plot;
 
 pub use constant::{
-    analyze_constant_logs, count_levels, fit_psychometric, ConstantAnalysis, FitError,
-    FitOptions, LevelCount, Logistic, PointEstimate, PsychometricFit, CONSTANT_COLUMNS,
-    MAX_LAPSE, POINT_PERCENTS,
+    analyze_constant_logs, count_levels, fit_psychometric, ConstantAnalysis, FitError, FitOptions,
+    LevelCount, Logistic, PointEstimate, PsychometricFit, CONSTANT_COLUMNS, MAX_LAPSE,
+    POINT_PERCENTS,
 };
 pub use error::AnalysisError;
 pub use paired::{

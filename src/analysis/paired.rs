@@ -187,7 +187,10 @@ pub fn scale_paired(trials: &[PairedTrial]) -> Result<PairedAnalysis, String> {
                 .collect()
         })
         .collect();
-    let means: Vec<f64> = z.iter().map(|row| row.iter().sum::<f64>() / n as f64).collect();
+    let means: Vec<f64> = z
+        .iter()
+        .map(|row| row.iter().sum::<f64>() / n as f64)
+        .collect();
     let lowest = means.iter().copied().fold(f64::INFINITY, f64::min);
     let scale: Vec<f64> = means.iter().map(|mean| mean - lowest).collect();
     let predicted: Vec<Vec<f64>> = (0..n)

@@ -75,9 +75,10 @@ pub fn draw_paired_plot(analysis: &PairedAnalysis, path: &Path) -> Result<(), An
         for (index, (name, &value)) in analysis.stimuli.iter().zip(&analysis.scale).enumerate() {
             let above = index % 2 == 0;
             chart
-                .draw_series([
-                    PathElement::new(vec![(value, -0.15), (value, 0.15)], RED.stroke_width(3)),
-                ])
+                .draw_series([PathElement::new(
+                    vec![(value, -0.15), (value, 0.15)],
+                    RED.stroke_width(3),
+                )])
                 .map_err(|e| fail(&e))?;
             let label = format!("{name} ({value:.2})");
             let y = if above { 0.45 } else { -0.45 };
@@ -109,7 +110,10 @@ pub fn draw_constant_plot(analysis: &ConstantAnalysis, path: &Path) -> Result<()
         root.fill(&WHITE).map_err(|e| fail(&e))?;
         let mut chart = ChartBuilder::on(&root)
             .margin(25)
-            .caption("Psychometric function (logistic, maximum likelihood)", (FONT, 26))
+            .caption(
+                "Psychometric function (logistic, maximum likelihood)",
+                (FONT, 26),
+            )
             .x_label_area_size(50)
             .y_label_area_size(70)
             .build_cartesian_2d(low..high, 0.0..1.0)
@@ -131,17 +135,26 @@ pub fn draw_constant_plot(analysis: &ConstantAnalysis, path: &Path) -> Result<()
         for (_, fit) in &analysis.participants {
             if let Ok(fit) = fit {
                 chart
-                    .draw_series(LineSeries::new(curve_points(&fit.curve), RGBColor(200, 200, 200)))
+                    .draw_series(LineSeries::new(
+                        curve_points(&fit.curve),
+                        RGBColor(200, 200, 200),
+                    ))
                     .map_err(|e| fail(&e))?;
             }
         }
         chart
-            .draw_series(LineSeries::new(curve_points(&pooled.curve), BLUE.stroke_width(3)))
+            .draw_series(LineSeries::new(
+                curve_points(&pooled.curve),
+                BLUE.stroke_width(3),
+            ))
             .map_err(|e| fail(&e))?;
         chart
-            .draw_series(pooled.levels.iter().map(|level| {
-                Circle::new((level.level, level.proportion()), 6, BLACK.filled())
-            }))
+            .draw_series(
+                pooled
+                    .levels
+                    .iter()
+                    .map(|level| Circle::new((level.level, level.proportion()), 6, BLACK.filled())),
+            )
             .map_err(|e| fail(&e))?;
         for (percent, point) in POINT_PERCENTS.iter().zip(&pooled.points) {
             let y = f64::from(*percent) / 100.0;
@@ -149,12 +162,18 @@ pub fn draw_constant_plot(analysis: &ConstantAnalysis, path: &Path) -> Result<()
                 .draw_series([
                     PathElement::new(vec![(low, y), (high, y)], RED.mix(0.3)),
                     PathElement::new(vec![(point.low, y), (point.high, y)], RED.stroke_width(3)),
-                    PathElement::new(vec![(point.value, y - 0.03), (point.value, y + 0.03)], RED.stroke_width(3)),
+                    PathElement::new(
+                        vec![(point.value, y - 0.03), (point.value, y + 0.03)],
+                        RED.stroke_width(3),
+                    ),
                 ])
                 .map_err(|e| fail(&e))?;
             chart
                 .draw_series(std::iter::once(Text::new(
-                    format!("{percent} %: {:.3} [{:.3}, {:.3}]", point.value, point.low, point.high),
+                    format!(
+                        "{percent} %: {:.3} [{:.3}, {:.3}]",
+                        point.value, point.low, point.high
+                    ),
                     (low + 0.02 * (high - low), y + 0.045),
                     (FONT, 16).into_font().color(&RED),
                 )))

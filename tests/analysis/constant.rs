@@ -12,7 +12,9 @@ use crate::{analyze, json_of};
 
 /// The paper's §4.4: nine comparison levels from c = 0.18 to 0.49, ten trials each.
 fn paper_levels() -> Vec<f64> {
-    (0..9).map(|index| 0.18 + 0.31 * f64::from(index) / 8.0).collect()
+    (0..9)
+        .map(|index| 0.18 + 0.31 * f64::from(index) / 8.0)
+        .collect()
 }
 const TRIALS_PER_LEVEL: usize = 10;
 
@@ -74,7 +76,10 @@ fn binomial_bounds(studies: u64) -> (u64, u64) {
 fn simulated_observers_intervals_cover_the_truth_in_about_95_percent_of_studies() {
     const STUDIES: u64 = 200;
     let (covered, fitted) = coverage(STUDIES, 500);
-    assert!(fitted >= STUDIES - 2, "{fitted} of {STUDIES} studies fitted");
+    assert!(
+        fitted >= STUDIES - 2,
+        "{fitted} of {STUDIES} studies fitted"
+    );
     let (low, high) = binomial_bounds(fitted);
     for (percent, count) in POINT_PERCENTS.iter().zip(covered) {
         assert!(
@@ -120,7 +125,15 @@ fn log_of(answers: &[(f64, bool)]) -> String {
 fn the_json_holds_the_pooled_points_with_intervals_and_each_participant() {
     let folder = tempfile::tempdir().unwrap();
     std::fs::write(folder.path().join("log.csv"), log_of(&simulated_study(7))).unwrap();
-    let args = ["constant", "log.csv", "--json", "--resamples", "300", "--seed", "5"];
+    let args = [
+        "constant",
+        "log.csv",
+        "--json",
+        "--resamples",
+        "300",
+        "--seed",
+        "5",
+    ];
     let json = json_of(&analyze(folder.path(), &args));
     for percent in ["25", "50", "75"] {
         let point = &json["points"][percent];
@@ -137,8 +150,22 @@ fn the_json_holds_the_pooled_points_with_intervals_and_each_participant() {
     assert_eq!(participants.len(), 2);
     // The same seed, the same intervals.
     assert_eq!(json, json_of(&analyze(folder.path(), &args)));
-    let other = json_of(&analyze(folder.path(), &["constant", "log.csv", "--json", "--resamples", "300", "--seed", "6"]));
-    assert_eq!(json["points"]["50"]["value"], other["points"]["50"]["value"]);
+    let other = json_of(&analyze(
+        folder.path(),
+        &[
+            "constant",
+            "log.csv",
+            "--json",
+            "--resamples",
+            "300",
+            "--seed",
+            "6",
+        ],
+    ));
+    assert_eq!(
+        json["points"]["50"]["value"],
+        other["points"]["50"]["value"]
+    );
     assert_ne!(json["points"]["50"]["low"], other["points"]["50"]["low"]);
 }
 
@@ -153,9 +180,21 @@ fn a_fitted_lapse_stays_within_its_bound_and_the_plot_is_written() {
         }
     }
     std::fs::write(folder.path().join("log.csv"), log_of(&answers)).unwrap();
-    let args = ["constant", "log.csv", "--json", "--resamples", "200", "--lapse", "0.1", "--plot", "fit.png"];
+    let args = [
+        "constant",
+        "log.csv",
+        "--json",
+        "--resamples",
+        "200",
+        "--lapse",
+        "0.1",
+        "--plot",
+        "fit.png",
+    ];
     let json = json_of(&analyze(folder.path(), &args));
     let lapse = json["curve"]["lapse"].as_f64().unwrap();
     assert!((0.0..=0.1).contains(&lapse), "{lapse}");
-    assert!(std::fs::read(folder.path().join("fit.png")).unwrap().starts_with(b"\x89PNG"));
+    assert!(std::fs::read(folder.path().join("fit.png"))
+        .unwrap()
+        .starts_with(b"\x89PNG"));
 }

@@ -23,22 +23,24 @@ const PARTICIPANTS: usize = 10;
 fn log_of_table(table: &[[u32; 3]; 3], participants: usize) -> String {
     let mut log = String::from("participant,trial,design,first,second,answer,rt_s,seed\n");
     let mut trial = vec![0; participants];
-    for i in 0..3 {
-        for j in i + 1..3 {
-            let answers = std::iter::repeat_n(i, table[i][j] as usize)
-                .chain(std::iter::repeat_n(j, table[j][i] as usize));
-            for (index, chosen) in answers.enumerate() {
-                let participant = index % participants;
-                // Alternate the order of presentation: both ordered pairs.
-                let (first, second) = if (index / participants) % 2 == 0 { (i, j) } else { (j, i) };
-                trial[participant] += 1;
-                writeln!(
-                    log,
-                    "p{participant},{},paired,{},{},{},1.25,7",
-                    trial[participant], STIMULI[first], STIMULI[second], STIMULI[chosen]
-                )
-                .unwrap();
-            }
+    for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+        let answers = std::iter::repeat_n(i, table[i][j] as usize)
+            .chain(std::iter::repeat_n(j, table[j][i] as usize));
+        for (index, chosen) in answers.enumerate() {
+            let participant = index % participants;
+            // Alternate the order of presentation: both ordered pairs.
+            let (first, second) = if (index / participants).is_multiple_of(2) {
+                (i, j)
+            } else {
+                (j, i)
+            };
+            trial[participant] += 1;
+            writeln!(
+                log,
+                "p{participant},{},paired,{},{},{},1.25,7",
+                trial[participant], STIMULI[first], STIMULI[second], STIMULI[chosen]
+            )
+            .unwrap();
         }
     }
     log
@@ -64,7 +66,10 @@ fn table_1_entered_as_trials_gives_back_its_count_matrix_and_the_model_first() {
     assert_eq!(counts, CONSTRUCTED_TABLE_1.map(Vec::from).to_vec());
     let scale = json["scale"].as_object().unwrap();
     let value = |name: &str| scale[name].as_f64().unwrap();
-    assert!(value("model") > value("high") && value("high") > value("low"), "{scale:?}");
+    assert!(
+        value("model") > value("high") && value("high") > value("low"),
+        "{scale:?}"
+    );
     assert_eq!(value("low"), 0.0, "the lowest is shifted to 0");
     assert_eq!(json["participants"], PARTICIPANTS);
     assert_eq!(json["trials"], 180);
@@ -84,10 +89,16 @@ fn the_scale_is_case_v_by_hand() {
             normal.inverse_cdf(f64::from(a) / f64::from(a + b))
         }
     };
-    let means: Vec<f64> = (0..3).map(|i| (0..3).map(|j| z(i, j)).sum::<f64>() / 3.0).collect();
+    let means: Vec<f64> = (0..3)
+        .map(|i| (0..3).map(|j| z(i, j)).sum::<f64>() / 3.0)
+        .collect();
     let lowest = means.iter().copied().fold(f64::INFINITY, f64::min);
     for (computed, mean) in analysis.scale.iter().zip(&means) {
-        assert!((computed - (mean - lowest)).abs() < 1e-12, "{:?} vs {means:?}", analysis.scale);
+        assert!(
+            (computed - (mean - lowest)).abs() < 1e-12,
+            "{:?} vs {means:?}",
+            analysis.scale
+        );
     }
     let fit = analysis.fit.expect("three stimuli: one degree of freedom");
     assert_eq!(fit.df, 1);
@@ -100,7 +111,11 @@ fn a_unanimous_pair_is_clipped_by_the_one_over_2n_rule() {
     let trials = trials_of_table(&[[0, 6, 6], [0, 0, 3], [0, 3, 0]]);
     let analysis = scale_paired(&trials).unwrap();
     let expected = Normal::standard().inverse_cdf(1.0 - 1.0 / 12.0);
-    assert!((analysis.z[0][1] - expected).abs() < 1e-12, "{:?}", analysis.z);
+    assert!(
+        (analysis.z[0][1] - expected).abs() < 1e-12,
+        "{:?}",
+        analysis.z
+    );
     assert!(analysis.scale.iter().all(|value| value.is_finite()));
 }
 
@@ -146,7 +161,10 @@ fn the_agreement_test_has_the_papers_40_degrees_of_freedom_for_21_participants()
     let alike: Vec<PairedTrial> = (0..21).flat_map(|p| camp(p, false)).collect();
     let agreement = scale_paired(&alike).unwrap().agreement.unwrap();
     assert_eq!(agreement.df, 40);
-    assert!(agreement.chi2.abs() < 1e-9 && agreement.p > 0.999, "{agreement:?}");
+    assert!(
+        agreement.chi2.abs() < 1e-9 && agreement.p > 0.999,
+        "{agreement:?}"
+    );
     let split: Vec<PairedTrial> = (0..21).flat_map(|p| camp(p, p % 2 == 1)).collect();
     let agreement = scale_paired(&split).unwrap().agreement.unwrap();
     assert_eq!(agreement.df, 40);
@@ -162,7 +180,11 @@ fn the_text_report_shows_the_matrix_the_scale_and_both_tests() {
     )
     .unwrap();
     let output = analyze(folder.path(), &["paired", "log.csv", "--plot", "scale.png"]);
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     let text = String::from_utf8(output.stdout).unwrap();
     for expected in ["chosen over", "scale", "Mosteller", "χ²(1)", "χ²(18)"] {
         assert!(text.contains(expected), "no `{expected}` in\n{text}");

@@ -60,7 +60,10 @@ fn the_threshold_presets_change_viscosity_alone() {
     for id in ["thin", "thick"] {
         let preset = Preset::find(id).unwrap();
         let mut controls = preset.controls(ControlValues::default());
-        assert_ne!(controls.viscosity, water.controls(ControlValues::default()).viscosity);
+        assert_ne!(
+            controls.viscosity,
+            water.controls(ControlValues::default()).viscosity
+        );
         controls.viscosity = water.controls(ControlValues::default()).viscosity;
         assert_eq!(controls, water.controls(ControlValues::default()), "{id}");
         assert_eq!(

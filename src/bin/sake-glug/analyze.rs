@@ -133,13 +133,21 @@ fn paired_json(analysis: &PairedAnalysis) -> Value {
 
 fn test_text(name: &str, test: Option<ChiSquareTest>, absent: &str) -> String {
     match test {
-        Some(test) => format!("{name}: χ²({}) = {:.2}, p = {:.4}\n", test.df, test.chi2, test.p),
+        Some(test) => format!(
+            "{name}: χ²({}) = {:.2}, p = {:.4}\n",
+            test.df, test.chi2, test.p
+        ),
         None => format!("{name}: {absent}\n"),
     }
 }
 
 fn matrix_text(title: &str, names: &[String], cell: impl Fn(usize, usize) -> String) -> String {
-    let width = names.iter().map(|name| name.chars().count()).max().unwrap_or(0).max(8);
+    let width = names
+        .iter()
+        .map(|name| name.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(8);
     let mut text = format!("{title}\n{:width$}", "");
     for name in names {
         text += &format!(" {name:>width$}");
@@ -170,12 +178,16 @@ fn paired_text(analysis: &PairedAnalysis) -> String {
     text += &matrix_text("\nproportions", names, |i, j| {
         diagonal(i, j, format!("{:.3}", analysis.proportions[i][j]))
     });
-    text += &matrix_text("\nz (proportions clipped to [1/2n, 1 − 1/2n])", names, |i, j| {
-        format!("{:.3}", analysis.z[i][j])
-    });
-    text += &matrix_text("\npredicted proportions Φ(Sᵢ − Sⱼ)", names, |i, j| {
-        diagonal(i, j, format!("{:.3}", analysis.predicted[i][j]))
-    });
+    text += &matrix_text(
+        "\nz (proportions clipped to [1/2n, 1 − 1/2n])",
+        names,
+        |i, j| format!("{:.3}", analysis.z[i][j]),
+    );
+    text += &matrix_text(
+        "\npredicted proportions Φ(Sᵢ − Sⱼ)",
+        names,
+        |i, j| diagonal(i, j, format!("{:.3}", analysis.predicted[i][j])),
+    );
     text += "\nscale (Case V, lowest 0)\n";
     let mut order: Vec<usize> = (0..names.len()).collect();
     order.sort_by(|&a, &b| analysis.scale[b].total_cmp(&analysis.scale[a]));
