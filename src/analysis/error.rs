@@ -80,6 +80,7 @@ impl AnalysisError {
         }
     }
 
+    #[cfg(feature = "plot")]
     pub(crate) fn plot(path: &Path, error: impl std::fmt::Display) -> Self {
         Self::Plot {
             path: shown(path),
