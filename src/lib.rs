@@ -15,9 +15,14 @@
 //! takes), shared by the plugin and the offline renderer. Data flows one way: scene, take or
 //! host → controls → pour → synthesis → sinks (WAV, clips, plot, audio out).
 //!
+//! [`analysis`] (feature `analysis`, which `cli` brings) reads the trial logs of the paper's two
+//! studies and scales or fits them.
+//!
 //! [`text::printable`] escapes the control characters of outside text echoed in any message.
 #![warn(missing_docs)]
 
+#[cfg(feature = "analysis")]
+pub mod analysis;
 pub mod device;
 pub mod engine;
 #[cfg(feature = "offline")]

@@ -3,7 +3,9 @@
 //! offers them in its preset menu and the command line as scene files under `presets/`.
 //!
 //! The liquids follow the paper: water is c = 0.33, and its perceived-viscosity thresholds lie
-//! at c = 0.29 (25 %: felt as thinner than water) and c = 0.42 (75 %: felt as thicker). The
+//! at c = 0.29 (25 %: felt as thinner than water) and c = 0.42 (75 %: felt as thicker). The two
+//! threshold presets change c alone, keeping water's pour time, so that a study of them (or a
+//! listener) meets one cue, not two; the liquids that also pour slower keep their own names. The
 //! bottles keep the model's shape and scale it: a smaller bottle glugs higher, faster and with
 //! smaller pockets; those values are chosen by ear, not measured.
 
@@ -96,7 +98,7 @@ pub const PRESETS: [Preset; 7] = [
         name: "Thick (c 0.42)",
         id: "thick",
         description: "a liquid felt as thicker than water: the paper's 75 % threshold, c = 0.42",
-        values: &paper_bottle_with([C(Control::Viscosity, 0.42), C(Control::PourTime, 7.0)]),
+        values: &paper_bottle_with([C(Control::Viscosity, 0.42)]),
     },
     Preset {
         name: "Syrup (c 0.6)",

@@ -51,3 +51,25 @@ fn presets_differ_where_they_should() {
     let capacity = |id: &str| preset(id).config(config).capacity_ml;
     assert!(capacity("small-bottle") < 300.0 && capacity("large-bottle") > 300.0);
 }
+
+/// The threshold presets change c alone: every other control and constant is water's, so a
+/// study of them presents one cue (issue 18: `thick` once also poured in 7 s instead of 5).
+#[test]
+fn the_threshold_presets_change_viscosity_alone() {
+    let water = Preset::find("water").unwrap();
+    for id in ["thin", "thick"] {
+        let preset = Preset::find(id).unwrap();
+        let mut controls = preset.controls(ControlValues::default());
+        assert_ne!(
+            controls.viscosity,
+            water.controls(ControlValues::default()).viscosity
+        );
+        controls.viscosity = water.controls(ControlValues::default()).viscosity;
+        assert_eq!(controls, water.controls(ControlValues::default()), "{id}");
+        assert_eq!(
+            preset.config(ModelConfig::default()),
+            water.config(ModelConfig::default()),
+            "{id}"
+        );
+    }
+}

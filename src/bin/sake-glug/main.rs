@@ -3,6 +3,7 @@
 
 mod accuracy;
 mod fit;
+mod analyze;
 mod parameters;
 mod presets;
 mod render;
@@ -39,6 +40,8 @@ enum Command {
     Parameters(parameters::ParametersArgs),
     /// Fits a model (a scene file) to recordings of a bottle: see MODEL.md §13.
     Fit(fit::FitArgs),
+    /// Analyses study logs: Thurstone scaling (paired) or a psychometric fit (constant).
+    Analyze(analyze::AnalyzeArgs),
 }
 
 /// A `--sample-rate` as a scene's `sample_rate` is checked (in range, whole), refused by the
@@ -62,5 +65,6 @@ fn main() -> ExitCode {
         Command::Presets(args) => presets::run(args),
         Command::Parameters(args) => parameters::run(args),
         Command::Fit(args) => fit::run(args),
+        Command::Analyze(args) => analyze::run(args),
     }
 }

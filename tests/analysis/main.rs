@@ -1,0 +1,30 @@
+//! The analysis of study logs (`sake-glug analyze`): Thurstone scaling of paired comparisons,
+//! the psychometric fit of constant stimuli and the coverage of its intervals, checked by
+//! simulation; bad logs refused with file, line and column; the JSON shapes.
+
+mod bad_logs;
+mod constant;
+mod paired;
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// Runs `sake-glug analyze ARGS` in `directory`.
+pub fn analyze(directory: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sake-glug"))
+        .current_dir(directory)
+        .arg("analyze")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// The JSON object a successful `--json` run printed.
+pub fn json_of(output: &Output) -> serde_json::Value {
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).expect("one JSON object")
+}

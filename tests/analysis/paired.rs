@@ -1,0 +1,196 @@
+//! Paired comparison: the count matrix back from the trials, Case V by hand, the tests' degrees
+//! of freedom.
+
+use std::fmt::Write;
+
+use sake_glug::analysis::{scale_paired, PairedTrial};
+use statrs::distribution::{ContinuousCDF, Normal};
+
+use crate::{analyze, json_of};
+
+/// The stimuli of the paper's §3: the two-sinusoid model, the high-frequency wave alone, the
+/// low-frequency wave alone.
+const STIMULI: [&str; 3] = ["model", "high", "low"];
+
+/// A count matrix in the shape of the paper's Table 1 (`[i][j]`: how often i was chosen over j),
+/// CONSTRUCTED for this test: the paper's numbers were not at hand. 10 participants, each
+/// judging every ordered pair 3 times: 60 trials a pair.
+const CONSTRUCTED_TABLE_1: [[u32; 3]; 3] = [[0, 45, 50], [15, 0, 34], [10, 26, 0]];
+const PARTICIPANTS: usize = 10;
+
+/// The table as a runner's log: each participant's 18 trials, every ordered pair 3 times, the
+/// choices of each pair dealt out in turn so every participant has some of each answer.
+fn log_of_table(table: &[[u32; 3]; 3], participants: usize) -> String {
+    let mut log = String::from("participant,trial,design,first,second,answer,rt_s,seed\n");
+    let mut trial = vec![0; participants];
+    for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+        let answers = std::iter::repeat_n(i, table[i][j] as usize)
+            .chain(std::iter::repeat_n(j, table[j][i] as usize));
+        for (index, chosen) in answers.enumerate() {
+            let participant = index % participants;
+            // Alternate the order of presentation: both ordered pairs.
+            let (first, second) = if (index / participants).is_multiple_of(2) {
+                (i, j)
+            } else {
+                (j, i)
+            };
+            trial[participant] += 1;
+            writeln!(
+                log,
+                "p{participant},{},paired,{},{},{},1.25,7",
+                trial[participant], STIMULI[first], STIMULI[second], STIMULI[chosen]
+            )
+            .unwrap();
+        }
+    }
+    log
+}
+
+#[test]
+fn table_1_entered_as_trials_gives_back_its_count_matrix_and_the_model_first() {
+    let folder = tempfile::tempdir().unwrap();
+    std::fs::write(
+        folder.path().join("table1.csv"),
+        log_of_table(&CONSTRUCTED_TABLE_1, PARTICIPANTS),
+    )
+    .unwrap();
+    let json = json_of(&analyze(folder.path(), &["paired", "table1.csv", "--json"]));
+    let stimuli: Vec<&str> = json["stimuli"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|name| name.as_str().unwrap())
+        .collect();
+    assert_eq!(stimuli, STIMULI);
+    let counts: Vec<Vec<u32>> = serde_json::from_value(json["counts"].clone()).unwrap();
+    assert_eq!(counts, CONSTRUCTED_TABLE_1.map(Vec::from).to_vec());
+    let scale = json["scale"].as_object().unwrap();
+    let value = |name: &str| scale[name].as_f64().unwrap();
+    assert!(
+        value("model") > value("high") && value("high") > value("low"),
+        "{scale:?}"
+    );
+    assert_eq!(value("low"), 0.0, "the lowest is shifted to 0");
+    assert_eq!(json["participants"], PARTICIPANTS);
+    assert_eq!(json["trials"], 180);
+}
+
+/// The scale as Thurstone's Case V has it, computed here from the table directly.
+#[test]
+fn the_scale_is_case_v_by_hand() {
+    let trials = trials_of_table(&CONSTRUCTED_TABLE_1);
+    let analysis = scale_paired(&trials).unwrap();
+    let normal = Normal::standard();
+    let z = |i: usize, j: usize| {
+        let (a, b) = (CONSTRUCTED_TABLE_1[i][j], CONSTRUCTED_TABLE_1[j][i]);
+        if i == j {
+            0.0
+        } else {
+            normal.inverse_cdf(f64::from(a) / f64::from(a + b))
+        }
+    };
+    let means: Vec<f64> = (0..3)
+        .map(|i| (0..3).map(|j| z(i, j)).sum::<f64>() / 3.0)
+        .collect();
+    let lowest = means.iter().copied().fold(f64::INFINITY, f64::min);
+    for (computed, mean) in analysis.scale.iter().zip(&means) {
+        assert!(
+            (computed - (mean - lowest)).abs() < 1e-12,
+            "{:?} vs {means:?}",
+            analysis.scale
+        );
+    }
+    let fit = analysis.fit.expect("three stimuli: one degree of freedom");
+    assert_eq!(fit.df, 1);
+    assert!(fit.p > 0.0 && fit.p <= 1.0);
+}
+
+/// A unanimous pair (p = 1) is clipped to 1 − 1/(2n), not scaled at infinity.
+#[test]
+fn a_unanimous_pair_is_clipped_by_the_one_over_2n_rule() {
+    let trials = trials_of_table(&[[0, 6, 6], [0, 0, 3], [0, 3, 0]]);
+    let analysis = scale_paired(&trials).unwrap();
+    let expected = Normal::standard().inverse_cdf(1.0 - 1.0 / 12.0);
+    assert!(
+        (analysis.z[0][1] - expected).abs() < 1e-12,
+        "{:?}",
+        analysis.z
+    );
+    assert!(analysis.scale.iter().all(|value| value.is_finite()));
+}
+
+fn trials_of_table(table: &[[u32; 3]; 3]) -> Vec<PairedTrial> {
+    let mut trials = Vec::new();
+    for i in 0..3 {
+        for j in 0..3 {
+            for _ in 0..table[i][j] {
+                trials.push(PairedTrial {
+                    participant: "p".into(),
+                    first: STIMULI[i.min(j)].into(),
+                    second: STIMULI[i.max(j)].into(),
+                    answer: STIMULI[i].into(),
+                });
+            }
+        }
+    }
+    trials
+}
+
+/// 21 participants, 3 stimuli: the agreement test has (21 − 1)(3 − 1) = 40 degrees of freedom,
+/// the paper's χ²(40). Participants who all answer alike agree (p near 1); two camps do not.
+#[test]
+fn the_agreement_test_has_the_papers_40_degrees_of_freedom_for_21_participants() {
+    let camp = |participant: usize, reversed: bool| {
+        let mut trials = Vec::new();
+        for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+            for repetition in 0..6 {
+                let (winner, loser) = if reversed { (j, i) } else { (i, j) };
+                let (first, second) = if repetition % 2 == 0 { (i, j) } else { (j, i) };
+                // One answer in six goes the other way, so no pair is unanimous.
+                let chosen = if repetition == 5 { loser } else { winner };
+                trials.push(PairedTrial {
+                    participant: format!("p{participant}"),
+                    first: STIMULI[first].into(),
+                    second: STIMULI[second].into(),
+                    answer: STIMULI[chosen].into(),
+                });
+            }
+        }
+        trials
+    };
+    let alike: Vec<PairedTrial> = (0..21).flat_map(|p| camp(p, false)).collect();
+    let agreement = scale_paired(&alike).unwrap().agreement.unwrap();
+    assert_eq!(agreement.df, 40);
+    assert!(
+        agreement.chi2.abs() < 1e-9 && agreement.p > 0.999,
+        "{agreement:?}"
+    );
+    let split: Vec<PairedTrial> = (0..21).flat_map(|p| camp(p, p % 2 == 1)).collect();
+    let agreement = scale_paired(&split).unwrap().agreement.unwrap();
+    assert_eq!(agreement.df, 40);
+    assert!(agreement.p < 1e-6, "{agreement:?}");
+}
+
+#[test]
+fn the_text_report_shows_the_matrix_the_scale_and_both_tests() {
+    let folder = tempfile::tempdir().unwrap();
+    std::fs::write(
+        folder.path().join("log.csv"),
+        log_of_table(&CONSTRUCTED_TABLE_1, PARTICIPANTS),
+    )
+    .unwrap();
+    let output = analyze(folder.path(), &["paired", "log.csv", "--plot", "scale.png"]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let text = String::from_utf8(output.stdout).unwrap();
+    for expected in ["chosen over", "scale", "Mosteller", "χ²(1)", "χ²(18)"] {
+        assert!(text.contains(expected), "no `{expected}` in\n{text}");
+    }
+    let png = std::fs::read(folder.path().join("scale.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"));
+    let left: Vec<_> = std::fs::read_dir(folder.path()).unwrap().collect();
+    assert_eq!(left.len(), 2, "the log and the plot, no temporary file");
+}
