@@ -15,6 +15,9 @@
 //! takes), shared by the plugin and the offline renderer. Data flows one way: scene, take or
 //! host → controls → pour → synthesis → sinks (WAV, clips, plot, audio out).
 //!
+//! [`study`] runs the paper's listening studies on the offline renderer's stimuli (feature
+//! `study`, which `cli` brings; presentation on JACK with `audio`).
+//!
 //! [`text::printable`] escapes the control characters of outside text echoed in any message.
 #![warn(missing_docs)]
 
@@ -28,6 +31,8 @@ pub mod offline;
 pub mod plugin;
 #[cfg(feature = "reports")]
 pub mod reports;
+#[cfg(feature = "study")]
+pub mod study;
 pub mod text;
 
 /// The plugin types, at the crate's root for nice-plug's export macros.

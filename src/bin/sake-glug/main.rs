@@ -2,6 +2,7 @@
 //! subcommand; the work is in the library, which knows nothing of `clap`.
 
 mod accuracy;
+mod experiment;
 mod parameters;
 mod presets;
 mod render;
@@ -36,6 +37,8 @@ enum Command {
     Presets(presets::PresetsArgs),
     /// Every control and model constant: parameter id, scene key, range and default.
     Parameters(parameters::ParametersArgs),
+    /// Runs a listening study's session (paired or constant stimuli) for one participant.
+    Experiment(experiment::ExperimentArgs),
 }
 
 /// A `--sample-rate` as a scene's `sample_rate` is checked (in range, whole), refused by the
@@ -58,5 +61,6 @@ fn main() -> ExitCode {
         Command::Stability(args) => stability::run(args),
         Command::Presets(args) => presets::run(args),
         Command::Parameters(args) => parameters::run(args),
+        Command::Experiment(args) => experiment::run(args),
     }
 }
