@@ -18,4 +18,5 @@ mod memory;
 mod presets;
 mod readme;
 mod scene_files;
+mod study;
 mod takes;
