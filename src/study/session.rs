@@ -80,8 +80,8 @@ impl Session<'_> {
         }
     }
 
-    /// Presents the trials from number `from` (0-based) on, reading each answer from `input`
-    /// (a line `1` or `2`; anything else asks again) and appending it to `log` before the next
+    /// Presents the trials from number `from` (0-based) on, once a first line (Enter) comes from
+    /// `input`, reading each answer from it (a line `1` or `2`; anything else asks again) and appending it to `log` before the next
     /// trial. Prompts go to `prompt`. Ends with [`StudyError::InputClosed`] if `input` ends first.
     pub fn run(
         &self,
@@ -96,6 +96,23 @@ impl Session<'_> {
             // A prompt that cannot be shown is no reason to lose the session.
             let _ = prompt.write_fmt(text).and_then(|()| prompt.flush());
         };
+        let read_line = |input: &mut dyn BufRead, line: &mut String, answered: usize| {
+            line.clear();
+            match input.read_line(line) {
+                Ok(0) => Err(StudyError::InputClosed { answered, total }),
+                Ok(_) => Ok(()),
+                Err(source) => Err(StudyError::Io {
+                    path: "stdin".into(),
+                    source,
+                }),
+            }
+        };
+        let mut line = String::new();
+        if from < total {
+            // The participant (and whoever connects the audio) starts the session.
+            say(prompt, format_args!("Press Enter to begin.\n"));
+            read_line(input, &mut line, from)?;
+        }
         for (index, &trial) in self.trials.iter().enumerate().skip(from) {
             say(
                 prompt,
@@ -107,19 +124,7 @@ impl Session<'_> {
                 format_args!("{} 1 (the first) or 2 (the second): ", self.spec.question),
             );
             let pressed = loop {
-                let mut line = String::new();
-                let read = input
-                    .read_line(&mut line)
-                    .map_err(|source| StudyError::Io {
-                        path: "stdin".into(),
-                        source,
-                    })?;
-                if read == 0 {
-                    return Err(StudyError::InputClosed {
-                        answered: index,
-                        total,
-                    });
-                }
+                read_line(input, &mut line, index)?;
                 match line.trim() {
                     "1" => break 1u8,
                     "2" => break 2u8,

@@ -245,7 +245,7 @@ fn a_killed_session_keeps_its_answers_and_resume_continues() {
     let mut child = start(dir.path(), &args);
     let mut stdin = child.stdin.take().unwrap();
     // A bad answer is asked again; each good one is in the log before the next trial.
-    for (answer, rows) in [("x", 0), ("1", 1), ("", 1), ("2", 2), ("1", 3)] {
+    for (answer, rows) in [("", 0), ("x", 0), ("1", 1), ("", 1), ("2", 2), ("1", 3)] {
         writeln!(stdin, "{answer}").unwrap();
         stdin.flush().unwrap();
         wait_for_rows(&log, rows);
@@ -300,6 +300,7 @@ fn a_killed_session_keeps_its_answers_and_resume_continues() {
 
     let mut resumed = start(dir.path(), &[&args[..], &["--resume"]].concat());
     let mut stdin = resumed.stdin.take().unwrap();
+    writeln!(stdin).unwrap();
     for _ in 3..12 {
         writeln!(stdin, "wrong\n2").unwrap();
     }
@@ -360,6 +361,7 @@ fn the_constant_log_says_which_was_the_comparison() {
         ],
     );
     let mut stdin = child.stdin.take().unwrap();
+    writeln!(stdin).unwrap();
     for _ in 0..9 {
         writeln!(stdin, "1").unwrap();
     }

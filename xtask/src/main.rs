@@ -78,6 +78,8 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             cargo(&["test", "--workspace", "--no-fail-fast", "--all-features"])?;
             build_bundles_and_cli()?;
             build_standalone()?;
+            // The host tests play a study on JACK: the command line with its audio output.
+            build_cli_with("cli,audio")?;
             host_tests()
         }
         Some("docs") => {
@@ -185,6 +187,11 @@ fn build_standalone() -> nice_plug_xtask::Result<()> {
 
 /// The release command line alone, with only its features.
 fn build_cli() -> nice_plug_xtask::Result<()> {
+    build_cli_with("cli")
+}
+
+/// The release command line with `features`.
+fn build_cli_with(features: &str) -> nice_plug_xtask::Result<()> {
     cargo(&[
         "build",
         "--release",
@@ -192,7 +199,7 @@ fn build_cli() -> nice_plug_xtask::Result<()> {
         "sake-glug",
         "--no-default-features",
         "--features",
-        "cli",
+        features,
     ])
 }
 
