@@ -103,23 +103,27 @@ impl JackOutput {
         // Uniform on ±a has an RMS of a/√3.
         let noise_peak = noise_dbfs.map_or(0.0, |db| 10f64.powf(db / 20.0) * 3f64.sqrt()) as f32;
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(0);
-        let mut playing: Option<(u64, usize, usize, u64)> = None; // generation, first, second, position
+        // The trial playing: its generation, first and second stimulus, and its onset frame.
+        let mut playing: Option<(u64, usize, usize, jack::Frames)> = None;
         let mut served = 0u64;
         let callback_shared = Arc::clone(&shared);
         let callback: Callback = Box::new(move |_client, scope| {
             let frames = scope.n_frames() as usize;
+            let now = scope.last_frame_time();
             let request = callback_shared.request.load(Ordering::Acquire);
             let generation = request >> 32;
             if playing.is_none() && generation > served {
                 served = generation;
                 let first = ((request >> 16) & 0xffff) as usize;
                 let second = (request & 0xffff) as usize;
-                playing = Some((generation, first, second, 0));
+                playing = Some((generation, first, second, now));
                 callback_shared
                     .onset_frame
-                    .store(scope.last_frame_time() as u64, Ordering::Release);
+                    .store(now as u64, Ordering::Release);
             }
-            let start = playing.map(|(_, _, _, position)| position);
+            // The position follows JACK's frame clock, so a cycle the server skips (an xrun)
+            // loses its samples but moves nothing later: the logged frames stay true.
+            let start = playing.map(|(_, _, _, onset)| now.wrapping_sub(onset) as u64);
             for (port, &(actuator, headphone)) in ports.iter_mut().zip(&roles) {
                 let out = port.as_mut_slice(scope);
                 out.fill(0.0);
@@ -149,12 +153,11 @@ impl JackOutput {
                     }
                 }
             }
-            if let Some((generation, first, second, position)) = playing.as_mut() {
-                *position += frames as u64;
+            if let (Some((generation, first, second, _)), Some(start)) = (playing, start) {
                 let total =
-                    stimuli[*first].len() as u64 + gap_samples + stimuli[*second].len() as u64;
-                if *position >= total {
-                    callback_shared.ended.store(*generation, Ordering::Release);
+                    stimuli[first].len() as u64 + gap_samples + stimuli[second].len() as u64;
+                if start + frames as u64 >= total {
+                    callback_shared.ended.store(generation, Ordering::Release);
                     playing = None;
                 }
             }
@@ -203,10 +206,11 @@ impl Presenter for JackPlayer {
         let client = self.client.as_client();
         let first = self.shared.onset_frame.load(Ordering::Acquire);
         let second = first + self.lengths[trial.first] + self.gap;
-        let end = second + self.lengths[trial.second];
+        // Frame times are 32-bit and wrap (after a day at 48 kHz), as JACK's own do.
+        let end = (second + self.lengths[trial.second]) as jack::Frames;
         // The end on JACK's clock (µs), and how long ago that was: the response time counts
         // from the last sample played, not from when this thread noticed.
-        let end_us = client.frames_to_time(end as jack::Frames);
+        let end_us = client.frames_to_time(end);
         let now_us = client.time();
         let since = Duration::from_micros(now_us.saturating_sub(end_us));
         Ok(Presented {

@@ -82,8 +82,15 @@ impl Channels {
             .unwrap_or(0)
     }
 
-    /// Refuses channel 0 and a channel with both roles (the noise must stay off the actuator).
-    pub fn check(&self) -> Result<(), String> {
+    /// Refuses channel 0, a channel with both roles (the noise must stay off the actuator), and
+    /// masking noise (`noise_dbfs`) with no headphone channel to play it on.
+    pub fn check(&self, noise_dbfs: Option<f64>) -> Result<(), String> {
+        if noise_dbfs.is_some() && self.headphones.is_empty() {
+            return Err(
+                "`noise_dbfs` needs headphone channels (`channels.headphones` or --headphones)"
+                    .into(),
+            );
+        }
         if self.actuator.is_empty() {
             return Err("`channels.actuator` names no channel".into());
         }
@@ -237,7 +244,7 @@ impl Spec {
             }
         }
         let channels = file.channels.unwrap_or_default();
-        channels.check().map_err(bad)?;
+        channels.check(file.noise_dbfs).map_err(bad)?;
         let folder = path.parent().unwrap_or(Path::new(""));
         let stimulus = |name: String, table: toml::Table, level: Option<f64>| {
             build_stimulus(path, folder, name, table, level, file.duration_s)

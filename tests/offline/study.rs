@@ -90,6 +90,79 @@ fn spec_errors_name_the_file_and_the_key() {
         "{SHORT_PAIRED}[channels]\nactuator = [1]\nheadphones = [1, 2]\n"
     ));
     assert!(channels.contains("channel 1 is both"), "{channels}");
+    let noise = error_of(&format!("noise_dbfs = -30.0\n{SHORT_PAIRED}"));
+    assert!(
+        noise.contains("`noise_dbfs` needs headphone channels"),
+        "{noise}"
+    );
+}
+
+#[test]
+fn the_dry_run_writes_each_trials_stimuli_and_the_list() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("study.toml"), SHORT_PAIRED).unwrap();
+    let spec = Spec::load(&dir.path().join("study.toml")).unwrap();
+    let trials = plan_trials(&spec, order_seed(spec.seed, "p1"));
+    let rendered = render_stimuli(&spec, 48_000).unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_sake-glug"))
+        .current_dir(dir.path())
+        .args([
+            "experiment",
+            "study.toml",
+            "--participant",
+            "p1",
+            "--log",
+            "l.csv",
+        ])
+        .args(["--dry-run", "dry"])
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    // No answers: the files are written, the session stops at its first question.
+    assert_eq!(output.status.code(), Some(1));
+    let mut names: Vec<String> = std::fs::read_dir(dir.path().join("dry"))
+        .unwrap()
+        .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names.len(), 2 * trials.len() + 1, "{names:?}");
+    let list = log_rows(&dir.path().join("dry/trials.csv"));
+    for ((trial, row), index) in trials.iter().zip(&list).zip(1..) {
+        for (place, stimulus) in [(1, trial.first), (2, trial.second)] {
+            let name = &spec.stimuli[stimulus].name;
+            let file = format!("trial-{index:03}-{place}-{name}.wav");
+            assert_eq!(&row[2 + place], file.as_str());
+            let samples: Vec<f32> = hound::WavReader::open(dir.path().join("dry").join(&file))
+                .unwrap()
+                .into_samples()
+                .map(Result::unwrap)
+                .collect();
+            assert_eq!(samples, rendered[stimulus].samples, "{file}");
+        }
+    }
+    // A folder that holds anything is refused, and left as it was.
+    std::fs::remove_file(dir.path().join("l.csv")).unwrap();
+    let again = Command::new(env!("CARGO_BIN_EXE_sake-glug"))
+        .current_dir(dir.path())
+        .args([
+            "experiment",
+            "study.toml",
+            "--participant",
+            "p2",
+            "--log",
+            "l.csv",
+        ])
+        .args(["--dry-run", "dry"])
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    assert_eq!(again.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("not an empty folder"));
+    assert_eq!(log_rows(&dir.path().join("dry/trials.csv")), list);
+    assert!(
+        !dir.path().join("l.csv").exists(),
+        "no log for a refused session"
+    );
 }
 
 #[test]

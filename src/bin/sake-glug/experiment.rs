@@ -68,12 +68,19 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
     if let Some(headphones) = args.headphones {
         spec.channels.headphones = headphones;
     }
-    spec.channels.check().map_err(|message| {
+    spec.channels.check(spec.noise_dbfs).map_err(|message| {
         usage(StudyError::Spec {
             path: args.spec.clone(),
             message,
         })
     })?;
+    // Refused before the audio and the renders: the log is created or reopened after them.
+    if args.resume && !args.log.exists() {
+        return Err(usage(StudyError::NothingToResume(args.log)));
+    }
+    if !args.resume && args.log.exists() {
+        return Err(usage(StudyError::LogExists(args.log)));
+    }
     let seed = order_seed(spec.seed, &args.participant);
     let trials = plan_trials(&spec, seed);
 
@@ -127,26 +134,32 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         trials: &trials,
         rendered: &rendered,
     };
-    let (mut log, done) = if args.resume {
+    let resumed = if args.resume {
         let (log, done) = TrialLog::resume(&args.log, &session.expected()).map_err(usage)?;
         println!("Resuming after trial {done} of {}.", trials.len());
-        (log, done)
+        Some((log, done))
     } else {
-        (TrialLog::create(&args.log).map_err(usage)?, 0)
+        None
+    };
+    if let Some(dir) = &args.dry_run {
+        // A resumed dry run keeps the folder its first run wrote.
+        let already = args.resume && dir.join(sake_glug::study::TRIAL_LIST).exists();
+        if !already {
+            let written = write_dry_run(dir, &session, sample_rate).map_err(usage)?;
+            println!("Wrote {} files into {}.", written.len(), dir.display());
+        }
+    }
+    // Created last, so that a refused folder or spec leaves no log behind.
+    let (mut log, done) = match resumed {
+        Some(resumed) => resumed,
+        None => (TrialLog::create(&args.log).map_err(usage)?, 0),
     };
     let _ = std::io::stdout().flush();
 
     let mut input = std::io::stdin().lock();
     let mut prompt = std::io::stdout();
     let result = match &args.dry_run {
-        Some(dir) => {
-            let already = args.resume && dir.join(sake_glug::study::TRIAL_LIST).exists();
-            if !already {
-                let written = write_dry_run(dir, &session, sample_rate).map_err(usage)?;
-                println!("Wrote {} files into {}.", written.len(), dir.display());
-            }
-            session.run(done, &mut Silent, &mut log, &mut input, &mut prompt)
-        }
+        Some(_) => session.run(done, &mut Silent, &mut log, &mut input, &mut prompt),
         #[cfg(feature = "audio")]
         None => {
             let stimuli = rendered.iter().map(|r| r.samples.clone()).collect();
