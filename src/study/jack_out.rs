@@ -63,7 +63,7 @@ impl JackOutput {
 
     /// The server's sample rate (Hz).
     pub fn sample_rate(&self) -> u32 {
-        self.client.sample_rate() as u32
+        self.client.sample_rate()
     }
 
     /// Starts playing: ports `out_1` … `out_N` for the channels, each connected to the
@@ -77,7 +77,7 @@ impl JackOutput {
         noise_dbfs: Option<f64>,
     ) -> Result<JackPlayer, StudyError> {
         let client = self.client;
-        let sample_rate = client.sample_rate() as u32;
+        let sample_rate = client.sample_rate();
         let mut ports: Vec<Port<AudioOut>> = Vec::new();
         for channel in 1..=channels.count() {
             ports.push(
