@@ -7,8 +7,8 @@ use std::process::ExitCode;
 use clap::Args;
 
 use sake_glug::study::{
-    order_seed, plan_trials, render_stimuli, write_dry_run, Session, Silent, Spec, StudyError,
-    TrialLog,
+    order_seed, plan_trials, render_stimuli, write_dry_run, Equalize, Session, Silent, Spec,
+    StudyError, TrialLog,
 };
 
 #[derive(Args, Debug)]
@@ -101,13 +101,15 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         if args.dry_run.is_none() {
             return Err((
                 2,
-                StudyError::Audio(format!(
-                    "this build plays no audio (build with `--features audio`, JACK); \
-                     `--dry-run DIR` runs the session without it (client `{}`)",
-                    args.client_name
-                )),
+                StudyError::Audio(
+                    "this build plays no audio: build it with `--features audio` (JACK), or \
+                     run the session without it with `--dry-run DIR`"
+                        .into(),
+                ),
             ));
         }
+        // JACK's client name means nothing without JACK.
+        let _ = args.client_name;
         spec.stimuli[0].scene.sample_rate
     };
 
@@ -119,10 +121,16 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         spec.equalize.name(),
         sample_rate
     );
+    // What was matched: `none` shows the peaks.
+    let kind = match spec.equalize {
+        Equalize::Rms => "rms ",
+        Equalize::Peak | Equalize::None => "peak",
+    };
     for (stimulus, rendered) in spec.stimuli.iter().zip(&rendered) {
         println!(
-            "  {:<24} level {:>8.2} dBFS  gain {:>+7.3} dB",
+            "  {:<24} {} {:>8.2} dBFS  gain {:>+7.3} dB",
             stimulus.name,
+            kind,
             20.0 * rendered.level.log10(),
             rendered.gain_db
         );
