@@ -344,13 +344,6 @@ impl Spec {
             stimuli,
         })
     }
-
-    /// The stimulus called `name`.
-    pub fn index_of(&self, name: &str) -> Option<usize> {
-        self.stimuli
-            .iter()
-            .position(|stimulus| stimulus.name == name)
-    }
 }
 
 /// The scene keys a constant design may vary: every control's and every constant's, from their
