@@ -17,6 +17,8 @@
 //!
 //! [`analysis`] (feature `analysis`, which `cli` brings) reads the trial logs of the paper's two
 //! studies and scales or fits them.
+//! [`study`] runs the paper's listening studies on the offline renderer's stimuli (feature
+//! `study`, which `cli` brings; presentation on JACK with `audio`).
 //!
 //! [`text::printable`] escapes the control characters of outside text echoed in any message.
 #![warn(missing_docs)]
@@ -35,6 +37,8 @@ pub mod offline;
 pub mod plugin;
 #[cfg(feature = "reports")]
 pub mod reports;
+#[cfg(feature = "study")]
+pub mod study;
 pub mod text;
 
 /// The plugin types, at the crate's root for nice-plug's export macros.

@@ -18,5 +18,6 @@ mod memory;
 mod presets;
 mod readme;
 mod scene_files;
+mod study;
 mod tables;
 mod takes;

@@ -80,7 +80,9 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             // All features, assert_process_allocs among them: the dev profile keeps the debug
             // assertions it needs.
             cargo(&["test", "--workspace", "--no-fail-fast", "--all-features"])?;
-            build_bundles_and_cli()?;
+            build_bundles()?;
+            // Built once, with what the host tests need of it: a study played on JACK.
+            build_cli_with("cli,audio")?;
             build_standalone()?;
             host_tests()?;
             python_tests()
@@ -121,6 +123,12 @@ fn xtask() -> nice_plug_xtask::Result<()> {
 
 /// The CLAP and VST3 bundles under target/bundled/, and the release CLI beside them.
 fn build_bundles_and_cli() -> nice_plug_xtask::Result<()> {
+    build_bundles()?;
+    build_cli()
+}
+
+/// The CLAP and VST3 bundles under target/bundled/.
+fn build_bundles() -> nice_plug_xtask::Result<()> {
     nice_plug_xtask::main_with_args(
         "cargo xtask",
         [
@@ -132,8 +140,7 @@ fn build_bundles_and_cli() -> nice_plug_xtask::Result<()> {
             "editor",
         ]
         .map(String::from),
-    )?;
-    build_cli()
+    )
 }
 
 /// What the standalone app links against, as pkg-config names each library, and the Debian
@@ -199,6 +206,11 @@ fn build_standalone() -> nice_plug_xtask::Result<()> {
 
 /// The release command line alone, with only its features.
 fn build_cli() -> nice_plug_xtask::Result<()> {
+    build_cli_with("cli")
+}
+
+/// The release command line with `features`.
+fn build_cli_with(features: &str) -> nice_plug_xtask::Result<()> {
     cargo(&[
         "build",
         "--release",
@@ -206,7 +218,7 @@ fn build_cli() -> nice_plug_xtask::Result<()> {
         "sake-glug",
         "--no-default-features",
         "--features",
-        "cli",
+        features,
     ])
 }
 

@@ -2,8 +2,9 @@
 //! subcommand; the work is in the library, which knows nothing of `clap`.
 
 mod accuracy;
-mod fit;
 mod analyze;
+mod experiment;
+mod fit;
 mod parameters;
 mod presets;
 mod render;
@@ -42,6 +43,8 @@ enum Command {
     Fit(fit::FitArgs),
     /// Analyses study logs: Thurstone scaling (paired) or a psychometric fit (constant).
     Analyze(analyze::AnalyzeArgs),
+    /// Runs a listening study's session (paired or constant stimuli) for one participant.
+    Experiment(experiment::ExperimentArgs),
 }
 
 /// A `--sample-rate` as a scene's `sample_rate` is checked (in range, whole), refused by the
@@ -66,5 +69,6 @@ fn main() -> ExitCode {
         Command::Parameters(args) => parameters::run(args),
         Command::Fit(args) => fit::run(args),
         Command::Analyze(args) => analyze::run(args),
+        Command::Experiment(args) => experiment::run(args),
     }
 }

@@ -1,0 +1,185 @@
+//! `sake-glug experiment`: runs a listening study's session for one participant.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Args;
+
+use sake_glug::study::{
+    order_seed, plan_trials, render_stimuli, write_dry_run, Equalize, Session, Silent, Spec,
+    StudyError, TrialLog,
+};
+
+#[derive(Args, Debug)]
+pub struct ExperimentArgs {
+    /// The study's spec file (see experiments/README.md).
+    spec: PathBuf,
+    /// The participant's ID: with the spec's seed it fixes the trial order.
+    #[arg(long)]
+    participant: String,
+    /// The trial log (CSV), one row appended per answer.
+    #[arg(long)]
+    log: PathBuf,
+    /// Writes every trial's two stimuli as WAV files and the trial list into this new (or
+    /// empty) folder, and runs the session without playing anything.
+    #[arg(long, value_name = "DIR")]
+    dry_run: Option<PathBuf>,
+    /// Continues the session of an existing log after its last trial (same order).
+    #[arg(long)]
+    resume: bool,
+    /// The actuator's output channels, from 1 (e.g. `1` or `1,2`): overrides the spec's.
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    actuator: Option<Vec<u16>>,
+    /// The headphones' output channels, which carry the masking noise: overrides the spec's.
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    headphones: Option<Vec<u16>>,
+    /// The JACK client's name.
+    #[arg(long, default_value = "sake-glug-experiment")]
+    client_name: String,
+}
+
+pub fn run(args: ExperimentArgs) -> ExitCode {
+    match session(args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err((status, error)) => {
+            eprintln!("error: {error}");
+            ExitCode::from(status)
+        }
+    }
+}
+
+/// A usage error (exit status 2): nothing was presented.
+fn usage(error: StudyError) -> (u8, StudyError) {
+    (2, error)
+}
+
+fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
+    let mut spec = Spec::load(&args.spec).map_err(usage)?;
+    if args.participant.trim().is_empty() || args.participant.chars().any(char::is_control) {
+        return Err(usage(StudyError::Spec {
+            path: args.spec.clone(),
+            message: "--participant: give a non-empty ID without control characters".into(),
+        }));
+    }
+    if let Some(actuator) = args.actuator {
+        spec.channels.actuator = actuator;
+    }
+    if let Some(headphones) = args.headphones {
+        spec.channels.headphones = headphones;
+    }
+    spec.channels.check(spec.noise_dbfs).map_err(|message| {
+        usage(StudyError::Spec {
+            path: args.spec.clone(),
+            message,
+        })
+    })?;
+    // Refused before the audio and the renders: the log is created or reopened after them.
+    if args.resume && !args.log.exists() {
+        return Err(usage(StudyError::NothingToResume(args.log)));
+    }
+    if !args.resume && args.log.exists() {
+        return Err(usage(StudyError::LogExists(args.log)));
+    }
+    let seed = order_seed(spec.seed, &args.participant);
+    let trials = plan_trials(&spec, seed);
+
+    // The audio interface first: its sample rate is the stimuli's.
+    #[cfg(feature = "audio")]
+    let output = match args.dry_run {
+        Some(_) => None,
+        None => Some(sake_glug::study::JackOutput::open(&args.client_name).map_err(|e| (1, e))?),
+    };
+    #[cfg(feature = "audio")]
+    let sample_rate = output
+        .as_ref()
+        .map_or(spec.stimuli[0].scene.sample_rate, |output| {
+            output.sample_rate()
+        });
+    #[cfg(not(feature = "audio"))]
+    let sample_rate = {
+        if args.dry_run.is_none() {
+            return Err((
+                2,
+                StudyError::Audio(
+                    "this build plays no audio: build it with `--features audio` (JACK), or \
+                     run the session without it with `--dry-run DIR`"
+                        .into(),
+                ),
+            ));
+        }
+        // JACK's client name means nothing without JACK.
+        let _ = args.client_name;
+        spec.stimuli[0].scene.sample_rate
+    };
+
+    let rendered = render_stimuli(&spec, sample_rate).map_err(usage)?;
+    println!(
+        "{} design, {} trials, order seed {seed}, equalize {} ({} Hz):",
+        spec.design.name(),
+        trials.len(),
+        spec.equalize.name(),
+        sample_rate
+    );
+    // What was matched: `none` shows the peaks.
+    let kind = match spec.equalize {
+        Equalize::Rms => "rms ",
+        Equalize::Peak | Equalize::None => "peak",
+    };
+    for (stimulus, rendered) in spec.stimuli.iter().zip(&rendered) {
+        println!(
+            "  {:<24} {} {:>8.2} dBFS  gain {:>+7.3} dB",
+            stimulus.name,
+            kind,
+            20.0 * rendered.level.log10(),
+            rendered.gain_db
+        );
+    }
+    let session = Session {
+        spec: &spec,
+        participant: &args.participant,
+        seed,
+        trials: &trials,
+        rendered: &rendered,
+    };
+    let resumed = if args.resume {
+        let (log, done) = TrialLog::resume(&args.log, &session.expected()).map_err(usage)?;
+        println!("Resuming after trial {done} of {}.", trials.len());
+        Some((log, done))
+    } else {
+        None
+    };
+    if let Some(dir) = &args.dry_run {
+        // A resumed dry run keeps the folder its first run wrote.
+        let already = args.resume && dir.join(sake_glug::study::TRIAL_LIST).exists();
+        if !already {
+            let written = write_dry_run(dir, &session, sample_rate).map_err(usage)?;
+            println!("Wrote {} files into {}.", written.len(), dir.display());
+        }
+    }
+    // Created last, so that a refused folder or spec leaves no log behind.
+    let (mut log, done) = match resumed {
+        Some(resumed) => resumed,
+        None => (TrialLog::create(&args.log).map_err(usage)?, 0),
+    };
+    let _ = std::io::stdout().flush();
+
+    let mut input = std::io::stdin().lock();
+    let mut prompt = std::io::stdout();
+    let result = match &args.dry_run {
+        Some(_) => session.run(done, &mut Silent, &mut log, &mut input, &mut prompt),
+        #[cfg(feature = "audio")]
+        None => {
+            let stimuli = rendered.iter().map(|r| r.samples.clone()).collect();
+            let gap = (spec.gap_s * sample_rate as f64).round() as u64;
+            let output = output.expect("opened above without --dry-run");
+            let mut player = output
+                .start(stimuli, gap, &spec.channels, spec.noise_dbfs)
+                .map_err(|e| (1, e))?;
+            session.run(done, &mut player, &mut log, &mut input, &mut prompt)
+        }
+        #[cfg(not(feature = "audio"))]
+        None => unreachable!("refused above without --dry-run"),
+    };
+    result.map_err(|error| (1, error))
+}

@@ -1,0 +1,223 @@
+//! Presentation on a JACK server (feature `audio`, as the standalone app reaches JACK): the
+//! stimuli on the actuator's channels, the masking noise on the headphone channels from the
+//! start of the session to its end.
+//!
+//! The stimuli are rendered before the client is activated and handed to its process callback
+//! whole; the session then starts a trial through one atomic word, and the callback reports the
+//! frame the trial started at and that it ended through two more. The callback neither
+//! allocates nor locks.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use jack::{AudioOut, Client, ClientOptions, Control, Port, PortFlags};
+use rand::{RngExt, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+use super::session::{Presented, Presenter};
+use super::spec::Channels;
+use super::trials::Trial;
+use super::StudyError;
+
+/// A JACK client, not yet playing: its sample rate decides the stimuli's.
+pub struct JackOutput {
+    client: Client,
+}
+
+/// The callback's side of the hand-off.
+#[derive(Default)]
+struct Shared {
+    /// Generation (high 32 bits), first and second stimulus (16 bits each) of the trial asked.
+    request: AtomicU64,
+    /// Generation of the last trial that has ended.
+    ended: AtomicU64,
+    /// JACK frame at which the last trial started.
+    onset_frame: AtomicU64,
+}
+
+/// The player, active on the server until dropped.
+pub struct JackPlayer {
+    client: jack::AsyncClient<(), jack::contrib::ClosureProcessHandler<(), Callback>>,
+    shared: Arc<Shared>,
+    generation: u64,
+    lengths: Vec<u64>,
+    gap: u64,
+    sample_rate: u32,
+}
+
+type Callback = Box<dyn FnMut(&Client, &jack::ProcessScope) -> Control + Send>;
+
+fn audio_error(what: &str, error: impl std::fmt::Display) -> StudyError {
+    StudyError::Audio(format!("{what}: {error}"))
+}
+
+impl JackOutput {
+    /// Opens a client called `name` on the running JACK server (`$JACK_DEFAULT_SERVER` or the
+    /// default one); never starts a server.
+    pub fn open(name: &str) -> Result<Self, StudyError> {
+        let (client, _) = Client::new(name, ClientOptions::NO_START_SERVER)
+            .map_err(|error| audio_error("cannot reach a JACK server", error))?;
+        Ok(Self { client })
+    }
+
+    /// The server's sample rate (Hz).
+    pub fn sample_rate(&self) -> u32 {
+        self.client.sample_rate()
+    }
+
+    /// Starts playing: ports `out_1` … `out_N` for the channels, each connected to the
+    /// server's physical playback port of the same number where there is one; the noise (an
+    /// RMS level in dBFS, uniform white noise) runs at once on the headphone channels.
+    pub fn start(
+        self,
+        stimuli: Vec<Vec<f32>>,
+        gap_samples: u64,
+        channels: &Channels,
+        noise_dbfs: Option<f64>,
+    ) -> Result<JackPlayer, StudyError> {
+        let client = self.client;
+        let sample_rate = client.sample_rate();
+        let mut ports: Vec<Port<AudioOut>> = Vec::new();
+        for channel in 1..=channels.count() {
+            ports.push(
+                client
+                    .register_port(&format!("out_{channel}"), AudioOut::default())
+                    .map_err(|error| audio_error("cannot register a port", error))?,
+            );
+        }
+        let roles: Vec<(bool, bool)> = (1..=channels.count())
+            .map(|channel| {
+                (
+                    channels.actuator.contains(&channel),
+                    channels.headphones.contains(&channel),
+                )
+            })
+            .collect();
+        let names: Vec<String> = ports
+            .iter()
+            .map(|port| port.name().unwrap_or_default())
+            .collect();
+        let shared = Arc::new(Shared::default());
+        let lengths: Vec<u64> = stimuli.iter().map(|s| s.len() as u64).collect();
+        // Uniform on ±a has an RMS of a/√3.
+        let noise_peak = noise_dbfs.map_or(0.0, |db| 10f64.powf(db / 20.0) * 3f64.sqrt()) as f32;
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(0);
+        // The trial playing: its generation, first and second stimulus, and its onset frame.
+        let mut playing: Option<(u64, usize, usize, jack::Frames)> = None;
+        let mut served = 0u64;
+        let callback_shared = Arc::clone(&shared);
+        let callback: Callback = Box::new(move |_client, scope| {
+            let frames = scope.n_frames() as usize;
+            let now = scope.last_frame_time();
+            let request = callback_shared.request.load(Ordering::Acquire);
+            let generation = request >> 32;
+            if playing.is_none() && generation > served {
+                served = generation;
+                let first = ((request >> 16) & 0xffff) as usize;
+                let second = (request & 0xffff) as usize;
+                playing = Some((generation, first, second, now));
+                callback_shared
+                    .onset_frame
+                    .store(now as u64, Ordering::Release);
+            }
+            // The position follows JACK's frame clock, so a cycle the server skips (an xrun)
+            // loses its samples but moves nothing later: the logged frames stay true.
+            let start = playing.map(|(_, _, _, onset)| now.wrapping_sub(onset) as u64);
+            for (port, &(actuator, headphone)) in ports.iter_mut().zip(&roles) {
+                let out = port.as_mut_slice(scope);
+                out.fill(0.0);
+                if actuator {
+                    if let (Some((_, first, second, _)), Some(start)) = (playing, start) {
+                        let first = &stimuli[first];
+                        let second = &stimuli[second];
+                        let second_at = first.len() as u64 + gap_samples;
+                        for (offset, sample) in out.iter_mut().enumerate() {
+                            let position = start + offset as u64;
+                            *sample = if position < first.len() as u64 {
+                                first[position as usize]
+                            } else if position >= second_at {
+                                second
+                                    .get((position - second_at) as usize)
+                                    .copied()
+                                    .unwrap_or(0.0)
+                            } else {
+                                0.0
+                            };
+                        }
+                    }
+                }
+                if headphone && noise_peak > 0.0 {
+                    for sample in out.iter_mut() {
+                        *sample = noise_peak * (2.0 * rng.random::<f32>() - 1.0);
+                    }
+                }
+            }
+            if let (Some((generation, first, second, _)), Some(start)) = (playing, start) {
+                let total =
+                    stimuli[first].len() as u64 + gap_samples + stimuli[second].len() as u64;
+                if start + frames as u64 >= total {
+                    callback_shared.ended.store(generation, Ordering::Release);
+                    playing = None;
+                }
+            }
+            Control::Continue
+        });
+        let active = client
+            .activate_async((), jack::contrib::ClosureProcessHandler::new(callback))
+            .map_err(|error| audio_error("cannot start the JACK client", error))?;
+        let physical = active.as_client().ports(
+            None,
+            Some("32 bit float mono audio"),
+            PortFlags::IS_INPUT | PortFlags::IS_PHYSICAL,
+        );
+        for (ours, theirs) in names.iter().zip(&physical) {
+            // A missing or refused connection leaves the port for the user to connect.
+            let _ = active.as_client().connect_ports_by_name(ours, theirs);
+        }
+        Ok(JackPlayer {
+            client: active,
+            shared,
+            generation: 0,
+            lengths,
+            gap: gap_samples,
+            sample_rate,
+        })
+    }
+}
+
+impl Presenter for JackPlayer {
+    fn present(&mut self, trial: Trial) -> Result<Presented, StudyError> {
+        self.generation += 1;
+        let request = (self.generation << 32) | ((trial.first as u64) << 16) | trial.second as u64;
+        self.shared.request.store(request, Ordering::Release);
+        let length = self.lengths[trial.first] + self.gap + self.lengths[trial.second];
+        // Far longer than the trial: a server that stopped running our callback.
+        let give_up = Instant::now()
+            + Duration::from_secs_f64(2.0 * length as f64 / self.sample_rate as f64 + 5.0);
+        while self.shared.ended.load(Ordering::Acquire) < self.generation {
+            if Instant::now() > give_up {
+                return Err(StudyError::Audio(
+                    "the JACK server stopped playing the trial".into(),
+                ));
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        let client = self.client.as_client();
+        let first = self.shared.onset_frame.load(Ordering::Acquire);
+        let second = first + self.lengths[trial.first] + self.gap;
+        // Frame times are 32-bit and wrap (after a day at 48 kHz), as JACK's own do.
+        let end = (second + self.lengths[trial.second]) as jack::Frames;
+        // The end on JACK's clock (µs), and how long ago that was: the response time counts
+        // from the last sample played, not from when this thread noticed.
+        let end_us = client.frames_to_time(end);
+        let now_us = client.time();
+        let since = Duration::from_micros(now_us.saturating_sub(end_us));
+        Ok(Presented {
+            onset_frames: Some((first, second)),
+            ended: Instant::now()
+                .checked_sub(since)
+                .unwrap_or_else(Instant::now),
+        })
+    }
+}

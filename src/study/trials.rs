@@ -1,0 +1,72 @@
+//! The trial order of a session: every ordered pair (paired) or every level with the standard
+//! first in half of its repetitions (constant), shuffled from a seed that mixes the spec's seed
+//! with the participant's ID, so one participant's order is the same on every run and resume.
+
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+use super::spec::{Design, Spec};
+
+/// One trial: which stimulus comes first and which second (indices into [`Spec::stimuli`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Trial {
+    /// The stimulus played first.
+    pub first: usize,
+    /// The stimulus played second.
+    pub second: usize,
+}
+
+/// The seed of a participant's order: FNV-1a (64-bit) over the participant's ID, started from
+/// the spec's seed. Stable across platforms and Rust versions (the log keeps it).
+pub fn order_seed(spec_seed: u64, participant: &str) -> u64 {
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+    const OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+    participant.bytes().fold(OFFSET ^ spec_seed, |hash, byte| {
+        (hash ^ byte as u64).wrapping_mul(PRIME)
+    })
+}
+
+/// Every trial of a session in the order presented.
+///
+/// Paired: each ordered pair of distinct stimuli `repetitions` times. Constant: each comparison
+/// `repetitions` times, the standard first in ⌊repetitions/2⌋ of them and second in the rest
+/// (an odd one left goes to the standard first for every other level, so the whole session
+/// stays balanced within one trial). The list is then shuffled from `seed`.
+pub fn plan_trials(spec: &Spec, seed: u64) -> Vec<Trial> {
+    let count = spec.stimuli.len();
+    let reps = spec.repetitions as usize;
+    let mut trials = Vec::new();
+    match spec.design {
+        Design::Paired => {
+            for _ in 0..reps {
+                for first in 0..count {
+                    for second in (0..count).filter(|&second| second != first) {
+                        trials.push(Trial { first, second });
+                    }
+                }
+            }
+        }
+        Design::Constant => {
+            // The standard is stimulus 0.
+            for comparison in 1..count {
+                let standard_first = reps / 2 + (reps % 2) * (comparison % 2);
+                for rep in 0..reps {
+                    trials.push(if rep < standard_first {
+                        Trial {
+                            first: 0,
+                            second: comparison,
+                        }
+                    } else {
+                        Trial {
+                            first: comparison,
+                            second: 0,
+                        }
+                    });
+                }
+            }
+        }
+    }
+    trials.shuffle(&mut Xoshiro256PlusPlus::seed_from_u64(seed));
+    trials
+}

@@ -1,0 +1,191 @@
+"""`sake-glug experiment` under a real JACK server (dummy driver), answers piped on stdin.
+
+A recorder client records the runner's three output channels in the same JACK cycles, so the
+frames the log gives for each stimulus's onset compare directly with the recording. Checked:
+each trial's two stimuli sit on the actuator channel at the logged frames, sample for sample
+what the dry run of the same spec and participant writes (the level-matched stimuli), with
+equal peaks; the actuator channel is silent everywhere else; the masking noise is on the
+headphone channels alone, at its level, and none of the stimulus leaks into them.
+
+Needs `jackd` (Debian's jackd2) and the release `sake-glug` built with JACK
+(`cargo build --release --bin sake-glug --no-default-features --features cli,audio`).
+"""
+
+import csv
+import os
+import shutil
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from test_standalone import CLI, start_jack, stop, wait_for
+
+NOISE_DBFS = -30.0
+SPEC = f"""
+design = "paired"
+duration_s = 0.5
+gap_s = 0.2
+repetitions = 1
+seed = 5
+equalize = "peak"
+noise_dbfs = {NOISE_DBFS}
+
+[channels]
+actuator = [1]
+headphones = [2, 3]
+
+[stimuli.model]
+preset = "water"
+
+[stimuli.high]
+preset = "water"
+viscosity_c = 0.0
+
+[stimuli.low]
+preset = "water"
+viscosity_c = 1.0
+"""
+CLIENT = "experiment-under-test"
+
+
+def read_f32_wav(path):
+    """A mono 32-bit float WAV's samples (the format the dry run writes)."""
+    data = Path(path).read_bytes()
+    at = data.index(b"data")
+    size = int.from_bytes(data[at + 4 : at + 8], "little")
+    return np.frombuffer(data[at + 8 : at + 8 + size], dtype="<f4")
+
+
+@pytest.fixture(scope="module")
+def jack_server():
+    if shutil.which("jackd") is None:
+        if os.environ.get("CI"):
+            pytest.fail("jackd is not installed (Debian: jackd2); .ci/run installs it")
+        pytest.skip("jackd is not installed (Debian: jackd2)")
+    assert CLI.exists(), f"{CLI} is missing: build it with --features cli,audio"
+    # A name of our own: other host tests may run a server at the same time.
+    name = f"sakeglug-experiment-{os.getpid()}"
+    server, log = start_jack(name)
+    try:
+        yield name
+    finally:
+        stop(server, signal.SIGTERM)
+        log.close()
+
+
+def test_the_runner_plays_level_matched_stimuli_at_the_logged_frames(jack_server, tmp_path):
+    import jack
+
+    (tmp_path / "study.toml").write_text(SPEC)
+    # The dry run of the same spec and participant: the stimuli as they must be heard.
+    dry = subprocess.run(
+        [CLI, "experiment", "study.toml", "--participant", "p1", "--log", "dry.csv",
+         "--dry-run", "dry"],
+        cwd=tmp_path, input="\n" + "1\n" * 6, capture_output=True, text=True, timeout=120,
+    )
+    assert dry.returncode == 0, dry.stderr
+
+    recorder = jack.Client("recorder", servername=jack_server, no_start_server=True)
+    inputs = [recorder.inports.register(f"in_{channel}") for channel in (1, 2, 3)]
+    chunks = []
+    recording = [True]
+
+    def record(frames):
+        if recording[0]:
+            chunks.append((recorder.last_frame_time, [p.get_array().copy() for p in inputs]))
+
+    recorder.set_process_callback(record)
+    recorder.activate()
+    env = dict(os.environ, JACK_DEFAULT_SERVER=jack_server)
+    runner = subprocess.Popen(
+        [CLI, "experiment", "study.toml", "--participant", "p1", "--log", "log.csv",
+         "--client-name", CLIENT],
+        cwd=tmp_path, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE, text=True,
+    )
+    try:
+        def ports_up():
+            return len(recorder.get_ports(f"{CLIENT}:out_")) == 3
+
+        wait_for(ports_up, 60, "the runner's ports")
+        for channel in (1, 2, 3):
+            recorder.connect(f"{CLIENT}:out_{channel}", f"recorder:in_{channel}")
+        # Answers typed ahead: each is read once its trial has ended.
+        out, err = runner.communicate("\n" + "x\n1\n2\n" * 3, timeout=60)
+        assert runner.returncode == 0, err
+        assert out.count("Please answer 1 or 2") == 3
+        time.sleep(0.1)
+    finally:
+        stop(runner)
+        recording[0] = False
+        recorder.deactivate()
+        recorder.close()
+
+    rows = list(csv.DictReader(open(tmp_path / "log.csv")))
+    trials = list(csv.DictReader(open(tmp_path / "dry" / "trials.csv")))
+    assert len(rows) == 6
+    # Each cycle's samples at its frame; a cycle the recorder missed (a busy machine) stays NaN.
+    start = chunks[0][0]
+    length = chunks[-1][0] + len(chunks[-1][1][0]) - start
+    recorded = [np.full(length, np.nan, dtype=np.float32) for _ in range(3)]
+    runner_missed = 0
+    previous_noise = None
+    for frame, arrays in chunks:
+        # A cycle the runner missed under load shows on the noise channel, which is never
+        # silent and never repeats: silence, or the previous cycle's buffer again. Such a cycle
+        # is not the runner's output, and is left out like one the recorder missed.
+        stale = previous_noise is not None and np.array_equal(arrays[1], previous_noise)
+        previous_noise = arrays[1]
+        if not np.any(arrays[1]) or stale:
+            runner_missed += 1
+            continue
+        for channel, array in zip(recorded, arrays):
+            channel[frame - start : frame - start + len(array)] = array
+    missed = np.isnan(recorded[0])
+    print(f"cycles recorded {len(chunks)}, frames missed {missed.sum()} of {length}, "
+          f"cycles without the runner {runner_missed}")
+    actuator = recorded[0]
+    stimulus_mask = np.zeros(len(actuator), dtype=bool)
+    peaks = {}
+    for row, trial in zip(rows, trials):
+        assert (row["first"], row["second"]) == (trial["first"], trial["second"])
+        assert float(row["rt_s"]) >= 0.0
+        assert row["answer"] == (row["first"] if row["pressed"] == "1" else row["second"])
+        for place in ("first", "second"):
+            expected = read_f32_wav(tmp_path / "dry" / trial[f"{place}_file"])
+            at = int(row[f"{place}_onset_frame"]) - start
+            assert 0 <= at and at + len(expected) <= len(actuator), "recorded whole"
+            heard = actuator[at : at + len(expected)]
+            # Compared where the recorder ran (a busy machine may skip a cycle of the graph).
+            kept = ~np.isnan(heard)
+            assert kept.mean() > 0.5, "most of the stimulus was recorded"
+            wrong = np.nonzero(kept & (heard != expected))[0]
+            assert len(wrong) == 0, f"trial {row['trial']} {place} ({row[place]}): {len(wrong)} " \
+                f"samples differ from the dry run's, the first at {wrong[:1]} of {len(expected)}"
+            stimulus_mask[at : at + len(expected)] = True
+            peaks[row[place]] = np.max(np.abs(expected))
+            assert np.max(np.abs(heard[kept])) <= peaks[row[place]]
+        gap = int(row["second_onset_frame"]) - int(row["first_onset_frame"])
+        assert gap == len(read_f32_wav(tmp_path / "dry" / trial["first_file"])) + round(0.2 * 48000)
+    assert len(peaks) == 3
+    assert max(peaks.values()) / min(peaks.values()) - 1 < 1e-6, f"peaks matched: {peaks}"
+    recorded_ok = ~missed
+    assert not np.any(actuator[~stimulus_mask & recorded_ok]), "the actuator is silent between"
+    target = 10 ** (NOISE_DBFS / 20)
+    # The session: from the first onset to the last stimulus's end (before it, the recorder
+    # was not yet connected).
+    session = np.zeros(len(actuator), dtype=bool)
+    session[np.argmax(stimulus_mask) : len(actuator) - np.argmax(stimulus_mask[::-1])] = True
+    session &= recorded_ok
+    for headphone in recorded[1:]:
+        during = np.sqrt(np.mean(headphone[stimulus_mask & session] ** 2))
+        outside = np.sqrt(np.mean(headphone[session & ~stimulus_mask] ** 2))
+        assert abs(during / target - 1) < 0.05 and abs(outside / target - 1) < 0.05
+        # No stimulus in the noise: uncorrelated with the actuator's signal.
+        both = stimulus_mask & session
+        correlation = np.corrcoef(headphone[both], actuator[both])[0, 1]
+        assert abs(correlation) < 0.05, correlation
