@@ -10,6 +10,7 @@ mod outputs;
 mod render;
 mod scene;
 pub mod sinks;
+pub mod steps;
 
 pub use automation::Automation;
 pub use memory::human_bytes;
@@ -18,4 +19,6 @@ pub use render::{render_scene, render_scene_to_vec, RenderError, RenderObserver,
 pub use scene::{
     InputFile, InputFileError, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S,
 };
-pub use sinks::{Output, OutputError, OutputFormat, OutputOptions, SampleFormat, WavError};
+pub use sinks::{
+    Output, OutputError, OutputFormat, OutputOptions, PlatformOptions, SampleFormat, WavError,
+};

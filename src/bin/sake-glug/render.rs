@@ -12,9 +12,11 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use sake_glug::engine::Preset;
 use sake_glug::offline::clips::HapticBand;
+use sake_glug::offline::sinks::DualSenseAudio;
+use sake_glug::offline::steps::{DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
 use sake_glug::offline::{
-    human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions, RenderError,
-    RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
+    human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions,
+    PlatformOptions, RenderError, RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
 };
 use sake_glug::text::printable;
 
@@ -67,6 +69,12 @@ pub struct RenderArgs {
     /// Sample format of WAV files: f32, s24 or s16.
     #[arg(long, default_value = "f32")]
     sample_format: SampleFormat,
+    /// Frames a second of a rumble file (1 to 1000).
+    #[arg(long, value_name = "HZ", default_value_t = DEFAULT_RUMBLE_RATE_HZ, value_parser = rumble_rate)]
+    rumble_rate: f64,
+    /// What the audio channels (1–2) of a dualsense file hold: silent or glug.
+    #[arg(long, value_name = "silent|glug", default_value = "silent")]
+    dualsense_audio: DualSenseAudio,
     /// The old name of --sample-format, which sat beside --formats: refused, naming the new one.
     #[arg(long = "format", hide = true, num_args = 0..=1, default_missing_value = "")]
     renamed_format: Option<String>,
@@ -108,6 +116,10 @@ pub fn run(args: RenderArgs) -> ExitCode {
     let options = OutputOptions {
         sample_format: args.sample_format,
         haptic_band: args.haptic_band,
+        platforms: PlatformOptions {
+            rumble_rate_hz: args.rumble_rate,
+            dualsense_audio: args.dualsense_audio,
+        },
     };
     let stop = Stop::on_signals();
     let mut out = Console::new(jobs.len());
@@ -315,6 +327,18 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
         });
     }
     Ok(jobs)
+}
+
+/// `--rumble-rate`'s value parser: a rate in [`RUMBLE_RATE_RANGE_HZ`].
+fn rumble_rate(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(hz) if RUMBLE_RATE_RANGE_HZ.contains(&hz) => Ok(hz),
+        _ => Err(format!(
+            "`{text}` is not a rate from {} to {} Hz",
+            RUMBLE_RATE_RANGE_HZ.start(),
+            RUMBLE_RATE_RANGE_HZ.end()
+        )),
+    }
 }
 
 /// `-o`'s value parser: `NAME:FILE` or a file its extension names.

@@ -10,12 +10,16 @@
 //! and an `open` function, and an entry in that table.
 
 mod ahap;
+mod android;
 mod clip;
 mod csv;
+mod dualsense;
+mod haps;
 mod haptic;
 mod pending;
 #[cfg(feature = "plot")]
 mod plot;
+mod rumble;
 mod wav;
 
 use std::path::{Path, PathBuf};
@@ -31,10 +35,14 @@ pub(crate) use pending::{remove_stale_temps, PendingFile};
 use plot::open as open_plot;
 
 pub use ahap::ahap_json;
+pub use android::{android_waveform_json, android_xml};
 pub use csv::write_csv_samples;
+pub use dualsense::{DualSenseAudio, DUALSENSE_CHANNELS, DUALSENSE_RATE_HZ};
+pub use haps::{haps_json, HAPS_VERSION};
 pub use haptic::haptic_json;
 #[cfg(feature = "plot")]
 pub use plot::{draw_pour_plot, PlotData, PlotError, Waveform};
+pub use rumble::rumble_json;
 pub use wav::{SampleFormat, WavError};
 
 /// One file of a render, written from the render's single pass. Every method but
@@ -104,9 +112,32 @@ impl OutputFormat {
     pub const CSV: Self = Self::new("csv", "csv", csv::open);
     /// `.png`: the pour plot (feature `plot`; a build without it refuses a plot by name).
     pub const PLOT: Self = Self::new("png", "png", open_plot);
+    /// `.xml`: Android's vibration XML (`VibrationXmlParser`).
+    pub const ANDROID_XML: Self = Self::new("android-xml", "xml", android::open_xml);
+    /// `android-waveform` (`.json`): the arrays of Android's `VibrationEffect.createWaveform`.
+    pub const ANDROID_WAVEFORM: Self =
+        Self::named("android-waveform", "json", android::open_waveform);
+    /// `rumble` (`.json`): frames of a dual-rumble gamepad's two motors.
+    pub const RUMBLE: Self = Self::named("rumble", "json", rumble::open);
+    /// `.haps`: an Interhaptics / Razer Haptic Composer file (version 5).
+    pub const HAPS: Self = Self::new("haps", "haps", haps::open);
+    /// `dualsense` (`.wav`): 4 channels at 48 kHz, the DualSense's audio and actuators.
+    pub const DUALSENSE: Self = Self::named("dualsense", "wav", dualsense::open);
 
     /// Every format, in the order a file's extension is looked up.
-    pub const ALL: &'static [Self] = &[Self::WAV, Self::HAPTIC, Self::AHAP, Self::CSV, Self::PLOT];
+    pub const ALL: &'static [Self] = &[
+        Self::WAV,
+        Self::HAPTIC,
+        Self::AHAP,
+        Self::CSV,
+        Self::PLOT,
+        // The platforms (issue 19).
+        Self::ANDROID_XML,
+        Self::ANDROID_WAVEFORM,
+        Self::RUMBLE,
+        Self::HAPS,
+        Self::DUALSENSE,
+    ];
 
     /// A format its extension picks.
     const fn new(name: &'static str, extension: &'static str, open: OpenSink) -> Self {
@@ -119,7 +150,6 @@ impl OutputFormat {
     }
 
     /// A format that shares its extension with another: picked only by its name.
-    #[allow(dead_code)] // the first such formats are being added on their own branches
     const fn named(name: &'static str, extension: &'static str, open: OpenSink) -> Self {
         Self {
             name,
@@ -279,6 +309,26 @@ pub struct OutputOptions {
     pub sample_format: SampleFormat,
     /// The actuator band the `.haptic` frequencies map to.
     pub haptic_band: HapticBand,
+    /// How the platform formats (rumble, DualSense, Android) are written.
+    pub platforms: PlatformOptions,
+}
+
+/// How the platform formats are written.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlatformOptions {
+    /// Frames a second of a `rumble` file ([`crate::offline::steps::RUMBLE_RATE_RANGE_HZ`]).
+    pub rumble_rate_hz: f64,
+    /// What the audio channels of a `dualsense` file hold.
+    pub dualsense_audio: DualSenseAudio,
+}
+
+impl Default for PlatformOptions {
+    fn default() -> Self {
+        Self {
+            rumble_rate_hz: crate::offline::steps::DEFAULT_RUMBLE_RATE_HZ,
+            dualsense_audio: DualSenseAudio::default(),
+        }
+    }
 }
 
 /// Why the files of a render could not be written.
@@ -330,6 +380,35 @@ pub enum OutputError {
     /// A WAV file could not be written.
     #[error(transparent)]
     Wav(#[from] WavError),
+    /// A format plays at one sample rate only, and the scene renders at another.
+    #[error(
+        "{}: a {format} file plays at {needed_hz} Hz, and the scene renders at {scene_hz} Hz; \
+         render it at {needed_hz} Hz (--sample-rate {needed_hz}, or sample_rate in the scene)",
+        path.display()
+    )]
+    WrongRate {
+        /// The file asked for.
+        path: PathBuf,
+        /// The format's name.
+        format: &'static str,
+        /// The rate it plays at (Hz).
+        needed_hz: u32,
+        /// The scene's rate (Hz).
+        scene_hz: u32,
+    },
+    /// The render is longer than a file of this format can hold.
+    #[error(
+        "{}: a {format} file holds at most {max_s:.0} s; give the scene a shorter duration_s",
+        path.display()
+    )]
+    TooLongFor {
+        /// The file asked for.
+        path: PathBuf,
+        /// The format's name.
+        format: &'static str,
+        /// The longest render it can hold (s).
+        max_s: f64,
+    },
     /// Another file could not be written.
     #[error("cannot write {}: {source}", path.display())]
     Io {
