@@ -1,0 +1,244 @@
+//! The platform files of a real render: every one passes its platform's rules, marks the
+//! engine's own glugs within its own step, and the rumble motors share the weight as the
+//! model shares it between f1 and f2.
+
+use std::path::{Path, PathBuf};
+
+use sake_glug::engine::UnitOnset;
+use sake_glug::offline::sinks::DUALSENSE_RATE_HZ;
+use sake_glug::offline::steps::ANDROID_STEP_MS;
+use sake_glug::offline::{
+    render_scene, render_to_files, Output, OutputFormat, OutputOptions, RenderError,
+    RenderObserver, Scene,
+};
+
+use super::{android_waveform, android_xml, dualsense, haps, rumble};
+use crate::command::{files_in, sake_glug};
+
+/// A pour with the viscosity and the gain automated.
+const SCENE: &str = r#"
+seed = 7
+tilt_deg = [[0.0, 90.0], [0.4, 140.0], [2.5, 140.0], [2.6, 0.0]]
+viscosity_c = [[0.0, 0.1], [2.5, 0.9]]
+[output]
+gain_db = [[0.0, -3.0], [2.5, -9.0]]
+"#;
+
+/// The onsets (s) of the audible units the engine starts for `scene`.
+fn audible_onsets(scene: &Scene) -> Vec<f64> {
+    struct Units(Vec<UnitOnset>);
+    impl RenderObserver for Units {
+        fn unit_started(&mut self, onset: &UnitOnset, _output_gain: f64) {
+            self.0.push(*onset);
+        }
+    }
+    let mut units = Units(Vec::new());
+    render_scene(scene, |_| Ok::<(), RenderError>(()), &mut units).unwrap();
+    units
+        .0
+        .iter()
+        .filter(|unit| unit.amplitude > 0.0)
+        .map(|unit| (unit.sample as f64 + unit.fraction) / scene.sample_rate as f64)
+        .collect()
+}
+
+/// Renders `scene` once into every platform format and the mono WAV, in `directory`.
+fn render(scene: &Scene, directory: &Path) -> Vec<(OutputFormat, PathBuf)> {
+    let formats = [
+        OutputFormat::WAV,
+        OutputFormat::ANDROID_XML,
+        OutputFormat::ANDROID_WAVEFORM,
+        OutputFormat::RUMBLE,
+        OutputFormat::HAPS,
+        OutputFormat::DUALSENSE,
+    ];
+    let outputs: Vec<Output> = formats
+        .iter()
+        .map(|&format| Output {
+            format,
+            path: directory.join(format.file_name("pour")),
+        })
+        .collect();
+    render_to_files(scene, "pour", &outputs, &OutputOptions::default(), |_| {}).unwrap();
+    outputs.into_iter().map(|o| (o.format, o.path)).collect()
+}
+
+fn file_of(files: &[(OutputFormat, PathBuf)], format: OutputFormat) -> &Path {
+    &files.iter().find(|(f, _)| *f == format).unwrap().1
+}
+
+fn text(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap()
+}
+
+/// How far each onset is from the nearest of `marks`, the worst of them (s).
+fn worst_distance(onsets: &[f64], marks: &[f64]) -> f64 {
+    onsets
+        .iter()
+        .map(|onset| {
+            marks
+                .iter()
+                .map(|mark| (mark - onset).abs())
+                .fold(f64::INFINITY, f64::min)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The start times (s) of entries given their durations (ms).
+fn starts(durations_ms: impl Iterator<Item = u64>) -> Vec<f64> {
+    let mut at = 0;
+    durations_ms
+        .map(|d| {
+            let start = at;
+            at += d;
+            start as f64 / 1000.0
+        })
+        .collect()
+}
+
+#[test]
+fn a_real_render_writes_valid_platform_files_with_the_engines_onsets() {
+    let directory = tempfile::tempdir().unwrap();
+    let scene = Scene::parse(SCENE).unwrap();
+    let files = render(&scene, directory.path());
+    let onsets = audible_onsets(&scene);
+    assert!(onsets.len() > 20, "{} audible glugs", onsets.len());
+    let half_ms = 0.0005 + 1e-9;
+
+    // Android XML: an entry starts within half a millisecond of every onset, and the entries
+    // that start at an onset vibrate.
+    let xml = text(file_of(&files, OutputFormat::ANDROID_XML));
+    let violations = android_xml::validate(&xml);
+    assert!(violations.is_empty(), "{violations:#?}");
+    let entries = android_xml::parse(&xml);
+    let entry_starts = starts(entries.iter().map(|e| e.duration_ms));
+    assert!(worst_distance(&onsets, &entry_starts) <= half_ms);
+    for onset in &onsets {
+        let index = entry_starts
+            .iter()
+            .position(|start| (start - onset).abs() <= half_ms)
+            .unwrap();
+        assert!(
+            (1..=255).contains(&entries[index].amplitude),
+            "at {onset} s"
+        );
+    }
+    assert!(entries
+        .iter()
+        .all(|e| e.duration_ms <= ANDROID_STEP_MS || e.amplitude == 0));
+
+    // The waveform JSON holds the same entries.
+    let waveform = text(file_of(&files, OutputFormat::ANDROID_WAVEFORM));
+    let violations = android_waveform::validate(&waveform);
+    assert!(violations.is_empty(), "{violations:#?}");
+    let pairs: Vec<(i64, i64)> = entries
+        .iter()
+        .map(|e| (e.duration_ms as i64, e.amplitude as i64))
+        .collect();
+    assert_eq!(android_waveform::parse(&waveform), pairs);
+
+    // Rumble: every onset shows as a rise of the motors within one frame.
+    let rumble_text = text(file_of(&files, OutputFormat::RUMBLE));
+    let violations = rumble::validate(&rumble_text);
+    assert!(violations.is_empty(), "{violations:#?}");
+    let rumble = rumble::parse(&rumble_text);
+    let sum: Vec<f64> = rumble.frames.iter().map(|f| f.1 + f.2).collect();
+    for onset in &onsets {
+        let k = (onset * rumble.rate_hz) as usize;
+        let before = if k == 0 { 0.0 } else { sum[k - 1] };
+        assert!(
+            sum[k].max(sum[(k + 1).min(sum.len() - 1)]) > before,
+            "no rise within a frame of the glug at {onset} s"
+        );
+    }
+
+    // .haps: one note per audible glug, starting at its onset.
+    let haps_text = text(file_of(&files, OutputFormat::HAPS));
+    let violations = haps::validate(&haps_text);
+    assert!(violations.is_empty(), "{violations:#?}");
+    let melodies = haps::parse(&haps_text);
+    let note_starts: Vec<f64> = melodies[0].iter().map(|n| n.start_s).collect();
+    assert_eq!(note_starts.len(), onsets.len());
+    assert!(worst_distance(&onsets, &note_starts) < 1e-9);
+
+    // DualSense: 4 channels; the actuators are the render's own samples, the audio silent.
+    let bytes = std::fs::read(file_of(&files, OutputFormat::DUALSENSE)).unwrap();
+    let violations = dualsense::validate(&bytes);
+    assert!(violations.is_empty(), "{violations:#?}");
+    let frames = dualsense::parse(&bytes);
+    let wav: Vec<f32> = hound::WavReader::open(file_of(&files, OutputFormat::WAV))
+        .unwrap()
+        .samples::<f32>()
+        .map(Result::unwrap)
+        .collect();
+    assert_eq!(scene.sample_rate, DUALSENSE_RATE_HZ);
+    assert_eq!(frames.len(), wav.len());
+    for (frame, y) in frames.iter().zip(&wav) {
+        let expected = (*y as f64 * 32_768.0).round().clamp(-32_768.0, 32_767.0) as i16;
+        assert_eq!(*frame, [0, 0, expected, expected]);
+    }
+}
+
+/// The low motor's share of the energy, Σ low² / Σ (low² + high²), of a pour at viscosity `c`.
+fn low_share(c: f64) -> f64 {
+    let scene = Scene::parse(&format!(
+        "seed = 3\nduration_s = 3.0\ntilt_deg = 140.0\nviscosity_c = {c}\n"
+    ))
+    .unwrap();
+    let directory = tempfile::tempdir().unwrap();
+    let path = directory.path().join("pour.json");
+    let output = Output {
+        format: OutputFormat::RUMBLE,
+        path: path.clone(),
+    };
+    render_to_files(&scene, "pour", &[output], &OutputOptions::default(), |_| {}).unwrap();
+    let rumble = rumble::parse(&text(&path));
+    let low: f64 = rumble.frames.iter().map(|f| f.1 * f.1).sum();
+    let high: f64 = rumble.frames.iter().map(|f| f.2 * f.2).sum();
+    assert!(low + high > 0.0, "a silent pour at c = {c}");
+    low / (low + high)
+}
+
+/// The model gives the low component (f1) the share c of each glug's amplitude: a more
+/// viscous liquid moves the weight to the low motor.
+#[test]
+fn viscosity_moves_the_rumble_to_the_low_motor() {
+    let shares: Vec<(f64, f64)> = [0.1, 0.33, 0.6, 0.9]
+        .into_iter()
+        .map(|c| (c, low_share(c)))
+        .collect();
+    eprintln!("low motor's share of the energy by viscosity: {shares:?}");
+    for pair in shares.windows(2) {
+        assert!(pair[1].1 > pair[0].1, "{shares:?}");
+    }
+}
+
+#[test]
+fn one_command_writes_every_platform_file() {
+    let directory = tempfile::tempdir().unwrap();
+    let scene = directory.path().join("pour.toml");
+    std::fs::write(&scene, "seed = 5\nduration_s = 1.0\ntilt_deg = 140.0\n").unwrap();
+    let formats = "wav,haptic,ahap,android-xml,android-waveform,dualsense,rumble,haps";
+    let output = sake_glug(
+        directory.path(),
+        &[
+            "render",
+            "pour.toml",
+            "--out-dir",
+            "clips",
+            "--formats",
+            formats,
+        ],
+    );
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let mut expected: Vec<String> = formats
+        .split(',')
+        .map(|name| OutputFormat::of_name(name).unwrap().file_name("pour"))
+        .collect();
+    expected.sort();
+    assert_eq!(files_in(&directory.path().join("clips")), expected);
+}
