@@ -12,7 +12,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use sake_glug::engine::Preset;
 use sake_glug::offline::clips::HapticBand;
-use sake_glug::offline::sinks::DualSenseAudio;
+use sake_glug::offline::sinks::AudioChannels;
 use sake_glug::offline::steps::{DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
 use sake_glug::offline::{
     human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions,
@@ -72,9 +72,10 @@ pub struct RenderArgs {
     /// Frames a second of a rumble file (1 to 1000).
     #[arg(long, value_name = "HZ", default_value_t = DEFAULT_RUMBLE_RATE_HZ, value_parser = rumble_rate)]
     rumble_rate: f64,
-    /// What the audio channels (1–2) of a dualsense file hold: silent or glug.
+    /// What the audio channels of a dualsense or android-ogg file hold: silent or glug (the
+    /// actuators and the haptic channel always hold the glug).
     #[arg(long, value_name = "silent|glug", default_value = "silent")]
-    dualsense_audio: DualSenseAudio,
+    audio_channels: AudioChannels,
     /// The old name of --sample-format, which sat beside --formats: refused, naming the new one.
     #[arg(long = "format", hide = true, num_args = 0..=1, default_missing_value = "")]
     renamed_format: Option<String>,
@@ -118,7 +119,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
         haptic_band: args.haptic_band,
         platforms: PlatformOptions {
             rumble_rate_hz: args.rumble_rate,
-            dualsense_audio: args.dualsense_audio,
+            audio_channels: args.audio_channels,
         },
     };
     let stop = Stop::on_signals();

@@ -1,7 +1,7 @@
 //! The DualSense's file (`dualsense`, a 4-channel `.wav`): what the controller plays over USB
 //! audio, 48 kHz, 16-bit, channels 1–2 its speaker/headset audio and 3–4 its left and right
 //! actuators. The actuators get the glug (the render's own samples), the audio channels the
-//! glug or silence, by [`DualSenseAudio`].
+//! glug or silence, by [`AudioChannels`].
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -18,22 +18,23 @@ pub const DUALSENSE_RATE_HZ: u32 = 48_000;
 /// Its channels: audio left and right, then the left and right actuator.
 pub const DUALSENSE_CHANNELS: u16 = 4;
 
-/// What the two audio channels of a DualSense file hold.
+/// What the audio channels of a file that also drives actuators hold (the DualSense's two, the
+/// Android Ogg's one).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum DualSenseAudio {
-    /// Silence: the controller's speaker stays quiet, only the actuators play.
+pub enum AudioChannels {
+    /// Silence: the speaker stays quiet, only the actuators play.
     #[default]
     Silent,
     /// The glug itself, heard as it is felt.
     Glug,
 }
 
-impl DualSenseAudio {
+impl AudioChannels {
     /// Every choice, with the name the command line uses for it.
     pub const ALL: [(Self, &'static str); 2] = [(Self::Silent, "silent"), (Self::Glug, "glug")];
 }
 
-impl std::str::FromStr for DualSenseAudio {
+impl std::str::FromStr for AudioChannels {
     type Err = String;
 
     fn from_str(text: &str) -> Result<Self, String> {
@@ -80,7 +81,7 @@ pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, O
     Ok(Box::new(DualSenseFile {
         file,
         writer,
-        audio: context.options.platforms.dualsense_audio,
+        audio: context.options.platforms.audio_channels,
         frames: 0,
     }))
 }
@@ -109,7 +110,7 @@ fn encode_error(path: &Path) -> impl FnOnce(hound::Error) -> OutputError + '_ {
 struct DualSenseFile {
     file: PendingFile,
     writer: WavWriter<BufWriter<File>>,
-    audio: DualSenseAudio,
+    audio: AudioChannels,
     frames: u64,
 }
 
@@ -129,8 +130,8 @@ impl Sink for DualSenseFile {
         for &sample in block {
             let glug = to_i16(sample);
             let audio = match self.audio {
-                DualSenseAudio::Silent => 0,
-                DualSenseAudio::Glug => glug,
+                AudioChannels::Silent => 0,
+                AudioChannels::Glug => glug,
             };
             for channel in [audio, audio, glug, glug] {
                 frames.write_sample(channel);

@@ -11,6 +11,8 @@
 
 mod ahap;
 mod android;
+#[cfg(feature = "ogg")]
+mod android_ogg;
 mod clip;
 mod csv;
 mod dualsense;
@@ -29,6 +31,8 @@ use super::memory::human_bytes;
 use super::render::{RenderError, RenderSummary};
 use super::scene::Scene;
 use crate::engine::UnitOnset;
+#[cfg(feature = "ogg")]
+use android_ogg::open as open_ogg;
 use clip::ClipSink;
 pub(crate) use pending::{remove_stale_temps, PendingFile};
 #[cfg(feature = "plot")]
@@ -36,8 +40,10 @@ use plot::open as open_plot;
 
 pub use ahap::ahap_json;
 pub use android::{android_waveform_json, android_xml};
+#[cfg(feature = "ogg")]
+pub use android_ogg::{ANDROID_HAPTIC_TAG, ANDROID_OGG_CHANNELS};
 pub use csv::write_csv_samples;
-pub use dualsense::{DualSenseAudio, DUALSENSE_CHANNELS, DUALSENSE_RATE_HZ};
+pub use dualsense::{AudioChannels, DUALSENSE_CHANNELS, DUALSENSE_RATE_HZ};
 pub use haps::{haps_json, HAPS_VERSION};
 pub use haptic::haptic_json;
 #[cfg(feature = "plot")]
@@ -123,6 +129,9 @@ impl OutputFormat {
     pub const HAPS: Self = Self::new("haps", "haps", haps::open);
     /// `dualsense` (`.wav`): 4 channels at 48 kHz, the DualSense's audio and actuators.
     pub const DUALSENSE: Self = Self::named("dualsense", "wav", dualsense::open);
+    /// `.ogg`: Android's haptic-coupled Ogg Vorbis (feature `ogg`; a build without it refuses
+    /// one by name).
+    pub const ANDROID_OGG: Self = Self::new("android-ogg", "ogg", open_ogg);
 
     /// Every format, in the order a file's extension is looked up.
     pub const ALL: &'static [Self] = &[
@@ -137,6 +146,7 @@ impl OutputFormat {
         Self::RUMBLE,
         Self::HAPS,
         Self::DUALSENSE,
+        Self::ANDROID_OGG,
     ];
 
     /// A format its extension picks.
@@ -302,6 +312,15 @@ fn open_plot<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputE
     })
 }
 
+/// Without the `ogg` feature an `.ogg` is refused by name, not taken for an unknown format.
+#[cfg(not(feature = "ogg"))]
+fn open_ogg<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
+    Err(OutputError::Ogg {
+        path: context.path.to_owned(),
+        message: "this build writes no Ogg Vorbis (feature `ogg`)".into(),
+    })
+}
+
 /// How the files of a render are written.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct OutputOptions {
@@ -318,15 +337,15 @@ pub struct OutputOptions {
 pub struct PlatformOptions {
     /// Frames a second of a `rumble` file ([`crate::offline::steps::RUMBLE_RATE_RANGE_HZ`]).
     pub rumble_rate_hz: f64,
-    /// What the audio channels of a `dualsense` file hold.
-    pub dualsense_audio: DualSenseAudio,
+    /// What the audio channels of a `dualsense` or `android-ogg` file hold.
+    pub audio_channels: AudioChannels,
 }
 
 impl Default for PlatformOptions {
     fn default() -> Self {
         Self {
             rumble_rate_hz: crate::offline::steps::DEFAULT_RUMBLE_RATE_HZ,
-            dualsense_audio: DualSenseAudio::default(),
+            audio_channels: AudioChannels::default(),
         }
     }
 }
@@ -395,6 +414,14 @@ pub enum OutputError {
         needed_hz: u32,
         /// The scene's rate (Hz).
         scene_hz: u32,
+    },
+    /// The Ogg Vorbis encoder refused, or this build has none.
+    #[error("cannot write {}: {message}", path.display())]
+    Ogg {
+        /// The file asked for.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
     },
     /// The render is longer than a file of this format can hold.
     #[error(

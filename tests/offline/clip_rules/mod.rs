@@ -38,6 +38,7 @@ macro_rules! rules {
 }
 
 pub mod ahap;
+pub mod android_ogg;
 pub mod android_waveform;
 pub mod android_xml;
 mod clips_written;

@@ -12,7 +12,7 @@ use sake_glug::offline::{
     RenderObserver, Scene,
 };
 
-use super::{android_waveform, android_xml, dualsense, haps, rumble};
+use super::{android_ogg, android_waveform, android_xml, dualsense, haps, rumble};
 use crate::command::{files_in, sake_glug};
 
 /// A pour with the viscosity and the gain automated.
@@ -51,6 +51,7 @@ fn render(scene: &Scene, directory: &Path) -> Vec<(OutputFormat, PathBuf)> {
         OutputFormat::RUMBLE,
         OutputFormat::HAPS,
         OutputFormat::DUALSENSE,
+        OutputFormat::ANDROID_OGG,
     ];
     let outputs: Vec<Output> = formats
         .iter()
@@ -177,6 +178,24 @@ fn a_real_render_writes_valid_platform_files_with_the_engines_onsets() {
         let expected = (*y as f64 * 32_768.0).round().clamp(-32_768.0, 32_767.0) as i16;
         assert_eq!(*frame, [0, 0, expected, expected]);
     }
+
+    // Android Ogg: one audio channel (silent) and one haptic channel that decodes back to the
+    // render within Vorbis' loss: its error is 30 dB below the signal.
+    let bytes = std::fs::read(file_of(&files, OutputFormat::ANDROID_OGG)).unwrap();
+    let violations = android_ogg::validate(&bytes);
+    assert!(violations.is_empty(), "{violations:#?}");
+    let decoded = android_ogg::parse(&bytes);
+    assert_eq!(decoded.sample_rate, scene.sample_rate);
+    assert_eq!((decoded.channels.len(), decoded.haptic_channels), (2, 1));
+    let haptic = &decoded.channels[1];
+    assert_eq!(haptic.len(), wav.len());
+    assert!(decoded.channels[0].iter().all(|y| y.abs() < 1e-3));
+    let power = |samples: &mut dyn Iterator<Item = f64>| samples.map(|y| y * y).sum::<f64>();
+    let signal = power(&mut wav.iter().map(|&y| y as f64));
+    let error = power(&mut haptic.iter().zip(&wav).map(|(&d, &y)| (d - y) as f64));
+    let snr_db = 10.0 * (signal / error).log10();
+    eprintln!("the Ogg's haptic channel: {snr_db:.1} dB above its coding error");
+    assert!(snr_db > 30.0, "{snr_db} dB");
 }
 
 /// The low motor's share of the energy, Σ low² / Σ (low² + high²), of a pour at viscosity `c`.
@@ -218,7 +237,7 @@ fn one_command_writes_every_platform_file() {
     let directory = tempfile::tempdir().unwrap();
     let scene = directory.path().join("pour.toml");
     std::fs::write(&scene, "seed = 5\nduration_s = 1.0\ntilt_deg = 140.0\n").unwrap();
-    let formats = "wav,haptic,ahap,android-xml,android-waveform,dualsense,rumble,haps";
+    let formats = "wav,haptic,ahap,android-xml,android-waveform,android-ogg,dualsense,rumble,haps";
     let output = sake_glug(
         directory.path(),
         &[
