@@ -5,6 +5,7 @@
 
 mod automation;
 pub mod clips;
+pub mod fidelity;
 mod memory;
 mod outputs;
 mod render;

@@ -12,6 +12,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use sake_glug::engine::Preset;
 use sake_glug::offline::clips::HapticBand;
+use sake_glug::offline::fidelity::{self, fidelity_table, Fidelity};
 use sake_glug::offline::sinks::AudioChannels;
 use sake_glug::offline::steps::{DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
 use sake_glug::offline::{
@@ -76,6 +77,11 @@ pub struct RenderArgs {
     /// actuators and the haptic channel always hold the glug).
     #[arg(long, value_name = "silent|glug", default_value = "silent")]
     audio_channels: AudioChannels,
+    /// Measures what every format keeps of the render (onsets, envelope, what carries c, size,
+    /// platform limits) and prints it as a Markdown table on stdout; the summary line then goes
+    /// to stderr.
+    #[arg(long)]
+    fidelity: bool,
     /// The old name of --sample-format, which sat beside --formats: refused, naming the new one.
     #[arg(long = "format", hide = true, num_args = 0..=1, default_missing_value = "")]
     renamed_format: Option<String>,
@@ -130,7 +136,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
         let signal_name =
             |signal| signal_hook::low_level::signal_name(signal).unwrap_or("a signal");
         match render_job(job, &args, &options, &stop, progress) {
-            Ok((report, outside)) => {
+            Ok((report, outside, fidelity)) => {
                 for leftover in &report.leftovers {
                     out.error(&format!(
                         "warning: {} looks left by an interrupted render; remove it unless a \
@@ -138,7 +144,18 @@ pub fn run(args: RenderArgs) -> ExitCode {
                         leftover.display()
                     ));
                 }
-                out.summary(&summary(job, &report, &outside));
+                match fidelity {
+                    Some(rows) => {
+                        out.error(&summary(job, &report, &outside));
+                        let heading = if jobs.len() > 1 {
+                            format!("{}:\n\n", job.name)
+                        } else {
+                            String::new()
+                        };
+                        out.summary(&(heading + fidelity_table(&rows).trim_end()));
+                    }
+                    None => out.summary(&summary(job, &report, &outside)),
+                }
             }
             Err(JobError::Output(OutputError::Render(RenderError::Interrupted))) => {
                 let signal = stop.signal().map_or("a signal", signal_name);
@@ -353,7 +370,7 @@ fn render_job(
     options: &OutputOptions,
     stop: &Stop,
     progress: impl FnMut(f64),
-) -> Result<(RenderReport, Vec<PathBuf>), JobError> {
+) -> Result<(RenderReport, Vec<PathBuf>, Option<Vec<Fidelity>>), JobError> {
     let mut scene = match (&job.scene, args.preset.as_deref().and_then(Preset::find)) {
         (Some(path), _) => Scene::load(path)?,
         (None, Some(preset)) => Scene::parse(&Scene::preset_toml(preset))?,
@@ -377,7 +394,12 @@ fn render_job(
         .filter(|input| input.outside_folder)
         .map(|input| input.path.clone())
         .collect();
-    Ok((report, outside))
+    let fidelity = if args.fidelity {
+        Some(fidelity::measure(&scene, &job.name, options)?)
+    } else {
+        None
+    };
+    Ok((report, outside, fidelity))
 }
 
 /// What a job's render reports to: the progress bar, and whether a signal came.

@@ -459,7 +459,7 @@ pub enum OutputError {
 
 impl OutputError {
     /// The file system refused `path`.
-    fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Self + '_ {
+    pub(crate) fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Self + '_ {
         move |source| Self::Io {
             path: path.to_owned(),
             source,

@@ -261,3 +261,38 @@ fn one_command_writes_every_platform_file() {
     expected.sort();
     assert_eq!(files_in(&directory.path().join("clips")), expected);
 }
+
+/// The fidelity report finds each format's onsets within its own step of the model's, and
+/// the envelope of each clip format within a few dB.
+#[test]
+fn the_fidelity_report_measures_every_format_within_its_step() {
+    use sake_glug::offline::fidelity::measure;
+    let scene = Scene::parse(SCENE).unwrap();
+    let rows = measure(&scene, "pour", &OutputOptions::default()).unwrap();
+    let step_ms = |format: OutputFormat| match format.name() {
+        "android-xml" | "android-waveform" => Some(0.5),
+        "rumble" => Some(10.0),
+        "haptic" | "ahap" | "haps" => Some(1e-6),
+        _ => None,
+    };
+    assert_eq!(
+        rows.len(),
+        OutputFormat::ALL.len() - 1,
+        "every format but the plot"
+    );
+    for row in &rows {
+        assert!(row.bytes > 0, "{row:?}");
+        match (
+            step_ms(row.format),
+            row.onset_error_ms,
+            row.envelope_error_db,
+        ) {
+            (Some(step), Some((mean, worst)), Some(db)) => {
+                assert!(mean <= worst && worst <= step + 1e-9, "{row:?}");
+                assert!(db < 3.0, "{row:?}");
+            }
+            (None, None, None) => {}
+            _ => panic!("{row:?} is not measured as its kind"),
+        }
+    }
+}
