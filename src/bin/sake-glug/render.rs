@@ -136,7 +136,11 @@ pub fn run(args: RenderArgs) -> ExitCode {
         let signal_name =
             |signal| signal_hook::low_level::signal_name(signal).unwrap_or("a signal");
         match render_job(job, &args, &options, &stop, progress) {
-            Ok((report, outside, fidelity)) => {
+            Ok(Rendered {
+                report,
+                outside,
+                fidelity,
+            }) => {
                 for leftover in &report.leftovers {
                     out.error(&format!(
                         "warning: {} looks left by an interrupted render; remove it unless a \
@@ -364,13 +368,21 @@ fn output(argument: &str) -> Result<Output, String> {
     Output::parse(argument).map_err(|error| error.to_string())
 }
 
+/// What a job did: its report, the files it read from outside its scene's folder, and, with
+/// --fidelity, what every format keeps.
+struct Rendered {
+    report: RenderReport,
+    outside: Vec<PathBuf>,
+    fidelity: Option<Vec<Fidelity>>,
+}
+
 fn render_job(
     job: &Job,
     args: &RenderArgs,
     options: &OutputOptions,
     stop: &Stop,
     progress: impl FnMut(f64),
-) -> Result<(RenderReport, Vec<PathBuf>, Option<Vec<Fidelity>>), JobError> {
+) -> Result<Rendered, JobError> {
     let mut scene = match (&job.scene, args.preset.as_deref().and_then(Preset::find)) {
         (Some(path), _) => Scene::load(path)?,
         (None, Some(preset)) => Scene::parse(&Scene::preset_toml(preset))?,
@@ -399,7 +411,11 @@ fn render_job(
     } else {
         None
     };
-    Ok((report, outside, fidelity))
+    Ok(Rendered {
+        report,
+        outside,
+        fidelity,
+    })
 }
 
 /// What a job's render reports to: the progress bar, and whether a signal came.
