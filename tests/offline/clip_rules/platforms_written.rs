@@ -296,3 +296,33 @@ fn the_fidelity_report_measures_every_format_within_its_step() {
         }
     }
 }
+
+/// A rumble rate outside its range, and a DualSense file from a scene not at 48 kHz, are refused
+/// before anything is written, naming what was wrong.
+#[test]
+fn what_a_platform_cannot_play_is_refused_up_front() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = sake_glug(
+        directory.path(),
+        &["render", "--rumble-rate", "0", "-o", "rumble:pour.json"],
+    );
+    assert_eq!(output.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&output.stderr).contains("--rumble-rate"));
+    let output = sake_glug(
+        directory.path(),
+        &[
+            "render",
+            "--sample-rate",
+            "44100",
+            "-o",
+            "dualsense:pour.wav",
+        ],
+    );
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("48000 Hz") && stderr.contains("44100 Hz"),
+        "{stderr}"
+    );
+    assert!(files_in(directory.path()).is_empty());
+}
