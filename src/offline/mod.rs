@@ -6,11 +6,13 @@
 
 mod automation;
 pub mod clips;
+pub mod fidelity;
 mod memory;
 mod outputs;
 mod render;
 mod scene;
 pub mod sinks;
+pub mod steps;
 mod tables;
 
 pub use automation::Automation;
@@ -22,7 +24,9 @@ pub use render::{
 pub use scene::{
     InputFile, InputFileError, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S,
 };
-pub use sinks::{Output, OutputError, OutputFormat, OutputOptions, SampleFormat, WavError};
+pub use sinks::{
+    Output, OutputError, OutputFormat, OutputOptions, PlatformOptions, SampleFormat, WavError,
+};
 pub use tables::{
     csv_header, render_tables, Column, StateRate, StateRateError, StateRow, Tables, UnitRow,
 };

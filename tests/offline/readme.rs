@@ -25,3 +25,18 @@ fn the_parameter_table_is_the_codes() {
         "README.md's table of parameters is stale (run `cargo xtask docs`)"
     );
 }
+
+#[test]
+fn the_fidelity_table_is_the_codes() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = sake_glug(
+        directory.path(),
+        &["render", "--fidelity", "-o", "pour.wav"],
+    );
+    assert!(output.status.success());
+    assert_eq!(
+        generated_block("fidelity"),
+        String::from_utf8(output.stdout).unwrap(),
+        "README.md's fidelity table is stale (run `cargo xtask docs`)"
+    );
+}

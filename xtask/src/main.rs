@@ -280,6 +280,13 @@ fn docs() -> nice_plug_xtask::Result<()> {
     // The README's table of parameters, from the engine's tables.
     let parameters = output(&cli(), &["parameters"])?;
     replace_block("README.md", "parameters", &parameters)?;
+    // The README's table of what each format keeps of the default pour, measured.
+    let measured = target_dir().join("fidelity-pour.wav");
+    let fidelity = output(
+        &cli(),
+        &["render", "--fidelity", "-o", &measured.to_string_lossy()],
+    )?;
+    replace_block("README.md", "fidelity", &fidelity)?;
     // The README's example of the pour plot: the default scene.
     let clip = target_dir().join("pour-plot.haptic");
     run(

@@ -12,9 +12,13 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use sake_glug::engine::Preset;
 use sake_glug::offline::clips::HapticBand;
+use sake_glug::offline::fidelity::{self, fidelity_table, Fidelity};
+use sake_glug::offline::sinks::AudioChannels;
+use sake_glug::offline::steps::{DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
 use sake_glug::offline::{
-    human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions, RenderError,
-    RenderObserver, RenderReport, SampleFormat, Scene, SceneError, StateRate,
+    human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions,
+    PlatformOptions, RenderError, RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
+    StateRate,
 };
 use sake_glug::text::printable;
 
@@ -83,6 +87,18 @@ pub struct RenderArgs {
     /// Sample format of WAV files: f32, s24 or s16.
     #[arg(long, default_value = "f32")]
     sample_format: SampleFormat,
+    /// Frames a second of a rumble file (1 to 1000).
+    #[arg(long, value_name = "HZ", default_value_t = DEFAULT_RUMBLE_RATE_HZ, value_parser = rumble_rate)]
+    rumble_rate: f64,
+    /// What the audio channels of a dualsense or android-ogg file hold: silent or glug (the
+    /// actuators and the haptic channel always hold the glug).
+    #[arg(long, value_name = "silent|glug", default_value = "silent")]
+    audio_channels: AudioChannels,
+    /// Measures what every format keeps of the render (onsets, envelope, what carries c, size,
+    /// platform limits) and prints it as a Markdown table on stdout; the summary line then goes
+    /// to stderr.
+    #[arg(long)]
+    fidelity: bool,
     /// The old name of --sample-format, which sat beside --formats: refused, naming the new one.
     #[arg(long = "format", hide = true, num_args = 0..=1, default_missing_value = "")]
     renamed_format: Option<String>,
@@ -126,6 +142,10 @@ pub fn run(args: RenderArgs) -> ExitCode {
         haptic_band: args.haptic_band,
         csv_time: args.csv_time,
         state_rate: args.state_rate.unwrap_or_default(),
+        platforms: PlatformOptions {
+            rumble_rate_hz: args.rumble_rate,
+            audio_channels: args.audio_channels,
+        },
     };
     let stop = Stop::on_signals();
     let mut out = Console::new(jobs.len());
@@ -135,7 +155,11 @@ pub fn run(args: RenderArgs) -> ExitCode {
         let signal_name =
             |signal| signal_hook::low_level::signal_name(signal).unwrap_or("a signal");
         match render_job(job, &args, &options, &stop, progress) {
-            Ok((report, outside)) => {
+            Ok(Rendered {
+                report,
+                outside,
+                fidelity,
+            }) => {
                 for leftover in &report.leftovers {
                     out.error(&format!(
                         "warning: {} looks left by an interrupted render; remove it unless a \
@@ -143,7 +167,18 @@ pub fn run(args: RenderArgs) -> ExitCode {
                         leftover.display()
                     ));
                 }
-                out.summary(&summary(job, &report, &outside));
+                match fidelity {
+                    Some(rows) => {
+                        out.error(&summary(job, &report, &outside));
+                        let heading = if jobs.len() > 1 {
+                            format!("{}:\n\n", job.name)
+                        } else {
+                            String::new()
+                        };
+                        out.summary(&(heading + fidelity_table(&rows).trim_end()));
+                    }
+                    None => out.summary(&summary(job, &report, &outside)),
+                }
             }
             Err(JobError::Output(OutputError::Render(RenderError::Interrupted))) => {
                 let signal = stop.signal().map_or("a signal", signal_name);
@@ -364,9 +399,29 @@ fn state_rate(text: &str) -> Result<StateRate, String> {
     StateRate::new(hz).map_err(|error| error.to_string())
 }
 
+/// `--rumble-rate`'s value parser: a rate in [`RUMBLE_RATE_RANGE_HZ`].
+fn rumble_rate(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(hz) if RUMBLE_RATE_RANGE_HZ.contains(&hz) => Ok(hz),
+        _ => Err(format!(
+            "`{text}` is not a rate from {} to {} Hz",
+            RUMBLE_RATE_RANGE_HZ.start(),
+            RUMBLE_RATE_RANGE_HZ.end()
+        )),
+    }
+}
+
 /// `-o`'s value parser: `NAME:FILE` or a file its extension names.
 fn output(argument: &str) -> Result<Output, String> {
     Output::parse(argument).map_err(|error| error.to_string())
+}
+
+/// What a job did: its report, the files it read from outside its scene's folder, and, with
+/// --fidelity, what every format keeps.
+struct Rendered {
+    report: RenderReport,
+    outside: Vec<PathBuf>,
+    fidelity: Option<Vec<Fidelity>>,
 }
 
 fn render_job(
@@ -375,7 +430,7 @@ fn render_job(
     options: &OutputOptions,
     stop: &Stop,
     progress: impl FnMut(f64),
-) -> Result<(RenderReport, Vec<PathBuf>), JobError> {
+) -> Result<Rendered, JobError> {
     let mut scene = match (&job.scene, args.preset.as_deref().and_then(Preset::find)) {
         (Some(path), _) => Scene::load(path)?,
         (None, Some(preset)) => Scene::parse(&Scene::preset_toml(preset))?,
@@ -399,7 +454,16 @@ fn render_job(
         .filter(|input| input.outside_folder)
         .map(|input| input.path.clone())
         .collect();
-    Ok((report, outside))
+    let fidelity = if args.fidelity {
+        Some(fidelity::measure(&scene, &job.name, options)?)
+    } else {
+        None
+    };
+    Ok(Rendered {
+        report,
+        outside,
+        fidelity,
+    })
 }
 
 /// What a job's render reports to: the progress bar, and whether a signal came.

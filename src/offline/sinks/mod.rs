@@ -11,12 +11,18 @@
 //! and an `open` function, and an entry in that table.
 
 mod ahap;
+mod android;
+#[cfg(feature = "ogg")]
+mod android_ogg;
 mod clip;
 mod csv;
+mod dualsense;
+mod haps;
 mod haptic;
 mod pending;
 #[cfg(feature = "plot")]
 mod plot;
+mod rumble;
 mod state;
 mod units;
 mod wav;
@@ -29,16 +35,24 @@ use super::render::{BottleReport, RenderError, RenderSummary};
 use super::scene::Scene;
 use super::tables::{StateRate, StateRateError};
 use crate::engine::{UnitOnset, Voicing};
+#[cfg(feature = "ogg")]
+use android_ogg::open as open_ogg;
 use clip::ClipSink;
 pub(crate) use pending::{remove_stale_temps, PendingFile};
 #[cfg(feature = "plot")]
 use plot::open as open_plot;
 
 pub use ahap::ahap_json;
+pub use android::{android_waveform_json, android_xml};
+#[cfg(feature = "ogg")]
+pub use android_ogg::{ANDROID_HAPTIC_TAG, ANDROID_OGG_CHANNELS};
 pub use csv::{write_csv_samples, TIMED_SAMPLE_COLUMNS};
+pub use dualsense::{AudioChannels, DUALSENSE_CHANNELS, DUALSENSE_RATE_HZ};
+pub use haps::{haps_json, HAPS_VERSION};
 pub use haptic::haptic_json;
 #[cfg(feature = "plot")]
 pub use plot::{draw_pour_plot, PlotData, PlotError, Waveform};
+pub use rumble::rumble_json;
 pub use wav::{SampleFormat, WavError};
 
 /// One file of a render, written from the render's single pass. Every method but
@@ -113,6 +127,20 @@ impl OutputFormat {
     pub const UNITS: Self = Self::named("units", "csv", units::open);
     /// `state` (`.csv`): the bottle at the state rate (MODEL.md §14).
     pub const STATE: Self = Self::named("state", "csv", state::open);
+    /// `.xml`: Android's vibration XML (`VibrationXmlParser`).
+    pub const ANDROID_XML: Self = Self::new("android-xml", "xml", android::open_xml);
+    /// `android-waveform` (`.json`): the arrays of Android's `VibrationEffect.createWaveform`.
+    pub const ANDROID_WAVEFORM: Self =
+        Self::named("android-waveform", "json", android::open_waveform);
+    /// `rumble` (`.json`): frames of a dual-rumble gamepad's two motors.
+    pub const RUMBLE: Self = Self::named("rumble", "json", rumble::open);
+    /// `.haps`: an Interhaptics / Razer Haptic Composer file (version 5).
+    pub const HAPS: Self = Self::new("haps", "haps", haps::open);
+    /// `dualsense` (`.wav`): 4 channels at 48 kHz, the DualSense's audio and actuators.
+    pub const DUALSENSE: Self = Self::named("dualsense", "wav", dualsense::open);
+    /// `.ogg`: Android's haptic-coupled Ogg Vorbis (feature `ogg`; a build without it refuses
+    /// one by name).
+    pub const ANDROID_OGG: Self = Self::new("android-ogg", "ogg", open_ogg);
 
     /// Every format, in the order a file's extension is looked up.
     pub const ALL: &'static [Self] = &[
@@ -123,6 +151,13 @@ impl OutputFormat {
         Self::PLOT,
         Self::UNITS,
         Self::STATE,
+        // The platforms (issue 19).
+        Self::ANDROID_XML,
+        Self::ANDROID_WAVEFORM,
+        Self::RUMBLE,
+        Self::HAPS,
+        Self::DUALSENSE,
+        Self::ANDROID_OGG,
     ];
 
     /// A format its extension picks.
@@ -288,6 +323,15 @@ fn open_plot<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputE
     })
 }
 
+/// Without the `ogg` feature an `.ogg` is refused by name, not taken for an unknown format.
+#[cfg(not(feature = "ogg"))]
+fn open_ogg<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
+    Err(OutputError::Ogg {
+        path: context.path.to_owned(),
+        message: "this build writes no Ogg Vorbis (feature `ogg`)".into(),
+    })
+}
+
 /// How the files of a render are written.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct OutputOptions {
@@ -299,6 +343,26 @@ pub struct OutputOptions {
     pub csv_time: bool,
     /// Rows per second of a `state` table.
     pub state_rate: StateRate,
+    /// How the platform formats (rumble, DualSense, Android) are written.
+    pub platforms: PlatformOptions,
+}
+
+/// How the platform formats are written.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlatformOptions {
+    /// Frames a second of a `rumble` file ([`crate::offline::steps::RUMBLE_RATE_RANGE_HZ`]).
+    pub rumble_rate_hz: f64,
+    /// What the audio channels of a `dualsense` or `android-ogg` file hold.
+    pub audio_channels: AudioChannels,
+}
+
+impl Default for PlatformOptions {
+    fn default() -> Self {
+        Self {
+            rumble_rate_hz: crate::offline::steps::DEFAULT_RUMBLE_RATE_HZ,
+            audio_channels: AudioChannels::default(),
+        }
+    }
 }
 
 /// Why the files of a render could not be written.
@@ -353,6 +417,43 @@ pub enum OutputError {
     /// A `state` table's rate does not fit the render.
     #[error(transparent)]
     StateRate(#[from] StateRateError),
+    /// A format plays at one sample rate only, and the scene renders at another.
+    #[error(
+        "{}: a {format} file plays at {needed_hz} Hz, and the scene renders at {scene_hz} Hz; \
+         render it at {needed_hz} Hz (--sample-rate {needed_hz}, or sample_rate in the scene)",
+        path.display()
+    )]
+    WrongRate {
+        /// The file asked for.
+        path: PathBuf,
+        /// The format's name.
+        format: &'static str,
+        /// The rate it plays at (Hz).
+        needed_hz: u32,
+        /// The scene's rate (Hz).
+        scene_hz: u32,
+    },
+    /// The Ogg Vorbis encoder refused, or this build has none.
+    #[error("cannot write {}: {message}", path.display())]
+    Ogg {
+        /// The file asked for.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// The render is longer than a file of this format can hold.
+    #[error(
+        "{}: a {format} file holds at most {max_s:.0} s; give the scene a shorter duration_s",
+        path.display()
+    )]
+    TooLongFor {
+        /// The file asked for.
+        path: PathBuf,
+        /// The format's name.
+        format: &'static str,
+        /// The longest render it can hold (s).
+        max_s: f64,
+    },
     /// Another file could not be written.
     #[error("cannot write {}: {source}", path.display())]
     Io {
@@ -376,7 +477,7 @@ pub enum OutputError {
 
 impl OutputError {
     /// The file system refused `path`.
-    fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Self + '_ {
+    pub(crate) fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Self + '_ {
         move |source| Self::Io {
             path: path.to_owned(),
             source,

@@ -2,9 +2,51 @@
 //! requirement, fixtures that pass or break exactly one rule, and the clips written from a
 //! synthetic pour checked against the rules and the model.
 
+/// A format's `Rule` enum from `Variant => "snake_name": "what it requires",` lines: the name
+/// is that of the invalid fixture that breaks only it.
+macro_rules! rules {
+    ($($variant:ident => $name:literal: $description:literal,)+) => {
+        /// A requirement of the format.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        pub enum Rule {
+            $($variant,)+
+        }
+
+        impl crate::clip_rules::Rule for Rule {
+            const ALL: &'static [Self] = &[$(Rule::$variant,)+];
+
+            fn name(&self) -> &'static str {
+                match self {
+                    $(Rule::$variant => $name,)+
+                }
+            }
+
+            fn description(&self) -> &'static str {
+                match self {
+                    $(Rule::$variant => $description,)+
+                }
+            }
+        }
+
+        fn violation(rule: Rule, detail: impl Into<String>) -> crate::clip_rules::Violation<Rule> {
+            crate::clip_rules::Violation {
+                rule,
+                detail: detail.into(),
+            }
+        }
+    };
+}
+
 pub mod ahap;
+pub mod android_ogg;
+pub mod android_waveform;
+pub mod android_xml;
 mod clips_written;
+pub mod dualsense;
+pub mod haps;
 pub mod haptic;
+mod platforms_written;
+pub mod rumble;
 
 use std::fmt::Debug;
 use std::path::{Path, PathBuf};
@@ -46,9 +88,19 @@ pub fn fixtures(kind: &str, extension: &str) -> Vec<PathBuf> {
 /// Every valid fixture passes; every rule has an invalid fixture named after it that is
 /// refused for that rule and no other; no invalid fixture is named after an unknown rule.
 pub fn check_fixtures<R: Rule>(extension: &str, validate: impl Fn(&str) -> Vec<Violation<R>>) {
-    let read = |path: &Path| {
-        std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-    };
+    check_binary_fixtures(extension, |bytes| match std::str::from_utf8(bytes) {
+        Ok(text) => validate(text),
+        Err(e) => panic!("a .{extension} fixture is not UTF-8: {e}"),
+    })
+}
+
+/// [`check_fixtures`] for a format whose files are bytes, not text.
+pub fn check_binary_fixtures<R: Rule>(
+    extension: &str,
+    validate: impl Fn(&[u8]) -> Vec<Violation<R>>,
+) {
+    let read =
+        |path: &Path| std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let valid = fixtures("valid", extension);
     assert!(!valid.is_empty(), "no valid .{extension} fixtures");
     for path in &valid {

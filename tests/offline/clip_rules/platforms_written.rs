@@ -1,0 +1,328 @@
+//! The platform files of a real render: every one passes its platform's rules, marks the
+//! engine's own glugs within its own step, and the rumble motors share the weight as the
+//! model shares it between f1 and f2.
+
+use std::path::{Path, PathBuf};
+
+use sake_glug::engine::{UnitOnset, Voicing};
+use sake_glug::offline::sinks::DUALSENSE_RATE_HZ;
+use sake_glug::offline::steps::ANDROID_STEP_MS;
+use sake_glug::offline::{
+    render_scene, render_to_files, Output, OutputFormat, OutputOptions, RenderError,
+    RenderObserver, Scene,
+};
+
+use super::{android_ogg, android_waveform, android_xml, dualsense, haps, rumble};
+use crate::command::{files_in, sake_glug};
+
+/// A pour with the viscosity and the gain automated.
+const SCENE: &str = r#"
+seed = 7
+tilt_deg = [[0.0, 90.0], [0.4, 140.0], [2.5, 140.0], [2.6, 0.0]]
+viscosity_c = [[0.0, 0.1], [2.5, 0.9]]
+[output]
+gain_db = [[0.0, -3.0], [2.5, -9.0]]
+"#;
+
+/// The onsets (s) of the audible units the engine starts for `scene`.
+fn audible_onsets(scene: &Scene) -> Vec<f64> {
+    struct Units(Vec<UnitOnset>);
+    impl RenderObserver for Units {
+        fn unit_started(&mut self, onset: &UnitOnset, _voicing: Voicing) {
+            self.0.push(*onset);
+        }
+    }
+    let mut units = Units(Vec::new());
+    render_scene(scene, |_| Ok::<(), RenderError>(()), &mut units).unwrap();
+    units
+        .0
+        .iter()
+        .filter(|unit| unit.amplitude > 0.0)
+        .map(|unit| (unit.sample as f64 + unit.fraction) / scene.sample_rate as f64)
+        .collect()
+}
+
+/// Renders `scene` once into every platform format and the mono WAV, in `directory`.
+fn render(scene: &Scene, directory: &Path) -> Vec<(OutputFormat, PathBuf)> {
+    let formats = [
+        OutputFormat::WAV,
+        OutputFormat::ANDROID_XML,
+        OutputFormat::ANDROID_WAVEFORM,
+        OutputFormat::RUMBLE,
+        OutputFormat::HAPS,
+        OutputFormat::DUALSENSE,
+        OutputFormat::ANDROID_OGG,
+    ];
+    let outputs: Vec<Output> = formats
+        .iter()
+        .map(|&format| Output {
+            format,
+            path: directory.join(format.file_name("pour")),
+        })
+        .collect();
+    render_to_files(scene, "pour", &outputs, &OutputOptions::default(), |_| {}).unwrap();
+    outputs.into_iter().map(|o| (o.format, o.path)).collect()
+}
+
+fn file_of(files: &[(OutputFormat, PathBuf)], format: OutputFormat) -> &Path {
+    &files.iter().find(|(f, _)| *f == format).unwrap().1
+}
+
+fn text(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap()
+}
+
+/// How far each onset is from the nearest of `marks`, the worst of them (s).
+fn worst_distance(onsets: &[f64], marks: &[f64]) -> f64 {
+    onsets
+        .iter()
+        .map(|onset| {
+            marks
+                .iter()
+                .map(|mark| (mark - onset).abs())
+                .fold(f64::INFINITY, f64::min)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The start times (s) of entries given their durations (ms).
+fn starts(durations_ms: impl Iterator<Item = u64>) -> Vec<f64> {
+    let mut at = 0;
+    durations_ms
+        .map(|d| {
+            let start = at;
+            at += d;
+            start as f64 / 1000.0
+        })
+        .collect()
+}
+
+#[test]
+fn a_real_render_writes_valid_platform_files_with_the_engines_onsets() {
+    let directory = tempfile::tempdir().unwrap();
+    let scene = Scene::parse(SCENE).unwrap();
+    let files = render(&scene, directory.path());
+    let onsets = audible_onsets(&scene);
+    assert!(onsets.len() > 20, "{} audible glugs", onsets.len());
+    let half_ms = 0.0005 + 1e-9;
+
+    // Android XML: an entry starts within half a millisecond of every onset, and the entries
+    // that start at an onset vibrate.
+    let xml = text(file_of(&files, OutputFormat::ANDROID_XML));
+    let violations = android_xml::validate(&xml);
+    assert!(violations.is_empty(), "{violations:#?}");
+    let entries = android_xml::parse(&xml);
+    let entry_starts = starts(entries.iter().map(|e| e.duration_ms));
+    assert!(worst_distance(&onsets, &entry_starts) <= half_ms);
+    for onset in &onsets {
+        let index = entry_starts
+            .iter()
+            .position(|start| (start - onset).abs() <= half_ms)
+            .unwrap();
+        assert!(
+            (1..=255).contains(&entries[index].amplitude),
+            "at {onset} s"
+        );
+    }
+    assert!(entries
+        .iter()
+        .all(|e| e.duration_ms <= ANDROID_STEP_MS || e.amplitude == 0));
+
+    // The waveform JSON holds the same entries.
+    let waveform = text(file_of(&files, OutputFormat::ANDROID_WAVEFORM));
+    let violations = android_waveform::validate(&waveform);
+    assert!(violations.is_empty(), "{violations:#?}");
+    let pairs: Vec<(i64, i64)> = entries
+        .iter()
+        .map(|e| (e.duration_ms as i64, e.amplitude as i64))
+        .collect();
+    assert_eq!(android_waveform::parse(&waveform), pairs);
+
+    // Rumble: every onset shows as a rise of the motors within one frame.
+    let rumble_text = text(file_of(&files, OutputFormat::RUMBLE));
+    let violations = rumble::validate(&rumble_text);
+    assert!(violations.is_empty(), "{violations:#?}");
+    let rumble = rumble::parse(&rumble_text);
+    let sum: Vec<f64> = rumble.frames.iter().map(|f| f.1 + f.2).collect();
+    for onset in &onsets {
+        let k = (onset * rumble.rate_hz) as usize;
+        let before = if k == 0 { 0.0 } else { sum[k - 1] };
+        assert!(
+            sum[k].max(sum[(k + 1).min(sum.len() - 1)]) > before,
+            "no rise within a frame of the glug at {onset} s"
+        );
+    }
+
+    // .haps: one note per audible glug, starting at its onset.
+    let haps_text = text(file_of(&files, OutputFormat::HAPS));
+    let violations = haps::validate(&haps_text);
+    assert!(violations.is_empty(), "{violations:#?}");
+    let melodies = haps::parse(&haps_text);
+    let note_starts: Vec<f64> = melodies[0].iter().map(|n| n.start_s).collect();
+    assert_eq!(note_starts.len(), onsets.len());
+    assert!(worst_distance(&onsets, &note_starts) < 1e-9);
+
+    // DualSense: 4 channels; the actuators are the render's own samples, the audio silent.
+    let bytes = std::fs::read(file_of(&files, OutputFormat::DUALSENSE)).unwrap();
+    let violations = dualsense::validate(&bytes);
+    assert!(violations.is_empty(), "{violations:#?}");
+    let frames = dualsense::parse(&bytes);
+    let wav: Vec<f32> = hound::WavReader::open(file_of(&files, OutputFormat::WAV))
+        .unwrap()
+        .samples::<f32>()
+        .map(Result::unwrap)
+        .collect();
+    assert_eq!(scene.sample_rate, DUALSENSE_RATE_HZ);
+    assert_eq!(frames.len(), wav.len());
+    for (frame, y) in frames.iter().zip(&wav) {
+        let expected = (*y as f64 * 32_768.0).round().clamp(-32_768.0, 32_767.0) as i16;
+        assert_eq!(*frame, [0, 0, expected, expected]);
+    }
+
+    // Android Ogg: one audio channel (silent) and one haptic channel that decodes back to the
+    // render within Vorbis' loss: its error is 30 dB below the signal.
+    let bytes = std::fs::read(file_of(&files, OutputFormat::ANDROID_OGG)).unwrap();
+    let violations = android_ogg::validate(&bytes);
+    assert!(violations.is_empty(), "{violations:#?}");
+    let decoded = android_ogg::parse(&bytes);
+    assert_eq!(decoded.sample_rate, scene.sample_rate);
+    assert_eq!((decoded.channels.len(), decoded.haptic_channels), (2, 1));
+    let haptic = &decoded.channels[1];
+    assert_eq!(haptic.len(), wav.len());
+    assert!(decoded.channels[0].iter().all(|y| y.abs() < 1e-3));
+    let power = |samples: &mut dyn Iterator<Item = f64>| samples.map(|y| y * y).sum::<f64>();
+    let signal = power(&mut wav.iter().map(|&y| y as f64));
+    let error = power(&mut haptic.iter().zip(&wav).map(|(&d, &y)| (d - y) as f64));
+    let snr_db = 10.0 * (signal / error).log10();
+    eprintln!("the Ogg's haptic channel: {snr_db:.1} dB above its coding error");
+    assert!(snr_db > 30.0, "{snr_db} dB");
+}
+
+/// The low motor's share of the energy, Σ low² / Σ (low² + high²), of a pour at viscosity `c`.
+fn low_share(c: f64) -> f64 {
+    let scene = Scene::parse(&format!(
+        "seed = 3\nduration_s = 3.0\ntilt_deg = 140.0\nviscosity_c = {c}\n"
+    ))
+    .unwrap();
+    let directory = tempfile::tempdir().unwrap();
+    let path = directory.path().join("pour.json");
+    let output = Output {
+        format: OutputFormat::RUMBLE,
+        path: path.clone(),
+    };
+    render_to_files(&scene, "pour", &[output], &OutputOptions::default(), |_| {}).unwrap();
+    let rumble = rumble::parse(&text(&path));
+    let low: f64 = rumble.frames.iter().map(|f| f.1 * f.1).sum();
+    let high: f64 = rumble.frames.iter().map(|f| f.2 * f.2).sum();
+    assert!(low + high > 0.0, "a silent pour at c = {c}");
+    low / (low + high)
+}
+
+/// The model gives the low component (f1) the share c of each glug's amplitude: a more
+/// viscous liquid moves the weight to the low motor.
+#[test]
+fn viscosity_moves_the_rumble_to_the_low_motor() {
+    let shares: Vec<(f64, f64)> = [0.1, 0.33, 0.6, 0.9]
+        .into_iter()
+        .map(|c| (c, low_share(c)))
+        .collect();
+    eprintln!("low motor's share of the energy by viscosity: {shares:?}");
+    for pair in shares.windows(2) {
+        assert!(pair[1].1 > pair[0].1, "{shares:?}");
+    }
+}
+
+#[test]
+fn one_command_writes_every_platform_file() {
+    let directory = tempfile::tempdir().unwrap();
+    let scene = directory.path().join("pour.toml");
+    std::fs::write(&scene, "seed = 5\nduration_s = 1.0\ntilt_deg = 140.0\n").unwrap();
+    let formats = "wav,haptic,ahap,android-xml,android-waveform,android-ogg,dualsense,rumble,haps";
+    let output = sake_glug(
+        directory.path(),
+        &[
+            "render",
+            "pour.toml",
+            "--out-dir",
+            "clips",
+            "--formats",
+            formats,
+        ],
+    );
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let mut expected: Vec<String> = formats
+        .split(',')
+        .map(|name| OutputFormat::of_name(name).unwrap().file_name("pour"))
+        .collect();
+    expected.sort();
+    assert_eq!(files_in(&directory.path().join("clips")), expected);
+}
+
+/// The fidelity report finds each format's onsets within its own step of the model's, and
+/// the envelope of each clip format within a few dB.
+#[test]
+fn the_fidelity_report_measures_every_format_within_its_step() {
+    use sake_glug::offline::fidelity::measure;
+    let scene = Scene::parse(SCENE).unwrap();
+    let rows = measure(&scene, "pour", &OutputOptions::default()).unwrap();
+    let step_ms = |format: OutputFormat| match format.name() {
+        "android-xml" | "android-waveform" => Some(0.5),
+        "rumble" => Some(10.0),
+        "haptic" | "ahap" | "haps" => Some(1e-6),
+        _ => None,
+    };
+    assert_eq!(
+        rows.len(),
+        OutputFormat::ALL.len() - 1,
+        "every format but the plot"
+    );
+    for row in &rows {
+        assert!(row.bytes > 0, "{row:?}");
+        match (
+            step_ms(row.format),
+            row.onset_error_ms,
+            row.envelope_error_db,
+        ) {
+            (Some(step), Some((mean, worst)), Some(db)) => {
+                assert!(mean <= worst && worst <= step + 1e-9, "{row:?}");
+                assert!(db < 3.0, "{row:?}");
+            }
+            (None, None, None) => {}
+            _ => panic!("{row:?} is not measured as its kind"),
+        }
+    }
+}
+
+/// A rumble rate outside its range, and a DualSense file from a scene not at 48 kHz, are refused
+/// before anything is written, naming what was wrong.
+#[test]
+fn what_a_platform_cannot_play_is_refused_up_front() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = sake_glug(
+        directory.path(),
+        &["render", "--rumble-rate", "0", "-o", "rumble:pour.json"],
+    );
+    assert_eq!(output.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&output.stderr).contains("--rumble-rate"));
+    let output = sake_glug(
+        directory.path(),
+        &[
+            "render",
+            "--sample-rate",
+            "44100",
+            "-o",
+            "dualsense:pour.wav",
+        ],
+    );
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("48000 Hz") && stderr.contains("44100 Hz"),
+        "{stderr}"
+    );
+    assert!(files_in(directory.path()).is_empty());
+}
