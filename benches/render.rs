@@ -3,7 +3,8 @@
 //! pouring in follow mode. Beside each, measured in the same run: the memory limit (merely
 //! filling a buffer of the same length) and the same glug train synthesised unit by unit with
 //! NumPy (`benches/numpy_glug.py`, when a Python with NumPy is found: the project's `.venv`, then
-//! `python3`).
+//! `python3`). Then the fit of a minute's recording by `sake_glug::fit` against SciPy's
+//! `curve_fit` of the same units (`render/fit.rs`, `benches/scipy_fit.py`).
 //!
 //! Criterion reports its own statistics; the lines the project quotes are printed after each
 //! scene and written to `<target>/bench-render.md`, which `cargo xtask docs` copies into
@@ -17,6 +18,10 @@ use std::time::Instant;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use sake_glug::engine::{UnitOnset, Voicing};
 use sake_glug::offline::{render_scene, RenderError, RenderObserver, Scene};
+
+#[cfg(feature = "fit")]
+#[path = "render/fit.rs"]
+mod fit;
 
 /// One hour of repeated pours at 48 kHz: every 10 s tilt up and pour 6 s, put the bottle
 /// upright, and refill it. A change of the fill level refills in simulate mode, so the level
@@ -108,6 +113,12 @@ fn bench(c: &mut Criterion) {
         println!("{line}");
         writeln!(report, "{line}").expect("a String takes any text");
     }
+    #[cfg(feature = "fit")]
+    {
+        let line = fit::fit_versus_scipy(c);
+        println!("{line}");
+        writeln!(report, "{line}").expect("a String takes any text");
+    }
     save_report(&report);
 }
 
@@ -115,19 +126,10 @@ fn bench(c: &mut Criterion) {
 /// and of the NumPy synthesis, all measured here in the same run (best of five for the two
 /// Rust figures, one run of the slower NumPy script).
 fn realtime_factors(name: &str, scene: &Scene, samples: usize, out: &mut Vec<f32>) -> String {
-    let best = |f: &mut dyn FnMut()| {
-        (0..5)
-            .map(|_| {
-                let start = Instant::now();
-                f();
-                start.elapsed().as_secs_f64()
-            })
-            .fold(f64::INFINITY, f64::min)
-    };
-    let render_s = best(&mut || {
+    let render_s = best_of(5, &mut || {
         render_into(scene, out);
     });
-    let fill_s = best(&mut || {
+    let fill_s = best_of(5, &mut || {
         out.clear();
         out.resize(samples, 0.0);
     });
@@ -146,11 +148,22 @@ fn realtime_factors(name: &str, scene: &Scene, samples: usize, out: &mut Vec<f32
     )
 }
 
+/// The shortest of `runs` timings of `f` (s).
+fn best_of(runs: usize, f: &mut dyn FnMut()) -> f64 {
+    (0..runs)
+        .map(|_| {
+            let start = Instant::now();
+            f();
+            start.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Runs `benches/numpy_glug.py` on the units of one render of `scene`; returns the script's
 /// synthesis time (s) and its largest difference from the render, relative to the render's peak
 /// (dB): a check that it synthesised the same train.
 fn numpy_synthesis(scene: &Scene, samples: usize) -> Result<(f64, f64), String> {
-    let python = python_with_numpy().ok_or("no python3 with numpy found")?;
+    let python = python_with("numpy").ok_or("no python3 with numpy found")?;
     let mut units = Units::default();
     let mut rendered = Vec::with_capacity(samples);
     render_scene(
@@ -209,13 +222,13 @@ fn numpy_synthesis(scene: &Scene, samples: usize) -> Result<(f64, f64), String> 
     Ok((seconds, 20.0 * (error / peak).log10()))
 }
 
-/// The project's virtual environment (made by `cargo xtask test`), else `python3`, if NumPy
+/// The project's virtual environment (made by `cargo xtask test`), else `python3`, if `module`
 /// imports in it.
-fn python_with_numpy() -> Option<PathBuf> {
+fn python_with(module: &str) -> Option<PathBuf> {
     let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
     [venv, PathBuf::from("python3")].into_iter().find(|python| {
         Command::new(python)
-            .args(["-c", "import numpy"])
+            .args(["-c", &format!("import {module}")])
             .output()
             .is_ok_and(|out| out.status.success())
     })

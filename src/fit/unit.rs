@@ -64,6 +64,10 @@ pub struct UnitFit {
     pub r_squared: f64,
     /// The samples fitted, `[first, end)`.
     pub window: (usize, usize),
+    /// Where Levenberg-Marquardt started, `[onset (s), A1, A2, f1, f2, B1, B2]` (the pencil's
+    /// poles, the onset grid and its amplitudes): another solver started here is compared fairly
+    /// (benches/render.rs).
+    pub start: [f64; 7],
 }
 
 impl UnitFit {
@@ -191,6 +195,15 @@ fn fit_unit(
     let data = &signal[first..end];
     let detected_s = onset as f64 / fs;
     let (start_s, amplitude) = onset_grid(data, first, fs, detected_s, frequency_hz, decay_per_s);
+    let start = [
+        start_s,
+        amplitude[0],
+        amplitude[1],
+        frequency_hz[0],
+        frequency_hz[1],
+        decay_per_s[0],
+        decay_per_s[1],
+    ];
     let problem = UnitProblem {
         data,
         first,
@@ -217,6 +230,7 @@ fn fit_unit(
         decay_per_s: [p[5], p[6]],
         r_squared: 0.0,
         window: (first, end),
+        start,
     };
     if unit.frequency_hz[0] > unit.frequency_hz[1] {
         unit.amplitude.swap(0, 1);

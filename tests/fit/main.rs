@@ -3,6 +3,7 @@
 //! refused or warned about.
 
 mod bad_input;
+mod command;
 mod round_trip;
 
 use std::path::{Path, PathBuf};

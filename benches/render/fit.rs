@@ -1,0 +1,211 @@
+//! The fit of a minute's recording (issue 17): a 60 s, 25 kHz render of the default model held
+//! full at 135° (follow mode, 12 units a second) with noise 40 dB below the glugs, written as a
+//! WAV file and fitted by `sake_glug::fit` as `sake-glug fit` does; beside it, measured in the
+//! same run, the same units fitted one by one by SciPy's `curve_fit` (`benches/scipy_fit.py`)
+//! from the starts `sake-glug fit` used, and how far the two fits lie apart.
+
+use std::path::Path;
+use std::process::Command;
+
+use criterion::Criterion;
+use sake_glug::fit::{fit_session, fit_units, Session, SessionFit, UnitFit};
+use sake_glug::offline::{render_scene_to_vec, Scene};
+
+use super::{best_of, python_with};
+
+const RECORDING: &str = "sample_rate = 25000\nduration_s = 60.0\ntilt_deg = 135.0\n\
+                         [output]\ndrain = \"follow\"\n";
+/// The noise's level below the RMS of the glugs (dB).
+const NOISE_DB: f64 = -40.0;
+
+/// Benchmarks the fit and returns the line the report quotes.
+pub fn fit_versus_scipy(c: &mut Criterion) -> String {
+    let folder = tempfile::tempdir().expect("a temporary folder");
+    let session_path = write_recording(folder.path());
+    let session = Session::load(&session_path).expect("the benchmark's session is valid");
+    let fit = fit_session(&session).expect("the benchmark's recording fits");
+    let mut group = c.benchmark_group("fit of a 60 s, 25 kHz recording");
+    group.sample_size(10);
+    group.bench_function("sake-glug fit", |b| {
+        b.iter(|| fit_session(&session).expect("fits"))
+    });
+    group.finish();
+    let fit_s = best_of(3, &mut || {
+        fit_session(&session).expect("fits");
+    });
+    let audio = &fit.recordings[0].audio;
+    let units_s = best_of(3, &mut || {
+        fit_units(&audio.samples, audio.sample_rate);
+    });
+    let units: Vec<UnitFit> = fit.recordings[0].units.iter().map(|u| u.fit).collect();
+    let ours = format!(
+        "fit of a 60 s, 25 kHz recording ({} units): sake-glug fit {fit_s:.2} s (the unit fits \
+         alone {units_s:.2} s)",
+        units.len()
+    );
+    match scipy_fits(&fit, &units) {
+        Ok((scipy_s, fitted)) => {
+            let speed = if scipy_s >= fit_s {
+                format!("{:.1}× faster than", scipy_s / fit_s)
+            } else {
+                format!("{:.1}× slower than", fit_s / scipy_s)
+            };
+            format!(
+                "{ours}; SciPy curve_fit of the same units from the same starts {scipy_s:.2} s: \
+                 the whole fit {speed} SciPy's unit fits; {}",
+                agreement(&units, &fitted)
+            )
+        }
+        Err(why) => format!("{ours}; SciPy not measured: {why}"),
+    }
+}
+
+/// Renders the recording, adds the noise, and writes it and its session into `folder`.
+fn write_recording(folder: &Path) -> std::path::PathBuf {
+    let scene = Scene::parse(RECORDING).expect("the benchmark scene is valid");
+    let (mut samples, _) = render_scene_to_vec(&scene).expect("renders");
+    let peak = samples.iter().fold(0.0f32, |p, y| p.max(y.abs())) as f64;
+    let loud: Vec<f64> = samples
+        .iter()
+        .map(|&y| y as f64)
+        .filter(|y| y.abs() > 0.1 * peak)
+        .collect();
+    let glug_rms = (loud.iter().map(|y| y * y).sum::<f64>() / loud.len() as f64).sqrt();
+    add_noise(&mut samples, glug_rms * 10f64.powf(NOISE_DB / 20.0));
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: scene.sample_rate,
+        bits_per_sample: 32,
+        sample_format: hound::SampleFormat::Float,
+    };
+    let mut wav = hound::WavWriter::create(folder.join("minute.wav"), spec).expect("a WAV file");
+    for sample in samples {
+        wav.write_sample(sample).expect("writes");
+    }
+    wav.finalize().expect("writes");
+    let session = folder.join("session.toml");
+    std::fs::write(
+        &session,
+        "capacity_ml = 300.0\n[[recording]]\naudio = \"minute.wav\"\ntilt_deg = 135.0\n\
+         start_ml = 300.0\n",
+    )
+    .expect("writes");
+    session
+}
+
+/// Nearly normal noise of standard deviation `sigma` (a sum of twelve uniforms from a fixed
+/// generator: the same recording on every run).
+fn add_noise(samples: &mut [f32], sigma: f64) {
+    let mut state = 0x5eed_u64;
+    let mut uniform = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    for sample in samples {
+        let normal: f64 = (0..12).map(|_| uniform()).sum();
+        *sample += (sigma * normal) as f32;
+    }
+}
+
+/// Runs `benches/scipy_fit.py` on the windows `sake-glug fit` fitted: each the recording less
+/// the units fitted before it, as the fit saw it. Returns SciPy's time (s) and its fits.
+fn scipy_fits(fit: &SessionFit, units: &[UnitFit]) -> Result<(f64, Vec<[f64; 7]>), String> {
+    let python = python_with("scipy").ok_or("no python3 with scipy found")?;
+    let audio = &fit.recordings[0].audio;
+    let fs = audio.sample_rate as f64;
+    let (mut table, mut windows) = (Vec::new(), Vec::new());
+    for (index, unit) in units.iter().enumerate() {
+        let (first, end) = unit.window;
+        let earlier: Vec<&UnitFit> = units[..index]
+            .iter()
+            .filter(|e| e.onset_s > first as f64 / fs - 0.5)
+            .collect();
+        for n in first..end {
+            let t = n as f64 / fs;
+            let before: f64 = earlier.iter().map(|e| e.value_at(t)).sum();
+            windows.extend_from_slice(&(audio.samples[n] - before).to_le_bytes());
+        }
+        for value in [first as f64, (end - first) as f64]
+            .into_iter()
+            .chain(unit.start)
+        {
+            table.extend_from_slice(&value.to_le_bytes());
+        }
+    }
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let (units_path, windows_path, out_path) = (
+        dir.path().join("units.f64"),
+        dir.path().join("windows.f64"),
+        dir.path().join("fitted.f64"),
+    );
+    std::fs::write(&units_path, &table).map_err(|e| e.to_string())?;
+    std::fs::write(&windows_path, &windows).map_err(|e| e.to_string())?;
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/scipy_fit.py");
+    let output = Command::new(&python)
+        .arg(&script)
+        .arg(&units_path)
+        .arg(&windows_path)
+        .arg(fs.to_string())
+        .arg(&out_path)
+        .output()
+        .map_err(|e| e.to_string())?;
+    if !output.status.success() {
+        return Err(String::from_utf8_lossy(&output.stderr).into_owned());
+    }
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let seconds: f64 = stdout
+        .trim()
+        .strip_prefix("seconds=")
+        .and_then(|s| s.parse().ok())
+        .ok_or_else(|| format!("unexpected output from the script: {stdout}"))?;
+    let fitted: Vec<[f64; 7]> = std::fs::read(&out_path)
+        .map_err(|e| e.to_string())?
+        .chunks_exact(8 * 7)
+        .map(|row| {
+            std::array::from_fn(|k| {
+                f64::from_le_bytes(row[8 * k..8 * k + 8].try_into().expect("8 bytes"))
+            })
+        })
+        .collect();
+    if fitted.len() != units.len() {
+        return Err(format!("{} fits for {} units", fitted.len(), units.len()));
+    }
+    Ok((seconds, fitted))
+}
+
+/// How far SciPy's fits lie from ours: the median and largest relative difference of f and B
+/// (both components) and the absolute difference of c, over the units SciPy fitted.
+fn agreement(units: &[UnitFit], fitted: &[[f64; 7]]) -> String {
+    let (mut f, mut b, mut c) = (Vec::new(), Vec::new(), Vec::new());
+    let mut failed = 0;
+    for (unit, p) in units.iter().zip(fitted) {
+        if p.iter().any(|v| !v.is_finite()) {
+            failed += 1;
+            continue;
+        }
+        // SciPy's components in our order (f1 the lower).
+        let (low, high) = if p[3] <= p[4] { (0, 1) } else { (1, 0) };
+        for (k, j) in [low, high].into_iter().enumerate() {
+            f.push((p[3 + j] / unit.frequency_hz[k] - 1.0).abs());
+            b.push((p[5 + j] / unit.decay_per_s[k] - 1.0).abs());
+        }
+        c.push((p[1 + low] / (p[1] + p[2]) - unit.viscosity()).abs());
+    }
+    let spread = |values: &mut Vec<f64>| {
+        values.sort_by(f64::total_cmp);
+        let median = values.get(values.len() / 2).copied().unwrap_or(f64::NAN);
+        (median, values.last().copied().unwrap_or(f64::NAN))
+    };
+    let ((f_median, f_max), (b_median, b_max), (c_median, c_max)) =
+        (spread(&mut f), spread(&mut b), spread(&mut c));
+    format!(
+        "the fits differ by f {:.2} % (median; largest {:.2} %), B {:.2} % ({:.2} %), c {c_median:.4} \
+         ({c_max:.4}); SciPy failed on {failed} units",
+        100.0 * f_median,
+        100.0 * f_max,
+        100.0 * b_median,
+        100.0 * b_max,
+    )
+}

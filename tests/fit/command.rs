@@ -1,0 +1,185 @@
+//! `sake-glug fit` run as a user runs it: the exit status and the message for bad input and bad
+//! arguments, the files a fit leaves (all of them, or none), and the fitted model played by
+//! `sake-glug render`.
+
+use std::process::{Command, Output};
+
+use super::*;
+
+/// Runs `sake-glug ARGS` in `folder`.
+fn sake_glug(folder: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sake-glug"))
+        .current_dir(folder)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// The names of the files in `folder`, sorted.
+fn files_in(folder: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(folder)
+        .unwrap()
+        .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Asserts that `output` ended with `code` and that its stderr names every one of `parts`.
+fn assert_refused(output: &Output, code: i32, parts: &[&str]) {
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(code), "stderr: {stderr}");
+    for part in parts {
+        assert!(stderr.contains(part), "`{part}` missing from: {stderr}");
+    }
+}
+
+const FIT_ALL: [&str; 8] = [
+    "fit",
+    "-o",
+    "model.toml",
+    "--report",
+    "fit.md",
+    "--plot",
+    "fit.png",
+    "session.toml",
+];
+
+/// A session of one recording `a.wav`, written with `samples` at `rate`.
+fn session_of(folder: &Path, samples: &[f32], rate: u32) {
+    write_wav(&folder.join("a.wav"), samples, rate);
+    std::fs::write(
+        folder.join("session.toml"),
+        "[[recording]]\naudio = \"a.wav\"\ntilt_deg = 135\nstart_ml = 300\n",
+    )
+    .unwrap();
+}
+
+#[test]
+fn bad_input_exits_1_naming_the_file_and_the_key_and_writes_nothing() {
+    let folder = tempfile::tempdir().unwrap();
+    let dir = folder.path();
+    let output = sake_glug(dir, &["fit", "absent.toml", "-o", "model.toml"]);
+    assert_refused(&output, 1, &["error:", "absent.toml"]);
+    std::fs::write(
+        dir.join("session.toml"),
+        "[[recording]]\naudio = \"gone.wav\"\ntilt_deg = 135\nstart_ml = 300\n",
+    )
+    .unwrap();
+    let before = files_in(dir);
+    let output = sake_glug(dir, &FIT_ALL);
+    assert_refused(&output, 1, &["recording[0].audio", "gone.wav"]);
+    assert_eq!(files_in(dir), before, "a refused fit wrote something");
+    session_of(dir, &vec![0.1; 8000], 4000);
+    let before = files_in(dir);
+    let output = sake_glug(dir, &FIT_ALL);
+    assert_refused(&output, 1, &["recording[0].audio", "a.wav", "4000 Hz"]);
+    assert_eq!(files_in(dir), before, "a refused fit wrote something");
+    session_of(dir, &vec![0.0; 25_000], 25_000);
+    let output = sake_glug(dir, &FIT_ALL);
+    assert_refused(&output, 1, &["recording[0].audio", "a.wav", "silent"]);
+    assert_eq!(files_in(dir), before, "a refused fit wrote something");
+}
+
+#[test]
+fn bad_arguments_exit_2() {
+    let folder = tempfile::tempdir().unwrap();
+    let dir = folder.path();
+    session_of(dir, &vec![0.0; 25_000], 25_000);
+    let before = files_in(dir);
+    assert_refused(&sake_glug(dir, &["fit"]), 2, &["SESSION"]);
+    assert_refused(
+        &sake_glug(dir, &["fit", "session.toml"]),
+        2,
+        &["nothing to write"],
+    );
+    assert_refused(
+        &sake_glug(
+            dir,
+            &["fit", "session.toml", "-o", "m.toml", "--frobnicate"],
+        ),
+        2,
+        &["--frobnicate"],
+    );
+    assert_refused(
+        &sake_glug(
+            dir,
+            &["fit", "session.toml", "-o", "m.toml", "--out-dir", "d"],
+        ),
+        2,
+        &["--out-dir"],
+    );
+    assert_eq!(files_in(dir), before, "a refused command wrote something");
+}
+
+/// A poured bottle (3 s from full at 135°, 25 kHz, noise 40 dB below the glugs) as a session.
+fn good_session(folder: &Path) {
+    let rendered = render("sample_rate = 25000\ntilt_deg = 135.0\nduration_s = 3.0\n");
+    let take = Take {
+        name: "a",
+        rendered: &rendered,
+        tilt_deg: 135.0,
+        liquid: None,
+        weight: false,
+        noise_db: Some(-40.0),
+    };
+    write_session(folder, 300.0, &[take]);
+}
+
+#[test]
+fn a_good_session_writes_the_model_the_report_and_the_plot_and_the_model_renders() {
+    let folder = tempfile::tempdir().unwrap();
+    let dir = folder.path();
+    good_session(dir);
+    let output = sake_glug(dir, &FIT_ALL);
+    assert_refused(
+        &output,
+        0,
+        &["units fitted", "model.toml", "fit.md", "fit.png"],
+    );
+    assert_eq!(
+        files_in(dir),
+        ["a.wav", "fit.md", "fit.png", "model.toml", "session.toml"]
+    );
+    let report = std::fs::read_to_string(dir.join("fit.md")).unwrap();
+    assert!(report.contains("glug.f1_hz"), "{report}");
+    let png = std::fs::read(dir.join("fit.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"), "fit.png is no PNG");
+    // The model plays, and its glugs are the fitted ones: fitted again, f1 and f2 agree.
+    let model = dir.join("model.toml");
+    let output = sake_glug(dir, &["render", "model.toml", "-o", "played.wav"]);
+    assert_refused(&output, 0, &[]);
+    let fitted = fit(&dir.join("session.toml"));
+    std::fs::write(
+        dir.join("played.toml"),
+        "[[recording]]\naudio = \"played.wav\"\ntilt_deg = 135\nstart_ml = 300\n",
+    )
+    .unwrap();
+    let played = fit(&dir.join("played.toml"));
+    for key in ["glug.f1_hz", "glug.f2_hz"] {
+        let (truth, again) = (estimate(&fitted, 0, key), estimate(&played, 0, key));
+        assert!(
+            (again / truth - 1.0).abs() < 0.02,
+            "{key}: the model's render gives {again}, the model {truth} ({})",
+            model.display()
+        );
+    }
+}
+
+#[test]
+fn a_fit_whose_last_file_cannot_be_written_leaves_no_file_and_keeps_the_old_ones() {
+    let folder = tempfile::tempdir().unwrap();
+    let dir = folder.path();
+    good_session(dir);
+    std::fs::write(dir.join("model.toml"), "# the old model\n").unwrap();
+    // The plot's path is a folder: renaming the finished plot over it fails last.
+    std::fs::create_dir(dir.join("fit.png")).unwrap();
+    let before = files_in(dir);
+    let output = sake_glug(dir, &FIT_ALL);
+    assert_refused(&output, 1, &["fit"]);
+    assert_eq!(files_in(dir), before, "a failed fit left a file");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("model.toml")).unwrap(),
+        "# the old model\n"
+    );
+}
