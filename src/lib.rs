@@ -22,6 +22,8 @@ pub mod device;
 pub mod engine;
 #[cfg(feature = "offline")]
 mod files;
+#[cfg(feature = "model")]
+pub mod model;
 #[cfg(feature = "offline")]
 pub mod offline;
 #[cfg(feature = "plugin")]
