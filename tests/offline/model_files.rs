@@ -131,7 +131,7 @@ fn a_model_holds_only_the_bottle_and_the_liquid() {
         assert!(message.contains(expected), "{text}: {message}");
     }
     let model = Model::parse("m", "viscosity_c = 1\n[glug]\nf2_hz = 310").unwrap();
-    assert_eq!(model.controls().viscosity_c, Some(1.0), "integers are numbers");
+    assert_eq!(model.controls().viscosity, Some(1.0), "integers are numbers");
     assert_eq!(model.config().frequency_hz, [80.0, 310.0]);
 }
 
