@@ -78,11 +78,21 @@ fn render_with_a_model_is_the_merged_scene_written_out_by_hand() {
     }
     let layered = render(
         path,
-        &["render", "--model", "model.toml", "scene.toml", "-o", "a.wav"],
+        &[
+            "render",
+            "--model",
+            "model.toml",
+            "scene.toml",
+            "-o",
+            "a.wav",
+        ],
     );
     let by_hand = render(path, &["render", "merged.toml", "-o", "b.wav"]);
     let scene_alone = render(path, &["render", "scene.toml", "-o", "c.wav"]);
-    assert!(layered == by_hand, "render --model differs from the merged scene");
+    assert!(
+        layered == by_hand,
+        "render --model differs from the merged scene"
+    );
     assert!(layered != scene_alone, "the model must change the sound");
     // The built-in pour on the model's bottle: the default scene with the model's keys.
     let built_in = render(path, &["render", "--model", "model.toml", "-o", "d.wav"]);
@@ -98,7 +108,10 @@ fn render_with_a_model_is_the_merged_scene_written_out_by_hand() {
 fn a_model_holds_only_the_bottle_and_the_liquid() {
     for (text, key) in [
         ("tilt_deg = [[0.0, 90.0], [1.0, 135.0]]", "`tilt_deg`"),
-        ("viscosity_c = { csv = \"log.csv\", column = \"c\" }", "`viscosity_c`"),
+        (
+            "viscosity_c = { csv = \"log.csv\", column = \"c\" }",
+            "`viscosity_c`",
+        ),
         ("midi_take = \"take.mid\"", "`midi_take`"),
         ("[midi]\nmidi_channel = 2", "`midi.midi_channel`"),
         ("sample_rate = 25000", "`sample_rate`"),
@@ -122,7 +135,10 @@ fn a_model_holds_only_the_bottle_and_the_liquid() {
             "[bottle]\ncapacity_ml = 80.0\n[amplitude]\nsilent_below_ml = 90.0",
             "must lie below `bottle.capacity_ml`",
         ),
-        ("[curves]\ndrain = [[0.0, 0.0], [90.0, 0.5]]", "`curves.drain`"),
+        (
+            "[curves]\ndrain = [[0.0, 0.0], [90.0, 0.5]]",
+            "`curves.drain`",
+        ),
         ("[curves]\nrest = [[0.0, 1.0], \"x\"]", "`curves.rest`"),
         ("[glug]\nf1_hz = \"high\"", "`glug.f1_hz`"),
         ("f1_hz = ", "invalid model"),
@@ -131,7 +147,11 @@ fn a_model_holds_only_the_bottle_and_the_liquid() {
         assert!(message.contains(expected), "{text}: {message}");
     }
     let model = Model::parse("m", "viscosity_c = 1\n[glug]\nf2_hz = 310").unwrap();
-    assert_eq!(model.controls().viscosity, Some(1.0), "integers are numbers");
+    assert_eq!(
+        model.controls().viscosity,
+        Some(1.0),
+        "integers are numbers"
+    );
     assert_eq!(model.config().frequency_hz, [80.0, 310.0]);
 }
 

@@ -41,7 +41,7 @@ fn with_model_fields(instance: &ClapInstance, name: &str, text: &str) -> Vec<u8>
 fn loaded(model: &Model) -> ClapInstance {
     let instance = ClapInstance::new();
     for (param, value) in model_values(model, &GlugParams::default()) {
-        instance.set_text(&param.name(), &value.to_string());
+        instance.set_text(param.name(), &value.to_string());
     }
     instance.set_text("Seed", "7");
     instance.set_text("Tilt", "90");
