@@ -235,13 +235,14 @@ fn model_key(key: &str) -> Option<ModelKey> {
     controls.or_else(constants).or_else(curves)
 }
 
-/// Every key of `table`, a table's keys as `section.name` (scene files nest no deeper), in the
-/// file's order.
+/// Every key of `table`, a section's keys as `section.name` (scene files nest no deeper), in the
+/// file's order. A control's table (a CSV lane) is one key, the control's.
 fn flatten(table: &toml::Table) -> Vec<(String, toml::Value)> {
     let mut keys = Vec::new();
     for (name, value) in table {
+        let lane = matches!(model_key(name), Some(ModelKey::Control(_)));
         match value {
-            toml::Value::Table(section) => {
+            toml::Value::Table(section) if !lane => {
                 for (inner, value) in section {
                     keys.push((format!("{name}.{inner}"), value.clone()));
                 }
