@@ -31,6 +31,8 @@ pub mod engine;
 mod files;
 #[cfg(feature = "fit")]
 pub mod fit;
+#[cfg(feature = "model")]
+pub mod model;
 #[cfg(feature = "offline")]
 pub mod offline;
 #[cfg(feature = "plugin")]

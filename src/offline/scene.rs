@@ -16,6 +16,7 @@ use crate::engine::{
     Constant, Control, ControlSource, ControlValues, Controls, Curve, DrainMode, ModelConfig,
     PerControl, Preset, PresetValue, Quantity,
 };
+use crate::model::{curve_points, Model};
 use crate::text::printable;
 
 /// The built-in default scene: a full 300 ml bottle of water tilted from 90° to 135° over half a
@@ -287,6 +288,25 @@ impl Scene {
         SceneFile::parse(text)?.validate(folder)
     }
 
+    /// The scene file at `path` played on `model`'s bottle (MODEL.md §12.1): every key the scene
+    /// leaves out that the model gives comes from the model; what the scene sets, it keeps.
+    pub fn load_with_model(path: &Path, model: &Model) -> Result<Self, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+            path: path.to_owned(),
+            source,
+        })?;
+        let folder = path.parent().unwrap_or(Path::new(""));
+        Self::parse_with_model(&text, folder, model)
+    }
+
+    /// The scene of TOML `text` (its files relative to `folder`) played on `model`'s bottle, as
+    /// [`Scene::load_with_model`].
+    pub fn parse_with_model(text: &str, folder: &Path, model: &Model) -> Result<Self, SceneError> {
+        let mut file = SceneFile::parse(text)?;
+        file.layer_over(model);
+        file.validate(folder)
+    }
+
     /// The same scene at another sample rate, refused as a scene's `sample_rate` would be: out
     /// of range or not a whole number of Hz. A take's messages move to their new samples.
     pub fn with_sample_rate(self, sample_rate: f64) -> Result<Self, SceneError> {
@@ -438,6 +458,28 @@ impl SceneFile {
         })
     }
 
+    /// Adds each key of `model` that the scene does not set (a model gives nothing but bottle
+    /// and liquid keys, so it adds no file, lane or setting). A section the scene writes as
+    /// something other than a table is left for validation to refuse.
+    fn layer_over(&mut self, model: &Model) {
+        for (key, value) in model.keys() {
+            let (table, name) = match key.split_once('.') {
+                None => (&mut self.table, key.as_str()),
+                Some((section, name)) => {
+                    let section = self
+                        .table
+                        .entry(section)
+                        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+                    match section.as_table_mut() {
+                        Some(table) => (table, name),
+                        None => continue,
+                    }
+                }
+            };
+            table.entry(name).or_insert_with(|| value.clone());
+        }
+    }
+
     /// The value at `key` (`section.name` inside a table), taken out of the file.
     fn take<T: serde::de::DeserializeOwned>(&mut self, key: &str) -> Result<Option<T>, SceneError> {
         self.known.push(key.to_owned());
@@ -581,7 +623,7 @@ impl SceneFile {
             let key = curve.scene_key();
             if let Some(points) = self.take::<Vec<toml::Value>>(key)? {
                 *curve.of_mut(&mut config.curves) = curve
-                    .from_points(&curve_points(key, &points)?)
+                    .from_points(&curve_points_of(key, &points)?)
                     .map_err(|source| SceneError::Curve { key, source })?;
             }
         }
@@ -731,26 +773,13 @@ fn shown(path: &Path) -> String {
     printable(&path.to_string_lossy()).into_owned()
 }
 
-/// A curve's points as a scene writes them: `[tilt_deg, value]` pairs of numbers, integer or
-/// float.
-fn curve_points(key: &str, points: &[toml::Value]) -> Result<Vec<(f64, f64)>, SceneError> {
-    let number = |value: &toml::Value| {
-        (value.as_float()).or_else(|| value.as_integer().map(|integer| integer as f64))
-    };
-    let pair = |point: &toml::Value| match point.as_array()?.as_slice() {
-        [tilt_deg, value] => Some((number(tilt_deg)?, number(value)?)),
-        _ => None,
-    };
-    points
-        .iter()
-        .map(|point| {
-            pair(point).ok_or_else(|| {
-                syntax(&format!(
-                    "`{key}`: each point must be a [tilt_deg, value] pair of numbers"
-                ))
-            })
-        })
-        .collect()
+/// A curve's points as a scene writes them ([`curve_points`]).
+fn curve_points_of(key: &str, points: &[toml::Value]) -> Result<Vec<(f64, f64)>, SceneError> {
+    curve_points(points).ok_or_else(|| {
+        syntax(&format!(
+            "`{key}`: each point must be a [tilt_deg, value] pair of numbers"
+        ))
+    })
 }
 
 /// A [`SceneError::Syntax`] whose message may quote the scene.

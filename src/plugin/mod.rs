@@ -2,6 +2,7 @@
 //! the parameters, hands MIDI and the transport to [`RealtimeEngine`] and keeps no DSP of its own.
 
 mod feed;
+mod model;
 mod osc_input;
 mod params;
 pub mod presets;
@@ -13,6 +14,7 @@ mod transport;
 mod editor;
 
 pub use feed::{Feed, UnitView, Visible, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
+pub use model::{model_values, LoadedModel, ModelLayer, MODEL_KEY, MODEL_NAME_KEY};
 pub use osc_input::{OscInput, OscSettings, OscStatus, DEFAULT_AXIS, DEFAULT_OSC_INTERFACE};
 pub use params::{
     exact, float_param, format, migrate_state, parse_number, GlugParams, ModelParams, STATE_VERSION,
@@ -41,6 +43,9 @@ pub struct SakeGlugPlugin<const RAW_MIDI: bool> {
     osc: Arc<OscInput>,
     /// Built in `activate()`, where allocating is allowed.
     renderer: Option<RealtimeEngine>,
+    /// The audio thread's copy of the loaded model (MODEL.md §12.1), taken from
+    /// [`GlugParams::loaded_model`] at the start of each block.
+    model: Option<ModelLayer>,
 }
 
 /// The CLAP plugin, with raw MIDI from the device.
@@ -50,11 +55,16 @@ pub type SakeGlugVst3 = SakeGlugPlugin<false>;
 
 impl<const RAW_MIDI: bool> Default for SakeGlugPlugin<RAW_MIDI> {
     fn default() -> Self {
+        let params = GlugParams::default();
+        if let Some(model) = standalone::options().and_then(|options| options.model.as_ref()) {
+            model::load_unshared(model, &params);
+        }
         Self {
-            params: Arc::new(GlugParams::default()),
+            params: Arc::new(params),
             feed: Arc::new(Feed::default()),
             osc: Arc::new(OscInput::default()),
             renderer: None,
+            model: None,
         }
     }
 }
@@ -78,6 +88,15 @@ impl<const RAW_MIDI: bool> SakeGlugPlugin<RAW_MIDI> {
     /// The renderer, once the plugin has been initialised.
     pub fn renderer(&self) -> Option<&RealtimeEngine> {
         self.renderer.as_ref()
+    }
+
+    /// The parameters' values over the loaded model, after taking the newest model loaded
+    /// (lock-free: also on the audio thread).
+    fn settings(&mut self) -> Settings {
+        if let Some(model) = self.params.loaded_model.take_change() {
+            self.model = model;
+        }
+        Settings::with_model(&self.params, self.model.as_ref())
     }
 }
 
@@ -169,15 +188,17 @@ impl<const RAW_MIDI: bool> Plugin for SakeGlugPlugin<RAW_MIDI> {
             .renderer
             .as_ref()
             .is_some_and(|renderer| renderer.sample_rate() == sample_rate);
+        let config = self.settings().config;
         if !reusable {
-            self.renderer = Some(RealtimeEngine::new(sample_rate, self.params.model_config()));
+            self.renderer = Some(RealtimeEngine::new(sample_rate, config));
         }
         true
     }
 
     fn reset(&mut self) {
+        let config = self.settings().config;
         if let Some(renderer) = &mut self.renderer {
-            renderer.reset(self.params.model_config());
+            renderer.reset(config);
         }
     }
 
@@ -189,11 +210,11 @@ impl<const RAW_MIDI: bool> Plugin for SakeGlugPlugin<RAW_MIDI> {
     ) -> ProcessStatus {
         let len = buffer.samples();
         let channels = buffer.as_slice();
+        let settings = self.settings();
         let Some(renderer) = &mut self.renderer else {
             channels.iter_mut().for_each(|channel| channel.fill(0.0));
             return ProcessStatus::Normal;
         };
-        let settings = Settings::from_params(&self.params);
         let transport = context.transport();
         renderer.observe_transport(transport.playing, transport.pos_samples(), settings.config);
         renderer.apply_live(self.osc.live());

@@ -17,6 +17,7 @@ use nice_plug::prelude::*;
 use crate::device::midi::{MidiMap, MidiSetting};
 use crate::engine::config::{self, Knob, Quantity, CEILING_DB};
 use crate::engine::{Constant, Control, ControlValues, DrainMode, ModelConfig, PerControl};
+use crate::plugin::model::{saved_model, LoadedModel, MODEL_KEY, MODEL_NAME_KEY};
 use crate::plugin::osc_input::OscSettings;
 
 /// The decimal number that `value` shows as on a knob with `decimals` decimals: what the engine
@@ -129,6 +130,8 @@ pub struct GlugParams {
     pub state_version: AtomicU8,
     /// OSC settings (saved with the state, not automatable).
     pub osc: OscSettings,
+    /// The model file loaded, if any (saved with the state as its text, MODEL.md §12.1).
+    pub loaded_model: LoadedModel,
 }
 
 /// The saved state's layout. 0: before states carried a version (the parameters and MIDI
@@ -163,7 +166,16 @@ pub fn migrate_state(state: &mut PluginState) {
 /// know, or a value of the wrong type loads as the default. The persisted fields load as the
 /// plugin would save them again (a MIDI byte out of range as off, a field that does not parse as
 /// its default). So a state the plugin saves is always one it loads.
+///
+/// A state whose model is no model is refused whole: its parameters and fields are emptied, so
+/// that loading it changes nothing (nice-plug gives `filter_state` no way to fail a load).
 pub fn validate_state(state: &mut PluginState) {
+    if let Err(reason) = saved_model(&state.fields) {
+        nice_warn!("state refused, nothing of it loads: its model: {reason}");
+        state.params.clear();
+        state.fields.clear();
+        return;
+    }
     // Fresh parameters: their ranges and defaults, and a scratch copy to read the fields into.
     let scratch = GlugParams::default();
     let params: HashMap<String, ParamPtr> = scratch
@@ -314,6 +326,7 @@ impl Default for GlugParams {
                 .collect(),
             state_version: AtomicU8::new(STATE_VERSION),
             osc: OscSettings::default(),
+            loaded_model: LoadedModel::default(),
         }
     }
 }
@@ -379,10 +392,28 @@ unsafe impl Params for GlugParams {
             }
         }
         fields.extend(self.osc.serialize_fields());
+        if let Some((name, text)) = self.loaded_model.saved() {
+            for (key, value) in [(MODEL_NAME_KEY, name), (MODEL_KEY, text)] {
+                match persist::serialize_field(&value) {
+                    Ok(data) => {
+                        fields.insert(key.to_owned(), data);
+                    }
+                    Err(error) => nice_debug_assert_failure!("cannot save '{}': {}", key, error),
+                }
+            }
+        }
         fields
     }
 
     fn deserialize_fields(&self, serialized: &BTreeMap<String, String>) {
+        // Only a refused state has no fields (every other has its version): it changes nothing.
+        if serialized.is_empty() {
+            return;
+        }
+        match saved_model(serialized) {
+            Ok(model) => self.loaded_model.set(model),
+            Err(reason) => nice_warn!("the saved model is kept out: {reason}"),
+        }
         let persisted = MidiSetting::all()
             .map(|setting| setting.key())
             .zip(&self.midi)

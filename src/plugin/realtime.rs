@@ -5,6 +5,7 @@ use crate::device::live::{LiveControls, LiveReader};
 use crate::device::midi::{CcDecoder, DeviceAction, MidiInput, MidiMap, Overrides};
 use crate::engine::{ControlValues, Controls, Engine, ModelConfig};
 use crate::plugin::feed::{Feed, ScopeWriter, Visible};
+use crate::plugin::model::{layered_config, layered_controls, ModelLayer};
 use crate::plugin::params::GlugParams;
 use crate::plugin::transport::TransportWatch;
 
@@ -30,9 +31,22 @@ pub struct Settings {
 impl Settings {
     /// The parameters' current values.
     pub fn from_params(params: &GlugParams) -> Self {
+        Self::with_model(params, None)
+    }
+
+    /// The parameters' current values over a loaded model's (MODEL.md §12.1): a parameter that
+    /// shows the model's value plays it in full; the model gives what has no parameter.
+    pub fn with_model(params: &GlugParams, model: Option<&ModelLayer>) -> Self {
+        let (values, config) = match model {
+            None => (params.control_values(), params.model_config()),
+            Some(layer) => (
+                layered_controls(params, layer),
+                layered_config(params, layer),
+            ),
+        };
         Self {
-            values: params.control_values(),
-            config: params.model_config(),
+            values,
+            config,
             midi: params.midi_map(),
         }
     }

@@ -10,7 +10,7 @@ use std::sync::{Arc, LazyLock, OnceLock};
 use crate::device::Axis;
 
 /// The standalone app's options for the plugin.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct StandaloneOptions {
     /// Open the editor window; without it the app runs headless until SIGINT or SIGTERM.
     pub editor: bool,
@@ -19,6 +19,8 @@ pub struct StandaloneOptions {
     pub osc: Option<(u16, Axis)>,
     /// The address the OSC socket binds to, whenever OSC is turned on in this session.
     pub osc_interface: IpAddr,
+    /// The model file to start with (`--model`), loaded as the editor's "Load model…" loads it.
+    pub model: Option<crate::model::Model>,
 }
 
 static OPTIONS: OnceLock<StandaloneOptions> = OnceLock::new();

@@ -15,6 +15,7 @@ mod fuzz;
 #[cfg(unix)]
 mod inputs;
 mod memory;
+mod model_files;
 mod presets;
 mod readme;
 mod scene_files;

@@ -13,6 +13,7 @@ mod clap_state;
 mod layouts;
 
 mod midi;
+mod model;
 mod nyquist;
 mod osc;
 mod osc_decoder;

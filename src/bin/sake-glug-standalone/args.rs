@@ -2,6 +2,7 @@
 //! rest (it refuses options it does not know).
 
 use std::net::IpAddr;
+use std::path::PathBuf;
 
 use clap::{CommandFactory, Parser};
 use sake_glug::device::Axis;
@@ -26,14 +27,19 @@ pub struct AppArgs {
     /// No editor window (no display needed); quit with Ctrl-C or SIGTERM.
     #[arg(long)]
     pub no_editor: bool,
+    /// A model file (as `sake-glug fit` writes) to play: its bottle and liquid, loaded as the
+    /// editor's "Load model…" loads it.
+    #[arg(long, value_name = "MODEL.toml")]
+    pub model: Option<PathBuf>,
 }
 
 /// Our options and whether each takes a value.
-const OWN: [(&str, bool); 4] = [
+const OWN: [(&str, bool); 5] = [
     ("--osc-port", true),
     ("--osc-bind", true),
     ("--osc-axis", true),
     ("--no-editor", false),
+    ("--model", true),
 ];
 
 /// Splits the command line into our options (as `--name=value`, after the program name) and
@@ -116,6 +122,24 @@ mod tests {
         assert_eq!(parsed.osc_axis, Axis::MinusZ);
         assert_eq!(parsed.osc_bind, IpAddr::from([0, 0, 0, 0]));
         assert!(parsed.no_editor);
+    }
+
+    #[test]
+    fn the_model_file_is_taken_out_with_its_path() {
+        for args in [
+            &["app", "--model", "honey.toml", "--backend", "dummy"][..],
+            &["app", "--model=honey.toml", "--backend", "dummy"][..],
+        ] {
+            let (own, rest) = split(strings(args));
+            assert_eq!(own, strings(&["app", "--model=honey.toml"]));
+            assert_eq!(rest, strings(&["app", "--backend", "dummy"]));
+            let parsed = parse(&own).unwrap();
+            assert_eq!(parsed.model, Some(PathBuf::from("honey.toml")));
+        }
+        assert_eq!(parse(&strings(&["app"])).unwrap().model, None);
+        let (own, _) = split(strings(&["app", "--model"]));
+        let error = parse(&own).unwrap_err().to_string();
+        assert!(error.contains("--model"), "{error}");
     }
 
     #[test]

@@ -9,7 +9,9 @@
 //! - `--osc-bind ADDRESS`: the address OSC listens on, 127.0.0.1 (this computer only) unless
 //!   asked (`0.0.0.0`: every network interface);
 //! - `--osc-axis AXIS`: the sensor axis from the bottle's base to its mouth (`+y` by default);
-//! - `--no-editor`: no window (no display needed); quit with Ctrl-C, SIGTERM or SIGHUP.
+//! - `--no-editor`: no window (no display needed); quit with Ctrl-C, SIGTERM or SIGHUP;
+//! - `--model MODEL.toml`: play a model file's bottle and liquid (MODEL.md §12.1); a model that
+//!   is refused ends the app at once (status 2) with the reason.
 //!
 //! If the audio stops coming (the JACK server or the audio device went away) the app says so and
 //! exits with status 1.
@@ -20,6 +22,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use nice_plug::prelude::nice_export_standalone_with_args;
+use sake_glug::model::Model;
 use sake_glug::plugin::standalone::{self, StandaloneOptions};
 use sake_glug::SakeGlug;
 
@@ -42,10 +45,18 @@ fn main() -> ExitCode {
     {
         println!("{}\n", args::help());
     }
+    let model = match options.model.as_deref().map(Model::load).transpose() {
+        Ok(model) => model,
+        Err(error) => {
+            eprintln!("error: --model: {error}");
+            return ExitCode::from(2);
+        }
+    };
     standalone::configure(StandaloneOptions {
         editor: !options.no_editor,
         osc: options.osc_port.map(|port| (port, options.osc_axis)),
         osc_interface: options.osc_bind,
+        model,
     });
     standalone::spawn_watch(QUIT_GRACE, AUDIO_LOST_AFTER);
     if nice_export_standalone_with_args::<SakeGlug, _>(wrapper_args) {

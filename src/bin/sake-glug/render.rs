@@ -11,6 +11,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use sake_glug::engine::Preset;
+use sake_glug::model::Model;
 use sake_glug::offline::clips::HapticBand;
 use sake_glug::offline::fidelity::{self, fidelity_table, Fidelity};
 use sake_glug::offline::sinks::AudioChannels;
@@ -18,7 +19,7 @@ use sake_glug::offline::steps::{DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
 use sake_glug::offline::{
     human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions,
     PlatformOptions, RenderError, RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
-    StateRate,
+    StateRate, DEFAULT_SCENE,
 };
 use sake_glug::text::printable;
 
@@ -81,6 +82,10 @@ pub struct RenderArgs {
     /// mapping (or the scene's [midi] table); replaces a take the scene names.
     #[arg(long, value_name = "TAKE.mid")]
     midi: Option<PathBuf>,
+    /// A model file (as `sake-glug fit` writes): each scene plays on its bottle and liquid, the
+    /// keys a scene sets its own (MODEL.md §12.1).
+    #[arg(long, value_name = "MODEL.toml")]
+    model: Option<PathBuf>,
     /// Overrides the scenes' sample rate (Hz).
     #[arg(long, value_parser = crate::sample_rate_hz)]
     sample_rate: Option<f64>,
@@ -131,6 +136,13 @@ pub fn run(args: RenderArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let model = match args.model.as_deref().map(Model::load).transpose() {
+        Ok(model) => model,
+        Err(error) => {
+            eprintln!("error: --model: {error}");
+            return ExitCode::from(2);
+        }
+    };
     if let Some(directory) = &args.out_dir {
         if let Err(error) = std::fs::create_dir_all(directory) {
             eprintln!("error: cannot create {}: {error}", directory.display());
@@ -154,7 +166,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
         let progress = |fraction| out.progress.set(index, fraction);
         let signal_name =
             |signal| signal_hook::low_level::signal_name(signal).unwrap_or("a signal");
-        match render_job(job, &args, &options, &stop, progress) {
+        match render_job(job, &args, model.as_ref(), &options, &stop, progress) {
             Ok(Rendered {
                 report,
                 outside,
@@ -424,17 +436,28 @@ struct Rendered {
     fidelity: Option<Vec<Fidelity>>,
 }
 
+/// A built-in scene (the default pour or a preset's), on `model`'s bottle if one is given.
+fn built_in(text: &str, model: Option<&Model>) -> Result<Scene, SceneError> {
+    match model {
+        None => Scene::parse(text),
+        Some(model) => Scene::parse_with_model(text, Path::new(""), model),
+    }
+}
+
 fn render_job(
     job: &Job,
     args: &RenderArgs,
+    model: Option<&Model>,
     options: &OutputOptions,
     stop: &Stop,
     progress: impl FnMut(f64),
 ) -> Result<Rendered, JobError> {
-    let mut scene = match (&job.scene, args.preset.as_deref().and_then(Preset::find)) {
-        (Some(path), _) => Scene::load(path)?,
-        (None, Some(preset)) => Scene::parse(&Scene::preset_toml(preset))?,
-        (None, None) => Scene::default(),
+    let preset = args.preset.as_deref().and_then(Preset::find);
+    let mut scene = match (&job.scene, preset, model) {
+        (Some(path), _, None) => Scene::load(path)?,
+        (Some(path), _, Some(model)) => Scene::load_with_model(path, model)?,
+        (None, Some(preset), model) => built_in(&Scene::preset_toml(preset), model)?,
+        (None, None, model) => built_in(DEFAULT_SCENE, model)?,
     };
     if let Some(take) = &args.midi {
         scene = scene.with_midi_take(take)?;

@@ -5,6 +5,7 @@ mod bottle;
 mod controls;
 mod envelopes;
 mod midi_settings;
+mod model_file;
 mod osc_settings;
 mod presets;
 mod scope;
@@ -43,6 +44,8 @@ pub struct GlugEditor {
     /// The MIDI settings were edited and the host is not told yet (it is, once the mouse is
     /// let go, not at every step of a drag).
     midi_edited: bool,
+    /// The model file's path field and the last refusal.
+    model_field: model_file::ModelField,
 }
 
 pub fn create(
@@ -64,6 +67,7 @@ pub fn create(
         gui: None,
         preset: 0,
         midi_edited: false,
+        model_field: model_file::ModelField::default(),
     };
     create_egui_editor(
         EguiEditorState::from_size(LogicalSize::new(WIDTH, HEIGHT), 1.0),
@@ -109,6 +113,7 @@ impl NiceEguiApp for GlugEditor {
                         .max_height(controls_height)
                         .show(ui, |ui| {
                             presets::show(ui, &self.params, &setter, &mut self.preset);
+                            model_file::show(ui, &self.params, gui, &mut self.model_field);
                             controls::show(ui, &self.params, &setter);
                             ui.separator();
                             self.midi_edited |= midi_settings::show(ui, &self.params);

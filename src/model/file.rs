@@ -1,0 +1,289 @@
+//! Reading and validating a model file: the keys of a scene that describe the bottle and the
+//! liquid, nothing else (MODEL.md §12.1).
+
+use std::io::Read;
+use std::path::Path;
+
+use crate::engine::{Constant, Control, Curve, ModelConfig, PerControl, Quantity, Range};
+use crate::text::printable;
+
+/// The largest model file read (bytes): a model is a few dozen lines; a larger file is no model.
+pub const MAX_MODEL_BYTES: u64 = 1 << 20;
+
+/// Why a model was refused. Text from the file is shown with its control characters escaped.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelError {
+    /// The file could not be read.
+    #[error("cannot read model file {}: {source}", printable(path))]
+    Read {
+        /// The file's path, as given.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// Larger than [`MAX_MODEL_BYTES`].
+    #[error(
+        "model file {} is over the limit of {MAX_MODEL_BYTES} bytes",
+        printable(path)
+    )]
+    TooLarge {
+        /// The file's path, as given.
+        path: String,
+    },
+    /// Not valid TOML, or a value of the wrong type: the parser's message, escaped.
+    #[error("invalid model: {0}")]
+    Syntax(String),
+    /// A key a scene may have but a model may not: automation, a take, render settings.
+    #[error(
+        "`{key}` does not belong in a model: a model gives the bottle and the liquid (the \
+         constants, the [curves] and each control as one number); {what} belong in the scene"
+    )]
+    NotAModelKey {
+        /// The key, as written.
+        key: String,
+        /// What such keys are.
+        what: &'static str,
+    },
+    /// A value outside its allowed range.
+    #[error("`{key}` = {value} is out of range: allowed {min} to {max}")]
+    OutOfRange {
+        /// The key.
+        key: &'static str,
+        /// The value given.
+        value: f64,
+        /// Lowest allowed value.
+        min: f64,
+        /// Highest allowed value.
+        max: f64,
+    },
+    /// V0 not below the capacity.
+    #[error("`{key}` = {value} is out of range: it must lie below `{limit_key}` ({limit})")]
+    NotBelow {
+        /// The key.
+        key: &'static str,
+        /// The value given.
+        value: f64,
+        /// The key of the value it must lie below.
+        limit_key: &'static str,
+        /// That value.
+        limit: f64,
+    },
+    /// A list of points that is no curve of the bottle (MODEL.md §12).
+    #[error("`{key}`: {source}")]
+    Curve {
+        /// The key.
+        key: &'static str,
+        /// What was wrong.
+        source: crate::engine::pour::CurveError,
+    },
+}
+
+/// A validated model file: its name and text (what the plugin saves), its keys as written (what
+/// a scene is layered over), and what they set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    name: String,
+    text: String,
+    keys: Vec<(String, toml::Value)>,
+    config: ModelConfig,
+    controls: PerControl<Option<f64>>,
+}
+
+impl Model {
+    /// Reads the model file at `path`, named after the file (its stem).
+    pub fn load(path: &Path) -> Result<Self, ModelError> {
+        let shown = path.to_string_lossy().into_owned();
+        let read = |source| ModelError::Read {
+            path: shown.clone(),
+            source,
+        };
+        let mut text = String::new();
+        std::fs::File::open(path)
+            .map_err(read)?
+            .take(MAX_MODEL_BYTES + 1)
+            .read_to_string(&mut text)
+            .map_err(read)?;
+        if text.len() as u64 > MAX_MODEL_BYTES {
+            return Err(ModelError::TooLarge { path: shown });
+        }
+        let name = path
+            .file_stem()
+            .map_or("model".into(), |stem| stem.to_string_lossy().into_owned());
+        Self::parse(&name, &text)
+    }
+
+    /// Parses and validates the model `text`, called `name`.
+    pub fn parse(name: &str, text: &str) -> Result<Self, ModelError> {
+        let table: toml::Table = toml::from_str(text).map_err(|error| {
+            let lines: Vec<_> = error
+                .to_string()
+                .split('\n')
+                .map(|line| printable(line).into_owned())
+                .collect();
+            ModelError::Syntax(lines.join("\n"))
+        })?;
+        let keys = flatten(&table);
+        let mut config = ModelConfig::default();
+        let mut controls = PerControl::from_fn(|_| None);
+        for (key, value) in &keys {
+            match model_key(key) {
+                Some(ModelKey::Control(control)) => {
+                    let quantity = control.quantity();
+                    let value = as_number(value).ok_or_else(|| ModelError::NotAModelKey {
+                        key: printable(key).into_owned(),
+                        what: "automation lanes and recorded takes",
+                    })?;
+                    controls[control] = Some(check(quantity, value)?);
+                }
+                Some(ModelKey::Constant(constant)) => {
+                    let quantity = constant.quantity();
+                    let value = as_number(value).ok_or_else(|| {
+                        syntax(&format!("`{key}`: invalid type: expected a number"))
+                    })?;
+                    constant.set(&mut config, check(quantity, value)?);
+                }
+                Some(ModelKey::Curve(curve)) => {
+                    let key = curve.scene_key();
+                    let points = value
+                        .as_array()
+                        .ok_or_else(|| syntax(&format!("`{key}`: expected a list of points")))?;
+                    let points = curve_points(points).ok_or_else(|| {
+                        syntax(&format!(
+                            "`{key}`: each point must be a [tilt_deg, value] pair of numbers"
+                        ))
+                    })?;
+                    *curve.of_mut(&mut config.curves) = curve
+                        .from_points(&points)
+                        .map_err(|source| ModelError::Curve { key, source })?;
+                }
+                None => {
+                    return Err(ModelError::NotAModelKey {
+                        key: printable(key).into_owned(),
+                        what: "automation, takes, [midi] and the render's settings",
+                    })
+                }
+            }
+        }
+        if !config.silent_below.fits(config.capacity_ml) {
+            return Err(ModelError::NotBelow {
+                key: Constant::SilentBelow.quantity().scene_key,
+                value: Constant::SilentBelow.get(&config),
+                limit_key: Constant::Capacity.quantity().scene_key,
+                limit: config.capacity_ml,
+            });
+        }
+        Ok(Self {
+            name: name.to_owned(),
+            text: text.to_owned(),
+            keys,
+            config,
+            controls,
+        })
+    }
+
+    /// Its name: the file's stem, or the name it was saved with.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The file's text, as read.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// Every key it gives (`section.name` inside a table), with its value as written.
+    pub fn keys(&self) -> &[(String, toml::Value)] {
+        &self.keys
+    }
+
+    /// The default constants with the model's (its constants, V0, spread and curves).
+    pub fn config(&self) -> &ModelConfig {
+        &self.config
+    }
+
+    /// The value it gives each control, if it gives one.
+    pub fn controls(&self) -> &PerControl<Option<f64>> {
+        &self.controls
+    }
+}
+
+/// What a model key sets.
+enum ModelKey {
+    Control(Control),
+    Constant(Constant),
+    Curve(Curve),
+}
+
+/// The model key `key` (`section.name` inside a table), if it is one.
+fn model_key(key: &str) -> Option<ModelKey> {
+    let controls = Control::ALL
+        .iter()
+        .find(|control| control.quantity().scene_key == key)
+        .map(|&control| ModelKey::Control(control));
+    let constants = || {
+        Constant::ALL
+            .iter()
+            .find(|constant| constant.quantity().scene_key == key)
+            .map(|&constant| ModelKey::Constant(constant))
+    };
+    let curves = || {
+        Curve::ALL
+            .iter()
+            .find(|curve| curve.scene_key() == key)
+            .map(|&curve| ModelKey::Curve(curve))
+    };
+    controls.or_else(constants).or_else(curves)
+}
+
+/// Every key of `table`, a section's keys as `section.name` (scene files nest no deeper), in the
+/// file's order. A control's table (a CSV lane) is one key, the control's.
+fn flatten(table: &toml::Table) -> Vec<(String, toml::Value)> {
+    let mut keys = Vec::new();
+    for (name, value) in table {
+        let lane = matches!(model_key(name), Some(ModelKey::Control(_)));
+        match value {
+            toml::Value::Table(section) if !lane => {
+                for (inner, value) in section {
+                    keys.push((format!("{name}.{inner}"), value.clone()));
+                }
+            }
+            value => keys.push((name.clone(), value.clone())),
+        }
+    }
+    keys
+}
+
+/// A number as a scene writes it: a float or an integer.
+fn as_number(value: &toml::Value) -> Option<f64> {
+    value
+        .as_float()
+        .or_else(|| value.as_integer().map(|integer| integer as f64))
+}
+
+/// A curve's points as a scene writes them: `[tilt_deg, value]` pairs of numbers, integer or
+/// float; `None` if any point is not.
+pub fn curve_points(points: &[toml::Value]) -> Option<Vec<(f64, f64)>> {
+    let pair = |point: &toml::Value| match point.as_array()?.as_slice() {
+        [tilt_deg, value] => Some((as_number(tilt_deg)?, as_number(value)?)),
+        _ => None,
+    };
+    points.iter().map(pair).collect()
+}
+
+fn check(quantity: &Quantity, value: f64) -> Result<f64, ModelError> {
+    let Range { min, max, .. } = quantity.range;
+    if quantity.range.contains(value) {
+        Ok(value)
+    } else {
+        Err(ModelError::OutOfRange {
+            key: quantity.scene_key,
+            value,
+            min,
+            max,
+        })
+    }
+}
+
+fn syntax(message: &str) -> ModelError {
+    ModelError::Syntax(printable(message).into_owned())
+}
