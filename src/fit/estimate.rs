@@ -14,7 +14,6 @@ use super::weight::WeightLog;
 use crate::engine::config::Range;
 use crate::engine::pour::REFERENCE_TILT_DEG;
 use crate::engine::{Constant, Control, Curve, ModelConfig};
-use crate::offline::DEFAULT_SCENE;
 
 /// An interval between units longer than this many times the median counts a missed unit, one
 /// shorter than [`SHORT_INTERVAL`] of it a spurious one: neither tells the pocket.
@@ -790,16 +789,20 @@ fn round(value: f64) -> f64 {
     format!("{value:.5e}").parse().unwrap_or(value)
 }
 
-/// The model of one liquid: the default pour's tilt (so that it plays as it is) and every key
-/// estimated, each at the scene key its table declares.
+/// The model of one liquid: every key estimated, each at the scene key its table declares, and
+/// the bottle held at the reference tilt (one number, as a model file's controls are: MODEL.md
+/// §12.1), so that `sake-glug render MODEL.toml` pours it as it is and `--model` takes it.
 fn model_toml(
     liquid: &str,
     estimates: &[Estimate],
     curves: &FittedCurves,
     kept_default: &[(String, String)],
 ) -> String {
-    let mut table: toml::Table =
-        toml::from_str(DEFAULT_SCENE).expect("the built-in scene is valid TOML");
+    let mut table = toml::Table::new();
+    table.insert(
+        Control::Tilt.quantity().scene_key.to_owned(),
+        toml::Value::Float(REFERENCE_TILT_DEG),
+    );
     let mut set = |key: &str, value: toml::Value| match key.split_once('.') {
         Some((section, name)) => {
             table

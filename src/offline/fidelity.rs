@@ -48,11 +48,13 @@ pub struct Fidelity {
     pub limits: String,
 }
 
-/// The formats measured for `scene`: every one but the plot (a picture, not a playable file),
+/// The formats measured for `scene`: every one but the plot and the tables (not played),
 /// those this build cannot write, and the DualSense's unless the scene is at its rate.
 fn measured_formats(scene: &Scene) -> impl Iterator<Item = OutputFormat> + '_ {
     OutputFormat::ALL.iter().copied().filter(|&format| {
-        format != OutputFormat::PLOT
+        // The plot and the tables (MODEL.md §14) are read by people and programs, not played:
+        // the tables hold the model's own numbers.
+        ![OutputFormat::PLOT, OutputFormat::UNITS, OutputFormat::STATE].contains(&format)
             && (cfg!(feature = "ogg") || format != OutputFormat::ANDROID_OGG)
             && (scene.sample_rate == DUALSENSE_RATE_HZ || format != OutputFormat::DUALSENSE)
     })

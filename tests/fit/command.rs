@@ -164,6 +164,25 @@ fn a_good_session_writes_the_model_the_report_and_the_plot_and_the_model_renders
             model.display()
         );
     }
+    // It is a model file too: the plugin and `--model` take it, under another scene's tilt.
+    std::fs::write(
+        dir.join("upright.toml"),
+        "duration_s = 1.0\ntilt_deg = 0.0\n",
+    )
+    .unwrap();
+    let output = sake_glug(
+        dir,
+        &[
+            "render",
+            "--model",
+            "model.toml",
+            "upright.toml",
+            "-o",
+            "upright.wav",
+        ],
+    );
+    assert_refused(&output, 0, &[]);
+    sake_glug::model::Model::load(&model).expect("the fitted model is a model file");
 }
 
 #[test]
