@@ -672,22 +672,33 @@ fn resolve(
 
 /// The bytes of the regular file at `path`, refused if larger than `limit` bytes.
 fn read_input_file(path: &Path, limit: u64) -> Result<Vec<u8>, InputFileError> {
-    let check = |metadata: std::fs::Metadata| {
-        if !metadata.is_file() {
-            return Err(InputFileError::NotAFile(kind(metadata.file_type())));
-        }
-        match metadata.len() {
-            size if size > limit => Err(InputFileError::TooLarge { size, limit }),
-            size => Ok(size),
-        }
-    };
-    // Checked before opening: opening a FIFO for reading waits for a writer.
-    check(std::fs::metadata(path)?)?;
-    let file = File::open(path)?;
-    // And again as opened, should the path have been replaced in between.
-    let size = check(file.metadata()?)?;
+    let (file, size) = open_regular_file(path, limit)?;
     // A file may hold more than its size says (/proc) or grow while read.
     read_at_most(file, size, limit)
+}
+
+/// The regular file at `path`, opened, and its size, refused if over `limit` bytes. What is
+/// checked is the opened file, not the path: a path checked and then opened can be replaced in
+/// between. Opening never waits: a FIFO opened for reading without O_NONBLOCK waits for a
+/// writer, and is refused as soon as it is open.
+fn open_regular_file(path: &Path, limit: u64) -> Result<(File, u64), InputFileError> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    let metadata = file.metadata()?;
+    if !metadata.is_file() {
+        return Err(InputFileError::NotAFile(kind(metadata.file_type())));
+    }
+    match metadata.len() {
+        size if size > limit => Err(InputFileError::TooLarge { size, limit }),
+        // O_NONBLOCK changes nothing for a regular file.
+        size => Ok((file, size)),
+    }
 }
 
 /// Everything `reader` holds (`expected_size` bytes, it says), or an error once more than

@@ -148,6 +148,48 @@ fn a_fifo_is_refused_without_waiting_for_a_writer() {
 }
 
 #[test]
+fn a_fifo_swapped_in_after_the_check_does_not_hang_the_read() {
+    // A link that another thread keeps pointing at a take, then at a FIFO: a read that checks
+    // the path and then opens it can find the take, then open the FIFO and wait for a writer.
+    let folder = tempfile::tempdir().unwrap();
+    std::fs::write(folder.path().join("take.mid"), take_mid()).unwrap();
+    make_fifo(&folder.path().join("pipe"));
+    let link = folder.path().join("input.mid");
+    std::os::unix::fs::symlink("take.mid", &link).unwrap();
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let swapper = {
+        let (folder, link, stop) = (folder.path().to_owned(), link.clone(), stop.clone());
+        std::thread::spawn(move || {
+            let staged = folder.join("staged");
+            for target in ["pipe", "take.mid"].iter().cycle() {
+                if stop.load(std::sync::atomic::Ordering::Relaxed) {
+                    break;
+                }
+                std::os::unix::fs::symlink(target, &staged).unwrap();
+                std::fs::rename(&staged, &link).unwrap();
+            }
+        })
+    };
+    let (takes, fifos) = without_hanging(move || {
+        let (mut takes, mut fifos) = (0, 0);
+        while takes < 200 || fifos < 200 {
+            match Scene::default().with_midi_take(&link) {
+                Ok(_) => takes += 1,
+                Err(SceneError::TakeFile {
+                    source: InputFileError::NotAFile(_),
+                    ..
+                }) => fifos += 1,
+                Err(error) => panic!("{error}"),
+            }
+        }
+        (takes, fifos)
+    });
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    swapper.join().unwrap();
+    assert!(takes >= 200 && fifos >= 200);
+}
+
+#[test]
 fn devices_and_folders_are_refused_as_not_regular_files() {
     let folder = tempfile::tempdir().unwrap();
     let error = load(folder.path(), "midi_take = '/dev/zero'\n").unwrap_err();
