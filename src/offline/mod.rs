@@ -17,5 +17,6 @@ pub use outputs::{render_to_files, RenderReport};
 pub use render::{render_scene, render_scene_to_vec, RenderError, RenderObserver, RenderSummary};
 pub use scene::{
     InputFile, InputFileError, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S,
+    MAX_SCENE_BYTES,
 };
 pub use sinks::{Output, OutputError, OutputFormat, OutputOptions, SampleFormat, WavError};

@@ -24,6 +24,11 @@ pub const DEFAULT_SCENE: &str = r#"
 tilt_deg = [[0.0, 90.0], [0.5, 135.0]]
 "#;
 
+/// The largest scene file read (16 MiB): its automation points are written out in TOML, which
+/// the parser holds several times over while it reads them; a longer recording belongs in a
+/// CSV lane, which may be larger.
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+
 /// Longest render a scene may ask for (and the limit on one that never falls silent).
 pub const MAX_DURATION_S: f64 = 86_400.0;
 
@@ -31,13 +36,13 @@ pub const MAX_DURATION_S: f64 = 86_400.0;
 /// characters escaped ([`printable`]).
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    /// The scene file could not be read.
+    /// The scene file could not be read: missing, not a regular file, too large, not UTF-8.
     #[error("cannot read scene file {}: {source}", shown(path))]
     Read {
         /// The file's path.
         path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
+        /// Why not.
+        source: InputFileError,
     },
     /// The file of a CSV lane could not be read.
     #[error("cannot read CSV lane `{key}` file {}: {source}", shown(path))]
@@ -163,7 +168,7 @@ pub enum InputFileError {
         /// The limit (bytes).
         limit: u64,
     },
-    /// A CSV lane that is not UTF-8 text.
+    /// A scene or a CSV lane that is not UTF-8 text.
     #[error("line {line} is not UTF-8 text")]
     NotText {
         /// The line, from 1.
@@ -268,10 +273,12 @@ impl Scene {
     /// Reads and validates the scene file at `path`; the files it names (CSV lanes, a MIDI
     /// take) are found relative to its folder.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
-            path: path.to_owned(),
-            source,
-        })?;
+        let text = read_input_file(path, MAX_SCENE_BYTES)
+            .and_then(utf8_text)
+            .map_err(|source| SceneError::Read {
+                path: path.to_owned(),
+                source,
+            })?;
         let folder = path.parent().unwrap_or(Path::new(""));
         Self::parse_in(&text, folder)
     }
@@ -658,12 +665,9 @@ fn resolve(
         path: path.clone(),
         source,
     };
-    let bytes = read_input_file(&path, MAX_CSV_LANE_BYTES).map_err(file_error)?;
-    let text = String::from_utf8(bytes).map_err(|error| {
-        let bytes = &error.as_bytes()[..error.utf8_error().valid_up_to()];
-        let line = 1 + bytes.iter().filter(|&&byte| byte == b'\n').count() as u64;
-        file_error(InputFileError::NotText { line })
-    })?;
+    let text = read_input_file(&path, MAX_CSV_LANE_BYTES)
+        .and_then(utf8_text)
+        .map_err(file_error)?;
     let points =
         read_csv_lane(&text, &path, &spec).map_err(|source| SceneError::Csv { key, source })?;
     inputs.push(InputFile::new(key, path, folder));
@@ -699,6 +703,15 @@ fn open_regular_file(path: &Path, limit: u64) -> Result<(File, u64), InputFileEr
         // O_NONBLOCK changes nothing for a regular file.
         size => Ok((file, size)),
     }
+}
+
+/// `bytes` as text, or the line (from 1) where they stop being UTF-8.
+fn utf8_text(bytes: Vec<u8>) -> Result<String, InputFileError> {
+    String::from_utf8(bytes).map_err(|error| {
+        let bytes = &error.as_bytes()[..error.utf8_error().valid_up_to()];
+        let line = 1 + bytes.iter().filter(|&&byte| byte == b'\n').count() as u64;
+        InputFileError::NotText { line }
+    })
 }
 
 /// Everything `reader` holds (`expected_size` bytes, it says), or an error once more than
