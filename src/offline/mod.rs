@@ -13,7 +13,7 @@ pub mod sinks;
 
 pub use automation::Automation;
 pub use memory::human_bytes;
-pub use outputs::{render_to_files, RenderReport};
+pub use outputs::{remove_temporary_files, render_to_files, RenderReport};
 pub use render::{render_scene, render_scene_to_vec, RenderError, RenderObserver, RenderSummary};
 pub use scene::{
     InputFile, InputFileError, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S,

@@ -4,7 +4,7 @@
 use std::io::{self, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 use clap::Args;
@@ -13,8 +13,8 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sake_glug::engine::Preset;
 use sake_glug::offline::clips::HapticBand;
 use sake_glug::offline::{
-    human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions, RenderError,
-    RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
+    human_bytes, remove_temporary_files, render_to_files, Output, OutputError, OutputFormat,
+    OutputOptions, RenderError, RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
 };
 use sake_glug::text::printable;
 
@@ -109,7 +109,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
         sample_format: args.sample_format,
         haptic_band: args.haptic_band,
     };
-    let stop = Stop::on_signals();
+    let stop = Stop::on_signals(jobs.iter().flat_map(|job| job.outputs.clone()).collect());
     let mut out = Console::new(jobs.len());
     let mut failed = 0;
     for (index, job) in jobs.iter().enumerate() {
@@ -167,8 +167,8 @@ pub fn run(args: RenderArgs) -> ExitCode {
 
 /// The signals that stop a render: Ctrl-C, `kill`'s default, a closed terminal. The render stops
 /// at its next block and removes its temporary files, and the command ends with 128 + the
-/// signal's number; a second signal ends it at once, as the signal would have (the temporary
-/// files are then removed by the next render to the same targets).
+/// signal's number; a second signal ends it at once, whatever the render is doing (finishing a
+/// clip, syncing), its temporary files removed, with 128 + the second signal's number.
 #[cfg(unix)]
 const STOP_SIGNALS: [i32; 3] = [
     signal_hook::consts::SIGINT,
@@ -184,16 +184,27 @@ struct Stop {
 }
 
 impl Stop {
-    fn on_signals() -> Self {
+    /// Catches [`STOP_SIGNALS`] for a batch that writes `outputs`.
+    fn on_signals(outputs: Vec<Output>) -> Self {
         let signal = Arc::new(AtomicUsize::new(0));
-        let stopping = Arc::new(AtomicBool::new(false));
         for number in STOP_SIGNALS {
-            use signal_hook::flag;
-            // In this order: a signal that finds `stopping` set ends the process, then sets it.
             // Not being able to catch a signal leaves it as it was: it ends the process.
-            let _ = flag::register_conditional_default(number, Arc::clone(&stopping))
-                .and_then(|_| flag::register(number, Arc::clone(&stopping)))
-                .and_then(|_| flag::register_usize(number, Arc::clone(&signal), number as usize));
+            let _ = signal_hook::flag::register_usize(number, Arc::clone(&signal), number as usize);
+        }
+        // The second signal is seen on a thread of its own, which can remove files (a signal
+        // handler cannot) while the render is wherever it is.
+        if let Ok(mut signals) = signal_hook::iterator::Signals::new(STOP_SIGNALS) {
+            std::thread::spawn(move || {
+                let second = signals.forever().nth(1);
+                if let Some(number) = second {
+                    remove_temporary_files(&outputs);
+                    let name = signal_hook::low_level::signal_name(number).unwrap_or("a signal");
+                    eprintln!(
+                        "stopped by {name}, a second stop signal: ended at once, no file written"
+                    );
+                    std::process::exit(128 + number);
+                }
+            });
         }
         Self { signal }
     }

@@ -26,7 +26,7 @@ use super::render::{RenderError, RenderSummary};
 use super::scene::Scene;
 use crate::engine::UnitOnset;
 use clip::ClipSink;
-pub(crate) use pending::{remove_stale_temps, PendingFile};
+pub(crate) use pending::{remove_own_temps, remove_stale_temps, PendingFile};
 #[cfg(feature = "plot")]
 use plot::open as open_plot;
 
