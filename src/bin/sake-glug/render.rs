@@ -13,8 +13,8 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sake_glug::engine::Preset;
 use sake_glug::offline::clips::HapticBand;
 use sake_glug::offline::{
-    human_bytes, remove_temporary_files, render_to_files, Output, OutputError, OutputFormat,
-    OutputOptions, RenderError, RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
+    human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions, RenderError,
+    RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
 };
 use sake_glug::text::printable;
 
@@ -191,21 +191,7 @@ impl Stop {
             // Not being able to catch a signal leaves it as it was: it ends the process.
             let _ = signal_hook::flag::register_usize(number, Arc::clone(&signal), number as usize);
         }
-        // The second signal is seen on a thread of its own, which can remove files (a signal
-        // handler cannot) while the render is wherever it is.
-        if let Ok(mut signals) = signal_hook::iterator::Signals::new(STOP_SIGNALS) {
-            std::thread::spawn(move || {
-                let second = signals.forever().nth(1);
-                if let Some(number) = second {
-                    remove_temporary_files(&outputs);
-                    let name = signal_hook::low_level::signal_name(number).unwrap_or("a signal");
-                    eprintln!(
-                        "stopped by {name}, a second stop signal: ended at once, no file written"
-                    );
-                    std::process::exit(128 + number);
-                }
-            });
-        }
+        end_at_a_second_signal(outputs);
         Self { signal }
     }
 
@@ -216,6 +202,30 @@ impl Stop {
         }
     }
 }
+
+/// Ends the process at a second of [`STOP_SIGNALS`], with the temporary files of `outputs`
+/// removed. A thread of its own sees it: it can remove files (a signal handler cannot), wherever
+/// the render is.
+#[cfg(unix)]
+fn end_at_a_second_signal(outputs: Vec<Output>) {
+    let Ok(mut signals) = signal_hook::iterator::Signals::new(STOP_SIGNALS) else {
+        return;
+    };
+    std::thread::spawn(move || {
+        if let Some(number) = signals.forever().nth(1) {
+            sake_glug::offline::remove_temporary_files(&outputs);
+            let name = signal_hook::low_level::signal_name(number).unwrap_or("a signal");
+            eprintln!(
+                "stopped by {name}, a second stop signal: ended at once, its temporary files removed"
+            );
+            std::process::exit(128 + number);
+        }
+    });
+}
+
+/// Without signal_hook's iterator, a second signal stops the render as the first does.
+#[cfg(not(unix))]
+fn end_at_a_second_signal(_outputs: Vec<Output>) {}
 
 /// The jobs the arguments ask for; every output's format is checked here, before anything is
 /// rendered.
