@@ -10,6 +10,27 @@ use crate::text::printable;
 /// The largest model file read (bytes): a model is a few dozen lines; a larger file is no model.
 pub const MAX_MODEL_BYTES: u64 = 1 << 20;
 
+/// The regular file at `path`, opened without waiting (a FIFO opened for reading waits for a
+/// writer) and checked as opened, so a path replaced after a check cannot slip through.
+fn open_regular_file(path: &Path) -> std::io::Result<std::fs::File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    if file.metadata()?.is_file() {
+        Ok(file)
+    } else {
+        Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file",
+        ))
+    }
+}
+
 /// Why a model was refused. Text from the file is shown with its control characters escaped.
 #[derive(Debug, thiserror::Error)]
 pub enum ModelError {
@@ -98,7 +119,7 @@ impl Model {
             source,
         };
         let mut text = String::new();
-        std::fs::File::open(path)
+        open_regular_file(path)
             .map_err(read)?
             .take(MAX_MODEL_BYTES + 1)
             .read_to_string(&mut text)

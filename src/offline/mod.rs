@@ -17,12 +17,13 @@ mod tables;
 
 pub use automation::Automation;
 pub use memory::human_bytes;
-pub use outputs::{render_to_files, RenderReport};
+pub use outputs::{remove_temporary_files, render_to_files, RenderReport};
 pub use render::{
     render_scene, render_scene_to_vec, BottleReport, RenderError, RenderObserver, RenderSummary,
 };
 pub use scene::{
     InputFile, InputFileError, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S,
+    MAX_SCENE_BYTES,
 };
 pub use sinks::{
     Output, OutputError, OutputFormat, OutputOptions, PlatformOptions, SampleFormat, WavError,

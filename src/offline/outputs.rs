@@ -12,7 +12,8 @@ use super::memory::available_bytes;
 use super::render::{render_scene, BottleReport, RenderError, RenderObserver, RenderSummary};
 use super::scene::Scene;
 use super::sinks::{
-    remove_stale_temps, Output, OutputError, OutputOptions, PendingFile, Sink, SinkContext,
+    remove_own_temps, remove_stale_temps, Output, OutputError, OutputOptions, PendingFile, Sink,
+    SinkContext,
 };
 use crate::engine::{UnitOnset, Voicing};
 
@@ -86,6 +87,15 @@ pub fn render_to_files(
         files,
         leftovers,
     })
+}
+
+/// Removes the temporary files this process's renders to `outputs` have open, for a process
+/// that ends at once instead of returning from [`render_to_files`] (which removes them itself);
+/// a render still running may then fail, so call it only on the way out.
+pub fn remove_temporary_files(outputs: &[Output]) {
+    for output in outputs {
+        remove_own_temps(&output.path);
+    }
 }
 
 /// Refuses a render whose sinks may together keep more memory than the machine has available.

@@ -25,6 +25,11 @@ pub const DEFAULT_SCENE: &str = r#"
 tilt_deg = [[0.0, 90.0], [0.5, 135.0]]
 "#;
 
+/// The largest scene file read (16 MiB): its automation points are written out in TOML, which
+/// the parser holds several times over while it reads them; a longer recording belongs in a
+/// CSV lane, which may be larger.
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+
 /// Longest render a scene may ask for (and the limit on one that never falls silent).
 pub const MAX_DURATION_S: f64 = 86_400.0;
 
@@ -32,13 +37,13 @@ pub const MAX_DURATION_S: f64 = 86_400.0;
 /// characters escaped ([`printable`]).
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    /// The scene file could not be read.
+    /// The scene file could not be read: missing, not a regular file, too large, not UTF-8.
     #[error("cannot read scene file {}: {source}", shown(path))]
     Read {
         /// The file's path.
         path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
+        /// Why not.
+        source: InputFileError,
     },
     /// The file of a CSV lane could not be read.
     #[error("cannot read CSV lane `{key}` file {}: {source}", shown(path))]
@@ -164,7 +169,7 @@ pub enum InputFileError {
         /// The limit (bytes).
         limit: u64,
     },
-    /// A CSV lane that is not UTF-8 text.
+    /// A scene or a CSV lane that is not UTF-8 text.
     #[error("line {line} is not UTF-8 text")]
     NotText {
         /// The line, from 1.
@@ -259,6 +264,16 @@ impl MidiTake {
     }
 }
 
+/// A scene file's text, read as a regular file within [`MAX_SCENE_BYTES`], in UTF-8.
+fn read_scene_text(path: &Path) -> Result<String, SceneError> {
+    read_input_file(path, MAX_SCENE_BYTES)
+        .and_then(utf8_text)
+        .map_err(|source| SceneError::Read {
+            path: path.to_owned(),
+            source,
+        })
+}
+
 impl Default for Scene {
     fn default() -> Self {
         Scene::parse(DEFAULT_SCENE).expect("the built-in scene is valid")
@@ -269,10 +284,7 @@ impl Scene {
     /// Reads and validates the scene file at `path`; the files it names (CSV lanes, a MIDI
     /// take) are found relative to its folder.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
-            path: path.to_owned(),
-            source,
-        })?;
+        let text = read_scene_text(path)?;
         let folder = path.parent().unwrap_or(Path::new(""));
         Self::parse_in(&text, folder)
     }
@@ -291,10 +303,7 @@ impl Scene {
     /// The scene file at `path` played on `model`'s bottle (MODEL.md §12.1): every key the scene
     /// leaves out that the model gives comes from the model; what the scene sets, it keeps.
     pub fn load_with_model(path: &Path, model: &Model) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
-            path: path.to_owned(),
-            source,
-        })?;
+        let text = read_scene_text(path)?;
         let folder = path.parent().unwrap_or(Path::new(""));
         Self::parse_with_model(&text, folder, model)
     }
@@ -700,12 +709,9 @@ fn resolve(
         path: path.clone(),
         source,
     };
-    let bytes = read_input_file(&path, MAX_CSV_LANE_BYTES).map_err(file_error)?;
-    let text = String::from_utf8(bytes).map_err(|error| {
-        let bytes = &error.as_bytes()[..error.utf8_error().valid_up_to()];
-        let line = 1 + bytes.iter().filter(|&&byte| byte == b'\n').count() as u64;
-        file_error(InputFileError::NotText { line })
-    })?;
+    let text = read_input_file(&path, MAX_CSV_LANE_BYTES)
+        .and_then(utf8_text)
+        .map_err(file_error)?;
     let points =
         read_csv_lane(&text, &path, &spec).map_err(|source| SceneError::Csv { key, source })?;
     inputs.push(InputFile::new(key, path, folder));
@@ -714,22 +720,42 @@ fn resolve(
 
 /// The bytes of the regular file at `path`, refused if larger than `limit` bytes.
 fn read_input_file(path: &Path, limit: u64) -> Result<Vec<u8>, InputFileError> {
-    let check = |metadata: std::fs::Metadata| {
-        if !metadata.is_file() {
-            return Err(InputFileError::NotAFile(kind(metadata.file_type())));
-        }
-        match metadata.len() {
-            size if size > limit => Err(InputFileError::TooLarge { size, limit }),
-            size => Ok(size),
-        }
-    };
-    // Checked before opening: opening a FIFO for reading waits for a writer.
-    check(std::fs::metadata(path)?)?;
-    let file = File::open(path)?;
-    // And again as opened, should the path have been replaced in between.
-    let size = check(file.metadata()?)?;
+    let (file, size) = open_regular_file(path, limit)?;
     // A file may hold more than its size says (/proc) or grow while read.
     read_at_most(file, size, limit)
+}
+
+/// The regular file at `path`, opened, and its size, refused if over `limit` bytes. What is
+/// checked is the opened file, not the path: a path checked and then opened can be replaced in
+/// between. Opening never waits: a FIFO opened for reading without O_NONBLOCK waits for a
+/// writer, and is refused as soon as it is open.
+fn open_regular_file(path: &Path, limit: u64) -> Result<(File, u64), InputFileError> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    let metadata = file.metadata()?;
+    if !metadata.is_file() {
+        return Err(InputFileError::NotAFile(kind(metadata.file_type())));
+    }
+    match metadata.len() {
+        size if size > limit => Err(InputFileError::TooLarge { size, limit }),
+        // O_NONBLOCK changes nothing for a regular file.
+        size => Ok((file, size)),
+    }
+}
+
+/// `bytes` as text, or the line (from 1) where they stop being UTF-8.
+fn utf8_text(bytes: Vec<u8>) -> Result<String, InputFileError> {
+    String::from_utf8(bytes).map_err(|error| {
+        let bytes = &error.as_bytes()[..error.utf8_error().valid_up_to()];
+        let line = 1 + bytes.iter().filter(|&&byte| byte == b'\n').count() as u64;
+        InputFileError::NotText { line }
+    })
 }
 
 /// Everything `reader` holds (`expected_size` bytes, it says), or an error once more than

@@ -123,8 +123,11 @@ fn midi_input<S>(event: &NoteEvent<S>, map: &MidiMap) -> Option<MidiInput> {
 impl<const RAW_MIDI: bool> Plugin for SakeGlugPlugin<RAW_MIDI> {
     const NAME: &'static str = "Sake Glug";
     const VENDOR: &'static str = "Sake Glug";
-    const URL: &'static str = "https://example.invalid/sake-glug";
-    const EMAIL: &'static str = "sake-glug@example.invalid";
+    // The project has no public homepage or contact: blank, which a host shows as nothing
+    // (CLAP lets an optional field be blank, VST3's factory fields are fixed arrays left
+    // empty), rather than a placeholder it would show to users.
+    const URL: &'static str = "";
+    const EMAIL: &'static str = "";
     const VERSION: &'static str = env!("CARGO_PKG_VERSION");
 
     // A generator: no audio input; the same signal on every output channel.

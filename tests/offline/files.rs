@@ -80,6 +80,60 @@ fn a_signal_stops_the_render_removes_its_temporary_files_and_sets_the_status() {
 }
 
 #[test]
+fn a_second_signal_ends_the_render_at_once_and_still_removes_its_temporary_files() {
+    // The shell's `kill` builtin sends both before the render can act on the first. Two of the
+    // same signal sent at once may reach it as one; two different ones are always two, in
+    // either order.
+    let number = |name| match name {
+        "INT" => 2,
+        _ => 15,
+    };
+    for (first, second) in [
+        ("INT", "TERM"),
+        ("TERM", "INT"),
+        ("INT", "INT"),
+        ("TERM", "TERM"),
+    ] {
+        let directory = tempfile::tempdir().unwrap();
+        let dir = directory.path();
+        fs::write(dir.join("day.toml"), ENDLESS).unwrap();
+        let mut child = spawn(
+            dir,
+            &["render", "day.toml", "-o", "d.csv", "-o", "d.haptic"],
+        );
+        wait_for_temporaries(dir, 2);
+        let sent = Command::new("sh")
+            .args(["-c", &format!("kill -s {first} $0 && kill -s {second} $0")])
+            .arg(child.id().to_string())
+            .status()
+            .unwrap();
+        assert!(sent.success());
+        let started = Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if started.elapsed() > Duration::from_secs(60) {
+                child.kill().unwrap();
+                panic!("SIG{first} then SIG{second}: the render did not end");
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let output = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        // 128 + the number of the signal it names as the one that stopped it.
+        let ended_by = [first, second]
+            .into_iter()
+            .find(|name| output.status.code() == Some(128 + number(*name)));
+        let Some(ended_by) = ended_by else {
+            panic!("SIG{first} then SIG{second}: {output:?}");
+        };
+        assert!(
+            stderr.contains(&format!("stopped by SIG{ended_by}")),
+            "{stderr}"
+        );
+        assert_eq!(files_in(dir), ["day.toml"], "SIG{first} then SIG{second}");
+    }
+}
+
+#[test]
 fn what_a_killed_render_left_goes_with_the_next_render_to_the_same_target() {
     let directory = tempfile::tempdir().unwrap();
     let dir = directory.path();

@@ -9,7 +9,9 @@ use std::time::Duration;
 
 use sake_glug::device::csv_lane::MAX_CSV_LANE_BYTES;
 use sake_glug::device::midi_take::MAX_TAKE_BYTES;
-use sake_glug::offline::{InputFile, InputFileError, Scene, SceneError};
+use sake_glug::offline::{InputFile, InputFileError, Scene, SceneError, MAX_SCENE_BYTES};
+
+use crate::command::sake_glug_within;
 
 /// A CSV take with a `tilt` and a `visc` column.
 const TAKE_CSV: &str = "time_s,tilt,visc\n0,90,1.0\n0.5,135,1.0\n";
@@ -145,6 +147,48 @@ fn a_fifo_is_refused_without_waiting_for_a_writer() {
     // The command line's take as well.
     let error = without_hanging(move || Scene::default().with_midi_take(&fifo)).unwrap_err();
     assert!(error.to_string().contains("FIFO"), "{error}");
+}
+
+#[test]
+fn a_fifo_swapped_in_after_the_check_does_not_hang_the_read() {
+    // A link that another thread keeps pointing at a take, then at a FIFO: a read that checks
+    // the path and then opens it can find the take, then open the FIFO and wait for a writer.
+    let folder = tempfile::tempdir().unwrap();
+    std::fs::write(folder.path().join("take.mid"), take_mid()).unwrap();
+    make_fifo(&folder.path().join("pipe"));
+    let link = folder.path().join("input.mid");
+    std::os::unix::fs::symlink("take.mid", &link).unwrap();
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let swapper = {
+        let (folder, link, stop) = (folder.path().to_owned(), link.clone(), stop.clone());
+        std::thread::spawn(move || {
+            let staged = folder.join("staged");
+            for target in ["pipe", "take.mid"].iter().cycle() {
+                if stop.load(std::sync::atomic::Ordering::Relaxed) {
+                    break;
+                }
+                std::os::unix::fs::symlink(target, &staged).unwrap();
+                std::fs::rename(&staged, &link).unwrap();
+            }
+        })
+    };
+    let (takes, fifos) = without_hanging(move || {
+        let (mut takes, mut fifos) = (0, 0);
+        while takes < 200 || fifos < 200 {
+            match Scene::default().with_midi_take(&link) {
+                Ok(_) => takes += 1,
+                Err(SceneError::TakeFile {
+                    source: InputFileError::NotAFile(_),
+                    ..
+                }) => fifos += 1,
+                Err(error) => panic!("{error}"),
+            }
+        }
+        (takes, fifos)
+    });
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    swapper.join().unwrap();
+    assert!(takes >= 200 && fifos >= 200);
 }
 
 #[test]
@@ -372,4 +416,106 @@ fn the_summary_names_a_file_read_from_outside_the_scene_folder() {
         "{stdout}"
     );
     assert!(!stdout.contains("inside.csv"), "{stdout}");
+}
+
+/// `Scene::load` of `path`, on its own thread.
+fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
+    let path = path.to_owned();
+    without_hanging(move || Scene::load(&path))
+}
+
+#[test]
+fn a_scene_that_is_a_fifo_or_a_device_is_refused_not_waited_for() {
+    let folder = tempfile::tempdir().unwrap();
+    let fifo = folder.path().join("scene.toml");
+    make_fifo(&fifo);
+    let error = load_scene_file(&fifo).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            SceneError::Read {
+                source: InputFileError::NotAFile(_),
+                ..
+            }
+        ),
+        "{error:?}"
+    );
+    assert_eq!(
+        error.to_string(),
+        format!(
+            "cannot read scene file {}: it is a FIFO (named pipe), not a regular file",
+            fifo.display()
+        )
+    );
+    // /dev/zero is read for ever; a folder means nothing.
+    let error = load_scene_file(Path::new("/dev/zero")).unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "cannot read scene file /dev/zero: it is a device, not a regular file"
+    );
+    let error = load_scene_file(folder.path()).unwrap_err();
+    assert!(
+        error
+            .to_string()
+            .ends_with("it is a folder, not a regular file"),
+        "{error}"
+    );
+
+    // And the command line says so and ends (exit 1, a bad scene), writing nothing.
+    for scene in [fifo.to_str().unwrap(), "/dev/zero"] {
+        let output = sake_glug_within(
+            folder.path(),
+            &["render", scene, "-o", "out.wav"],
+            Duration::from_secs(60),
+        );
+        assert_eq!(output.status.code(), Some(1), "{output:?}");
+        let message = String::from_utf8_lossy(&output.stderr);
+        assert!(message.contains("not a regular file"), "{message}");
+        assert_eq!(crate::command::files_in(folder.path()), ["scene.toml"]);
+    }
+}
+
+#[test]
+fn a_scene_over_the_limit_is_refused_from_its_size() {
+    let folder = tempfile::tempdir().unwrap();
+    let path = folder.path().join("big.toml");
+    // Sparse: the size is set without writing a byte.
+    let file = std::fs::File::create(&path).unwrap();
+    file.set_len(MAX_SCENE_BYTES + 1).unwrap();
+    let error = load_scene_file(&path).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            SceneError::Read {
+                source: InputFileError::TooLarge { .. },
+                ..
+            }
+        ),
+        "{error:?}"
+    );
+    assert!(
+        error
+            .to_string()
+            .ends_with("big.toml: it is 16777217 bytes, over the limit of 16777216 bytes (16 MiB)"),
+        "{error}"
+    );
+    // At the limit it is read (and refused for what it holds: 16 MiB of NUL bytes).
+    file.set_len(MAX_SCENE_BYTES).unwrap();
+    let error = load_scene_file(&path).unwrap_err();
+    assert!(matches!(error, SceneError::Syntax(_)), "{error:?}");
+}
+
+#[test]
+fn a_scene_that_is_not_text_is_refused_at_its_line() {
+    let folder = tempfile::tempdir().unwrap();
+    let path = folder.path().join("scene.toml");
+    std::fs::write(&path, b"viscosity_c = 0.5\n# \xff\n").unwrap();
+    let error = load_scene_file(&path).unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        format!(
+            "cannot read scene file {}: line 2 is not UTF-8 text",
+            path.display()
+        )
+    );
 }

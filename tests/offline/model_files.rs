@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::command::{files_in, sake_glug};
+use crate::command::{files_in, sake_glug, sake_glug_within};
 use sake_glug::model::{Model, ModelError};
 
 const MODEL: &str = "\
@@ -160,14 +160,26 @@ fn a_bad_model_is_refused_on_the_command_line_before_anything_is_rendered() {
     let directory = tempfile::tempdir().unwrap();
     let path = directory.path();
     std::fs::write(path.join("bad.toml"), "tilt_deg = [[0.0, 135.0]]\n").unwrap();
+    // A FIFO would wait for a writer for ever if it were opened as a file is.
+    let fifo = std::process::Command::new("mkfifo")
+        .arg(path.join("fifo.toml"))
+        .status()
+        .unwrap();
+    assert!(fifo.success());
     for (model, expected) in [
         ("bad.toml", "`tilt_deg` does not belong in a model"),
         ("missing.toml", "cannot read model file missing.toml"),
+        ("fifo.toml", "not a regular file"),
     ] {
-        let output = sake_glug(path, &["render", "--model", model, "-o", "out.wav"]);
+        let args = ["render", "--model", model, "-o", "out.wav"];
+        let output = sake_glug_within(path, &args, std::time::Duration::from_secs(60));
         assert_eq!(output.status.code(), Some(2));
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(stderr.contains(expected), "{stderr}");
-        assert_eq!(files_in(path), ["bad.toml"], "nothing is written");
+        assert_eq!(
+            files_in(path),
+            ["bad.toml", "fifo.toml"],
+            "nothing is written"
+        );
     }
 }

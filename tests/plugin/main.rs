@@ -10,6 +10,7 @@ mod host;
 
 mod automation;
 mod clap_state;
+mod descriptors;
 mod layouts;
 
 mod midi;

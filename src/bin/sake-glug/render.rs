@@ -4,7 +4,7 @@
 use std::io::{self, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 use clap::Args;
@@ -159,7 +159,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
             audio_channels: args.audio_channels,
         },
     };
-    let stop = Stop::on_signals();
+    let stop = Stop::on_signals(jobs.iter().flat_map(|job| job.outputs.clone()).collect());
     let mut out = Console::new(jobs.len());
     let mut failed = 0;
     for (index, job) in jobs.iter().enumerate() {
@@ -232,8 +232,8 @@ pub fn run(args: RenderArgs) -> ExitCode {
 
 /// The signals that stop a render: Ctrl-C, `kill`'s default, a closed terminal. The render stops
 /// at its next block and removes its temporary files, and the command ends with 128 + the
-/// signal's number; a second signal ends it at once, as the signal would have (the temporary
-/// files are then removed by the next render to the same targets).
+/// signal's number; a second signal ends it at once, whatever the render is doing (finishing a
+/// clip, syncing), its temporary files removed, with 128 + the second signal's number.
 #[cfg(unix)]
 const STOP_SIGNALS: [i32; 3] = [
     signal_hook::consts::SIGINT,
@@ -249,17 +249,14 @@ struct Stop {
 }
 
 impl Stop {
-    fn on_signals() -> Self {
+    /// Catches [`STOP_SIGNALS`] for a batch that writes `outputs`.
+    fn on_signals(outputs: Vec<Output>) -> Self {
         let signal = Arc::new(AtomicUsize::new(0));
-        let stopping = Arc::new(AtomicBool::new(false));
         for number in STOP_SIGNALS {
-            use signal_hook::flag;
-            // In this order: a signal that finds `stopping` set ends the process, then sets it.
             // Not being able to catch a signal leaves it as it was: it ends the process.
-            let _ = flag::register_conditional_default(number, Arc::clone(&stopping))
-                .and_then(|_| flag::register(number, Arc::clone(&stopping)))
-                .and_then(|_| flag::register_usize(number, Arc::clone(&signal), number as usize));
+            let _ = signal_hook::flag::register_usize(number, Arc::clone(&signal), number as usize);
         }
+        end_at_a_second_signal(outputs);
         Self { signal }
     }
 
@@ -270,6 +267,30 @@ impl Stop {
         }
     }
 }
+
+/// Ends the process at a second of [`STOP_SIGNALS`], with the temporary files of `outputs`
+/// removed. A thread of its own sees it: it can remove files (a signal handler cannot), wherever
+/// the render is.
+#[cfg(unix)]
+fn end_at_a_second_signal(outputs: Vec<Output>) {
+    let Ok(mut signals) = signal_hook::iterator::Signals::new(STOP_SIGNALS) else {
+        return;
+    };
+    std::thread::spawn(move || {
+        if let Some(number) = signals.forever().nth(1) {
+            sake_glug::offline::remove_temporary_files(&outputs);
+            let name = signal_hook::low_level::signal_name(number).unwrap_or("a signal");
+            eprintln!(
+                "stopped by {name}, a second stop signal: ended at once, its temporary files removed"
+            );
+            std::process::exit(128 + number);
+        }
+    });
+}
+
+/// Without signal_hook's iterator, a second signal stops the render as the first does.
+#[cfg(not(unix))]
+fn end_at_a_second_signal(_outputs: Vec<Output>) {}
 
 /// The jobs the arguments ask for; every output's format is checked here, before anything is
 /// rendered.

@@ -38,7 +38,7 @@ use crate::engine::{UnitOnset, Voicing};
 #[cfg(feature = "ogg")]
 use android_ogg::open as open_ogg;
 use clip::ClipSink;
-pub(crate) use pending::{remove_stale_temps, PendingFile};
+pub(crate) use pending::{remove_own_temps, remove_stale_temps, PendingFile};
 #[cfg(feature = "plot")]
 use plot::open as open_plot;
 

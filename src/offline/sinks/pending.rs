@@ -212,6 +212,23 @@ fn sibling_prefix(target: &Path) -> String {
     format!(".{}.sake-glug-", &name[..end])
 }
 
+/// Removes this process's temporary files beside `target`, for a process that is to end at once,
+/// without dropping them (a second stop signal). Not the backup of a target that a commit keeps
+/// (`.old`): a commit cut short may still need it, and the next render to the target removes it.
+pub(crate) fn remove_own_temps(target: &Path) {
+    let Ok(entries) = fs::read_dir(folder_of(target)) else {
+        return;
+    };
+    let prefix = own_prefix(target);
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        if name.starts_with(&prefix) && !name.ends_with(".old") {
+            let _ = fs::remove_file(entry.path());
+        }
+    }
+}
+
 /// Removes the files a render killed outright left beside `target` (their process is gone);
 /// returns those it cannot tell about (where the system does not say which processes run),
 /// for the caller to name.
