@@ -7,17 +7,40 @@ The offline renderer of the ``sake-glug`` command line, for Python::
 
 - :func:`render` renders a scene (a file, TOML text, a dict, or the built-in pour) to a NumPy
   ``float32`` array, bit for bit the samples ``sake-glug render`` writes to an f32 WAV;
+- :func:`render_tables` renders the same samples with the glug data: one row per unit and the
+  bottle's state at a fixed rate, the tables of ``sake-glug render --units/--state``;
 - :func:`presets` lists the presets of the plugin's menu;
 - :class:`SakeGlugError` (a ``ValueError``) carries the command line's message for whatever it
   refuses.
 """
 
-from typing import List, NamedTuple
+from typing import Any, Dict, List, NamedTuple
+
+import numpy as np
 
 from ._sake_glug import SakeGlugError, render
 from ._sake_glug import presets as _presets
+from ._sake_glug import render_tables as _render_tables
 
-__all__ = ["Preset", "SakeGlugError", "presets", "render"]
+__all__ = ["Preset", "SakeGlugError", "Tables", "presets", "render", "render_tables"]
+
+
+class Tables(NamedTuple):
+    """A render's samples and its glug data (MODEL.md §14)."""
+
+    samples: np.ndarray
+    """The samples, as :func:`render` returns them."""
+    units: Dict[str, np.ndarray]
+    """One row per glug unit: a float64 array per column of ``--units`` (onset_s, tilt_deg, …)."""
+    state: Dict[str, np.ndarray]
+    """The bottle at ``state_rate``: a float64 array per column of ``--state`` (time_s, …)."""
+
+
+def render_tables(scene: Any = None, **options: Any) -> Tables:
+    """Renders a scene as :func:`render` does (same arguments, plus ``state_rate`` in Hz, 1000
+    by default) and returns its samples with its units and state tables, the rows
+    ``sake-glug render --units/--state`` writes."""
+    return Tables(*_render_tables(scene, **options))
 
 
 class Preset(NamedTuple):

@@ -1,10 +1,10 @@
 import os
-from typing import Any, List, Mapping, NamedTuple, Optional, Union
+from typing import Any, Dict, List, Mapping, NamedTuple, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Preset", "SakeGlugError", "presets", "render"]
+__all__ = ["Preset", "SakeGlugError", "Tables", "presets", "render", "render_tables"]
 
 _Scene = Union[str, "os.PathLike[str]", Mapping[str, Any], None]
 
@@ -34,3 +34,21 @@ def render(
 
 def presets() -> List[Preset]:
     """Every preset, in the order of the plugin's menu."""
+
+class Tables(NamedTuple):
+    """A render's samples and its glug data (MODEL.md §14)."""
+
+    samples: npt.NDArray[np.float32]
+    units: Dict[str, npt.NDArray[np.float64]]
+    state: Dict[str, npt.NDArray[np.float64]]
+
+def render_tables(
+    scene: _Scene = None,
+    *,
+    sample_rate: Optional[float] = None,
+    preset: Optional[str] = None,
+    state_rate: float = 1000.0,
+) -> Tables:
+    """Renders a scene as render() does and returns its samples with its units and state
+    tables (a float64 array per column, named as the columns of `sake-glug render --units` and
+    `--state`). Raises SakeGlugError for what it refuses."""

@@ -13,7 +13,10 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
 use sake_glug::engine::{Preset, PRESETS};
-use sake_glug::offline::{render_scene, RenderError, RenderObserver, Scene, SceneError};
+use sake_glug::offline::{
+    render_scene, render_tables_until, Column, OutputError, RenderError, RenderObserver, Scene,
+    SceneError, StateRate, StateRow, UnitRow,
+};
 
 create_exception!(
     _sake_glug,
@@ -99,6 +102,8 @@ enum Refused {
     Scene(#[from] SceneError),
     #[error(transparent)]
     Render(#[from] RenderError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
     #[error("{0}")]
     Message(String),
     /// Python raised an exception (KeyboardInterrupt) while the render ran: it stopped there.
@@ -177,6 +182,70 @@ fn render<'py>(
     }
 }
 
+/// Renders a scene as render() does and returns its samples with its glug data:
+/// (samples, units, state), the tables `sake-glug render --units/--state` write, each a dict
+/// of float64 NumPy arrays keyed by the files' column names (units: onset_s, tilt_deg, …,
+/// audible as 1.0/0.0; state: time_s, tilt_deg, …, one row at the first sample at or after
+/// each k/state_rate). MODEL.md §14 says what each column is.
+///
+/// state_rate: rows a second of the state table (Hz, above 0 and at most the sample rate).
+#[pyfunction]
+#[pyo3(signature = (scene=None, *, sample_rate=None, preset=None, state_rate=1000.0))]
+fn render_tables<'py>(
+    py: Python<'py>,
+    scene: Option<&Bound<'py, PyAny>>,
+    sample_rate: Option<f64>,
+    preset: Option<&str>,
+    state_rate: f64,
+) -> PyResult<(
+    Bound<'py, PyArray1<f32>>,
+    Bound<'py, PyDict>,
+    Bound<'py, PyDict>,
+)> {
+    let source = SceneSource::of(scene)?;
+    let state_rate = StateRate::new(state_rate)
+        .map_err(|error| SakeGlugError::new_err(format!("state_rate: {error}")))?;
+    let rendered = py.detach(|| {
+        let scene = source.load(preset, sample_rate)?;
+        let signals = PythonSignals {
+            last_check: Cell::new(Instant::now()),
+            raised: RefCell::new(None),
+        };
+        match render_tables_until(&scene, state_rate, || signals.interrupted()) {
+            Ok(tables) => Ok(tables),
+            Err(OutputError::Render(RenderError::Interrupted)) => Err(signals
+                .raised
+                .into_inner()
+                .map_or(Refused::Render(RenderError::Interrupted), Refused::Signal)),
+            Err(error) => Err(error.into()),
+        }
+    });
+    let tables = match rendered {
+        Ok(tables) => tables,
+        Err(Refused::Signal(error)) => return Err(error),
+        Err(refused) => return Err(SakeGlugError::new_err(refused.to_string())),
+    };
+    Ok((
+        PyArray1::from_vec(py, tables.samples),
+        columns(py, UnitRow::COLUMNS, &tables.units)?,
+        columns(py, StateRow::COLUMNS, &tables.states)?,
+    ))
+}
+
+/// A table as a dict of one NumPy array per column, named as the table's file names them.
+fn columns<'py, R>(
+    py: Python<'py>,
+    columns: &[Column<R>],
+    rows: &[R],
+) -> PyResult<Bound<'py, PyDict>> {
+    let table = PyDict::new(py);
+    for column in columns {
+        let values: Vec<f64> = rows.iter().map(column.value).collect();
+        table.set_item(column.name, PyArray1::from_vec(py, values))?;
+    }
+    Ok(table)
+}
+
 /// Every preset as (id, name, description, scene): the id that render(preset=...) and
 /// `sake-glug render --preset` take, the name the plugin's menu shows, what it is for,
 /// and its scene file (TOML), in menu order.
@@ -198,6 +267,7 @@ fn presets() -> Vec<(&'static str, &'static str, &'static str, String)> {
 #[pymodule]
 fn _sake_glug(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(render, module)?)?;
+    module.add_function(wrap_pyfunction!(render_tables, module)?)?;
     module.add_function(wrap_pyfunction!(presets, module)?)?;
     module.add("SakeGlugError", module.py().get_type::<SakeGlugError>())?;
     Ok(())

@@ -29,5 +29,6 @@ pub use sinks::{
     Output, OutputError, OutputFormat, OutputOptions, PlatformOptions, SampleFormat, WavError,
 };
 pub use tables::{
-    csv_header, render_tables, Column, StateRate, StateRateError, StateRow, Tables, UnitRow,
+    csv_header, render_tables, render_tables_until, Column, StateRate, StateRateError, StateRow,
+    Tables, UnitRow,
 };

@@ -327,13 +327,27 @@ pub struct Tables {
 /// Renders `scene` once into memory: its samples, its units and its state at `state_rate`, the
 /// same rows the `units` and `state` files of the render get.
 pub fn render_tables(scene: &Scene, state_rate: StateRate) -> Result<Tables, OutputError> {
-    struct Collector {
+    render_tables_until(scene, state_rate, || false)
+}
+
+/// [`render_tables`], asking `interrupted` after every block whether to stop (then the render
+/// ends with [`super::RenderError::Interrupted`]): for a front end whose user may stop it.
+pub fn render_tables_until(
+    scene: &Scene,
+    state_rate: StateRate,
+    interrupted: impl Fn() -> bool,
+) -> Result<Tables, OutputError> {
+    struct Collector<I> {
         sample_rate: f64,
         schedule: StateSchedule,
         units: Vec<UnitRow>,
         states: Vec<(u64, StateRow)>,
+        interrupted: I,
     }
-    impl RenderObserver for Collector {
+    impl<I: Fn() -> bool> RenderObserver for Collector<I> {
+        fn interrupted(&self) -> bool {
+            (self.interrupted)()
+        }
         fn unit_started(&mut self, onset: &UnitOnset, voicing: Voicing) {
             self.units
                 .push(UnitRow::of(onset, voicing, self.sample_rate));
@@ -350,6 +364,7 @@ pub fn render_tables(scene: &Scene, state_rate: StateRate) -> Result<Tables, Out
         schedule: StateSchedule::new(scene, state_rate)?,
         units: Vec::new(),
         states: Vec::new(),
+        interrupted,
     };
     let mut samples = Vec::new();
     let summary = render_scene(
