@@ -197,11 +197,7 @@ fn render_tables<'py>(
     sample_rate: Option<f64>,
     preset: Option<&str>,
     state_rate: f64,
-) -> PyResult<(
-    Bound<'py, PyArray1<f32>>,
-    Bound<'py, PyDict>,
-    Bound<'py, PyDict>,
-)> {
+) -> PyResult<TablesTuple<'py>> {
     let source = SceneSource::of(scene)?;
     let state_rate = StateRate::new(state_rate)
         .map_err(|error| SakeGlugError::new_err(format!("state_rate: {error}")))?;
@@ -231,6 +227,13 @@ fn render_tables<'py>(
         columns(py, StateRow::COLUMNS, &tables.states)?,
     ))
 }
+
+/// (samples, units, state), as `__init__.py` makes its `Tables` of them.
+type TablesTuple<'py> = (
+    Bound<'py, PyArray1<f32>>,
+    Bound<'py, PyDict>,
+    Bound<'py, PyDict>,
+);
 
 /// A table as a dict of one NumPy array per column, named as the table's file names them.
 fn columns<'py, R>(

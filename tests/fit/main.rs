@@ -42,7 +42,7 @@ impl RenderObserver for Recorder {
     }
     fn bottle(&mut self, report: &BottleReport) {
         // The render reports after every block; the scale reads only on its own clock.
-        if report.position % self.log_every() == 0 {
+        if report.position.is_multiple_of(self.log_every()) {
             self.volume
                 .push((report.position as f64 / self.sample_rate, report.volume_ml));
         }
