@@ -4,7 +4,17 @@ from typing import Any, Dict, List, Mapping, NamedTuple, Optional, Union
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Preset", "SakeGlugError", "Tables", "presets", "render", "render_tables"]
+__all__ = [
+    "Preset",
+    "SakeGlugError",
+    "Tables",
+    "analyze_constant",
+    "analyze_paired",
+    "fit",
+    "presets",
+    "render",
+    "render_tables",
+]
 
 _Scene = Union[str, "os.PathLike[str]", Mapping[str, Any], None]
 
@@ -52,3 +62,20 @@ def render_tables(
     """Renders a scene as render() does and returns its samples with its units and state
     tables (a float64 array per column, named as the columns of `sake-glug render --units` and
     `--state`). Raises SakeGlugError for what it refuses."""
+
+def fit(session: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
+    """Fits a model to the recordings of a session file (`sake-glug fit`, MODEL.md §13):
+    {"liquids": {name: {"estimates": {key: {"value", "low", "high", "in_model"}}, "units",
+    "kept_default", "model"}}, "warnings": [...]}. Writes nothing."""
+
+def analyze_paired(logs: List[Union[str, "os.PathLike[str]"]]) -> Dict[str, Any]:
+    """The paired-comparison analysis of trial logs, as `sake-glug analyze paired --json`."""
+
+def analyze_constant(
+    logs: List[Union[str, "os.PathLike[str]"]],
+    *,
+    resamples: Optional[int] = None,
+    seed: Optional[int] = None,
+    lapse: Optional[float] = None,
+) -> Dict[str, Any]:
+    """The constant-stimuli analysis of trial logs, as `sake-glug analyze constant --json`."""

@@ -12,7 +12,11 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
+use sake_glug::analysis::{
+    analyze_constant_logs, analyze_paired_logs, constant_json, paired_json, FitOptions,
+};
 use sake_glug::engine::{Preset, PRESETS};
+use sake_glug::fit::{fit_session, Session};
 use sake_glug::offline::{
     render_scene, render_tables_until, Column, OutputError, RenderError, RenderObserver, Scene,
     SceneError, StateRate, StateRow, UnitRow,
@@ -249,6 +253,86 @@ fn columns<'py, R>(
     Ok(table)
 }
 
+/// Fits a model to the recordings of a session file (`sake-glug fit`, MODEL.md §13) and returns
+/// what the fit found: {"liquids": {name: {"estimates": {key: {"value", "low", "high",
+/// "in_model"}}, "units", "kept_default": {key: why}, "model": the model file's TOML}},
+/// "warnings": [...]}. Nothing is written. Raises SakeGlugError with the command line's message.
+#[pyfunction]
+fn fit(py: Python<'_>, session: PathBuf) -> PyResult<Bound<'_, PyAny>> {
+    let fitted = py
+        .detach(|| Session::load(&session).and_then(|session| fit_session(&session)))
+        .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
+    let liquids: serde_json::Map<String, serde_json::Value> = fitted
+        .liquids
+        .iter()
+        .map(|liquid| {
+            let estimates: serde_json::Map<String, serde_json::Value> = liquid
+                .estimates
+                .iter()
+                .map(|estimate| {
+                    let (low, high) = estimate.interval.unzip();
+                    let value = serde_json::json!({
+                        "value": estimate.value,
+                        "low": low,
+                        "high": high,
+                        "in_model": estimate.in_model,
+                    });
+                    (estimate.key.clone(), value)
+                })
+                .collect();
+            let kept: serde_json::Map<String, serde_json::Value> = liquid
+                .kept_default
+                .iter()
+                .map(|(key, why)| (key.clone(), why.clone().into()))
+                .collect();
+            let value = serde_json::json!({
+                "estimates": estimates,
+                "units": liquid.units,
+                "kept_default": kept,
+                "model": liquid.model_toml,
+            });
+            (liquid.liquid.clone(), value)
+        })
+        .collect();
+    let result = serde_json::json!({ "liquids": liquids, "warnings": fitted.warnings });
+    Ok(pythonize::pythonize(py, &result)?)
+}
+
+/// The paired-comparison analysis of trial logs (`sake-glug analyze paired --json`): the
+/// count matrix, proportions, Thurstone Case V "scale" by stimulus, predicted proportions,
+/// Mosteller's "fit" test and the participants' "agreement" test, as a dict.
+#[pyfunction]
+fn analyze_paired(py: Python<'_>, logs: Vec<PathBuf>) -> PyResult<Bound<'_, PyAny>> {
+    let analysis = py
+        .detach(|| analyze_paired_logs(&logs))
+        .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
+    Ok(pythonize::pythonize(py, &paired_json(&analysis))?)
+}
+
+/// The constant-stimuli analysis of trial logs (`sake-glug analyze constant --json`): the
+/// logistic fit pooled and per participant, its 25/50/75 % "points" with 95 % intervals
+/// ("value", "low", "high"), as a dict. resamples, seed and lapse as the command line's options.
+#[pyfunction]
+#[pyo3(signature = (logs, *, resamples=None, seed=None, lapse=None))]
+fn analyze_constant(
+    py: Python<'_>,
+    logs: Vec<PathBuf>,
+    resamples: Option<usize>,
+    seed: Option<u64>,
+    lapse: Option<f64>,
+) -> PyResult<Bound<'_, PyAny>> {
+    let defaults = FitOptions::default();
+    let options = FitOptions {
+        resamples: resamples.unwrap_or(defaults.resamples),
+        seed: seed.unwrap_or(defaults.seed),
+        max_lapse: lapse.unwrap_or(defaults.max_lapse),
+    };
+    let analysis = py
+        .detach(|| analyze_constant_logs(&logs, &options))
+        .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
+    Ok(pythonize::pythonize(py, &constant_json(&analysis))?)
+}
+
 /// Every preset as (id, name, description, scene): the id that render(preset=...) and
 /// `sake-glug render --preset` take, the name the plugin's menu shows, what it is for,
 /// and its scene file (TOML), in menu order.
@@ -271,6 +355,9 @@ fn presets() -> Vec<(&'static str, &'static str, &'static str, String)> {
 fn _sake_glug(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(render, module)?)?;
     module.add_function(wrap_pyfunction!(render_tables, module)?)?;
+    module.add_function(wrap_pyfunction!(fit, module)?)?;
+    module.add_function(wrap_pyfunction!(analyze_paired, module)?)?;
+    module.add_function(wrap_pyfunction!(analyze_constant, module)?)?;
     module.add_function(wrap_pyfunction!(presets, module)?)?;
     module.add("SakeGlugError", module.py().get_type::<SakeGlugError>())?;
     Ok(())

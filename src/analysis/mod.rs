@@ -11,6 +11,7 @@
 
 mod constant;
 mod error;
+mod json;
 mod log;
 mod paired;
 #[cfg(feature = "plot")]
@@ -22,6 +23,7 @@ pub use constant::{
     POINT_PERCENTS,
 };
 pub use error::AnalysisError;
+pub use json::{constant_json, paired_json};
 pub use paired::{
     analyze_paired_logs, scale_paired, ChiSquareTest, PairedAnalysis, PairedTrial, PAIRED_COLUMNS,
 };

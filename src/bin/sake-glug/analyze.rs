@@ -5,12 +5,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Subcommand};
-use serde_json::{json, Map, Value};
 
 use sake_glug::analysis::{
-    analyze_constant_logs, analyze_paired_logs, draw_constant_plot, draw_paired_plot,
-    AnalysisError, ChiSquareTest, ConstantAnalysis, FitOptions, PairedAnalysis, PsychometricFit,
-    POINT_PERCENTS,
+    analyze_constant_logs, analyze_paired_logs, constant_json, draw_constant_plot,
+    draw_paired_plot, paired_json, AnalysisError, ChiSquareTest, ConstantAnalysis, FitOptions,
+    PairedAnalysis, PsychometricFit, POINT_PERCENTS,
 };
 
 #[derive(Args, Debug)]
@@ -105,32 +104,6 @@ pub fn run(args: AnalyzeArgs) -> ExitCode {
     }
 }
 
-fn test_json(test: Option<ChiSquareTest>) -> Value {
-    test.map_or(Value::Null, |test| json!(test))
-}
-
-fn paired_json(analysis: &PairedAnalysis) -> Value {
-    let scale: Map<String, Value> = analysis
-        .stimuli
-        .iter()
-        .zip(&analysis.scale)
-        .map(|(name, value)| (name.clone(), json!(value)))
-        .collect();
-    json!({
-        "design": "paired",
-        "stimuli": analysis.stimuli,
-        "participants": analysis.participants.len(),
-        "trials": analysis.trials,
-        "counts": analysis.counts,
-        "proportions": analysis.proportions,
-        "z": analysis.z,
-        "scale": scale,
-        "predicted": analysis.predicted,
-        "fit": test_json(analysis.fit),
-        "agreement": test_json(analysis.agreement),
-    })
-}
-
 fn test_text(name: &str, test: Option<ChiSquareTest>, absent: &str) -> String {
     match test {
         Some(test) => format!(
@@ -206,44 +179,6 @@ fn paired_text(analysis: &PairedAnalysis) -> String {
         "needs two or more participants",
     );
     text.trim_end().to_owned()
-}
-
-fn fit_json(fit: &PsychometricFit) -> Value {
-    let points: Map<String, Value> = POINT_PERCENTS
-        .iter()
-        .zip(&fit.points)
-        .map(|(percent, point)| (percent.to_string(), json!(point)))
-        .collect();
-    json!({
-        "levels": fit.levels.iter().map(|level| json!({
-            "level": level.level,
-            "trials": level.trials,
-            "chosen": level.chosen,
-            "proportion": level.proportion(),
-        })).collect::<Vec<_>>(),
-        "curve": fit.curve,
-        "points": points,
-        "resamples": fit.resamples,
-        "failed_resamples": fit.failed_resamples,
-    })
-}
-
-fn constant_json(analysis: &ConstantAnalysis) -> Value {
-    let participants: Map<String, Value> = analysis
-        .participants
-        .iter()
-        .map(|(name, fit)| {
-            let value = match fit {
-                Ok(fit) => fit_json(fit),
-                Err(error) => json!({ "error": error.to_string() }),
-            };
-            (name.clone(), value)
-        })
-        .collect();
-    let mut object = fit_json(&analysis.pooled);
-    object["design"] = json!("constant");
-    object["participants"] = Value::Object(participants);
-    object
 }
 
 fn fit_text(fit: &PsychometricFit) -> String {

@@ -1,0 +1,74 @@
+//! The analyses as JSON values (`sake-glug analyze --json`, and the Python package's
+//! `analyze_paired`/`analyze_constant`): one shape, declared here once.
+
+use serde_json::{json, Map, Value};
+
+use super::{ChiSquareTest, ConstantAnalysis, PairedAnalysis, PsychometricFit, POINT_PERCENTS};
+
+fn test_json(test: Option<ChiSquareTest>) -> Value {
+    test.map_or(Value::Null, |test| json!(test))
+}
+
+/// `sake-glug analyze paired --json`: one object with the scale by name, the counts, the
+/// proportions, the predicted proportions and the two χ² tests (statistic, df, p).
+pub fn paired_json(analysis: &PairedAnalysis) -> Value {
+    let scale: Map<String, Value> = analysis
+        .stimuli
+        .iter()
+        .zip(&analysis.scale)
+        .map(|(name, value)| (name.clone(), json!(value)))
+        .collect();
+    json!({
+        "design": "paired",
+        "stimuli": analysis.stimuli,
+        "participants": analysis.participants.len(),
+        "trials": analysis.trials,
+        "counts": analysis.counts,
+        "proportions": analysis.proportions,
+        "z": analysis.z,
+        "scale": scale,
+        "predicted": analysis.predicted,
+        "fit": test_json(analysis.fit),
+        "agreement": test_json(analysis.agreement),
+    })
+}
+
+fn fit_json(fit: &PsychometricFit) -> Value {
+    let points: Map<String, Value> = POINT_PERCENTS
+        .iter()
+        .zip(&fit.points)
+        .map(|(percent, point)| (percent.to_string(), json!(point)))
+        .collect();
+    json!({
+        "levels": fit.levels.iter().map(|level| json!({
+            "level": level.level,
+            "trials": level.trials,
+            "chosen": level.chosen,
+            "proportion": level.proportion(),
+        })).collect::<Vec<_>>(),
+        "curve": fit.curve,
+        "points": points,
+        "resamples": fit.resamples,
+        "failed_resamples": fit.failed_resamples,
+    })
+}
+
+/// `sake-glug analyze constant --json`: the pooled fit (levels, curve, points 25/50/75 with
+/// their 95 % intervals) and each participant's.
+pub fn constant_json(analysis: &ConstantAnalysis) -> Value {
+    let participants: Map<String, Value> = analysis
+        .participants
+        .iter()
+        .map(|(name, fit)| {
+            let value = match fit {
+                Ok(fit) => fit_json(fit),
+                Err(error) => json!({ "error": error.to_string() }),
+            };
+            (name.clone(), value)
+        })
+        .collect();
+    let mut object = fit_json(&analysis.pooled);
+    object["design"] = json!("constant");
+    object["participants"] = Value::Object(participants);
+    object
+}
