@@ -18,8 +18,8 @@ use sake_glug::analysis::{
 use sake_glug::engine::{Preset, PRESETS};
 use sake_glug::fit::{fit_session, Session};
 use sake_glug::offline::{
-    render_scene, render_tables_until, Column, OutputError, RenderError, RenderObserver, Scene,
-    SceneError, StateRate, StateRow, UnitRow,
+    render_scene, render_tables_until, Column, RenderError, RenderObserver, Scene, SceneError,
+    StateRate, StateRow, TablesError, UnitRow,
 };
 
 create_exception!(
@@ -107,7 +107,7 @@ enum Refused {
     #[error(transparent)]
     Render(#[from] RenderError),
     #[error(transparent)]
-    Output(#[from] OutputError),
+    Tables(#[from] TablesError),
     #[error("{0}")]
     Message(String),
     /// Python raised an exception (KeyboardInterrupt) while the render ran: it stopped there.
@@ -213,7 +213,7 @@ fn render_tables<'py>(
         };
         match render_tables_until(&scene, state_rate, || signals.interrupted()) {
             Ok(tables) => Ok(tables),
-            Err(OutputError::Render(RenderError::Interrupted)) => Err(signals
+            Err(TablesError::Render(RenderError::Interrupted)) => Err(signals
                 .raised
                 .into_inner()
                 .map_or(Refused::Render(RenderError::Interrupted), Refused::Signal)),

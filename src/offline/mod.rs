@@ -30,5 +30,5 @@ pub use sinks::{
 };
 pub use tables::{
     csv_header, render_tables, render_tables_until, Column, StateRate, StateRateError, StateRow,
-    Tables, UnitRow,
+    Tables, TablesError, UnitRow,
 };

@@ -6,9 +6,8 @@
 
 use std::fmt::Write as _;
 
-use super::render::{render_scene, BottleReport, RenderObserver, RenderSummary};
+use super::render::{render_scene, BottleReport, RenderError, RenderObserver, RenderSummary};
 use super::scene::Scene;
-use super::sinks::OutputError;
 use crate::engine::{ModelConfig, UnitOnset, Voicing};
 
 /// One column of a table: its name in the header, and how a row gives its value. Every value
@@ -251,6 +250,17 @@ pub enum StateRateError {
     },
 }
 
+/// Why a render's tables could not be made in memory.
+#[derive(Debug, thiserror::Error)]
+pub enum TablesError {
+    /// The state rate does not fit the scene.
+    #[error(transparent)]
+    StateRate(#[from] StateRateError),
+    /// The render itself failed, or was stopped.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+}
+
 /// The samples a state table shows (MODEL.md §14): row k is sample n_k = ⌈k·fs/R⌉, the first
 /// sample at or after k/R; it is read from the report the render makes after that sample.
 pub(crate) struct StateSchedule {
@@ -326,7 +336,7 @@ pub struct Tables {
 
 /// Renders `scene` once into memory: its samples, its units and its state at `state_rate`, the
 /// same rows the `units` and `state` files of the render get.
-pub fn render_tables(scene: &Scene, state_rate: StateRate) -> Result<Tables, OutputError> {
+pub fn render_tables(scene: &Scene, state_rate: StateRate) -> Result<Tables, TablesError> {
     render_tables_until(scene, state_rate, || false)
 }
 
@@ -336,7 +346,7 @@ pub fn render_tables_until(
     scene: &Scene,
     state_rate: StateRate,
     interrupted: impl Fn() -> bool,
-) -> Result<Tables, OutputError> {
+) -> Result<Tables, TablesError> {
     struct Collector<I> {
         sample_rate: f64,
         schedule: StateSchedule,
@@ -371,7 +381,7 @@ pub fn render_tables_until(
         scene,
         |block: &[f32]| {
             samples.extend_from_slice(block);
-            Ok::<(), OutputError>(())
+            Ok::<(), RenderError>(())
         },
         &mut collector,
     )?;
