@@ -291,19 +291,32 @@ fn sorted_audible(glugs: &[Glug]) -> Vec<usize> {
 }
 
 /// Sums the envelope quickly over sorted glugs, skipping the ones that have long decayed, so
-/// that a render of minutes with thousands of glugs stays linear in time.
-struct EnvelopeSum<'a> {
+/// that a render of minutes with thousands of glugs stays linear in time. The clips' felt
+/// envelope and the platform formats' two components ([`super::steps`]) are both read from it.
+pub(crate) struct EnvelopeSum<'a> {
     glugs: &'a [Glug],
     /// Indices of the audible glugs, sorted by onset.
-    sorted: &'a [usize],
+    sorted: Vec<usize>,
     ceiling: f64,
     largest_amplitude: f64,
     slowest_decay_per_s: f64,
 }
 
+/// What rings at one time, summed over the glugs started by then (unclamped).
+pub(crate) struct RingingSums {
+    /// Σ |A1|·e^(−B1·τ) and Σ |A2|·e^(−B2·τ).
+    pub components: [f64; 2],
+    /// Both together, summed glug by glug (the felt envelope before the ceiling).
+    pub total: f64,
+    /// Σ of each component's amplitude × its frequency.
+    pub weighted_hz: f64,
+}
+
 impl<'a> EnvelopeSum<'a> {
-    fn new(source: &ClipSource<'a>, sorted: &'a [usize]) -> Self {
+    /// The envelope of `source`'s audible glugs.
+    pub(crate) fn new(source: &ClipSource<'a>) -> Self {
         let glugs = source.glugs;
+        let sorted = sorted_audible(glugs);
         let largest_amplitude = sorted
             .iter()
             .map(|&i| glugs[i].amplitudes[0].abs() + glugs[i].amplitudes[1].abs())
@@ -321,11 +334,14 @@ impl<'a> EnvelopeSum<'a> {
         }
     }
 
-    /// `envelope_at(t)` clamped to 0..1, and the felt frequency of what rings at `t` (see
-    /// [`Breakpoint::felt_frequency_hz`]), over the audible glugs.
-    fn at(&self, t: f64) -> (f64, Option<f64>) {
+    /// The sums of what rings at `t`, over the audible glugs.
+    pub(crate) fn ringing_at(&self, t: f64) -> RingingSums {
         let started = self.sorted.partition_point(|&i| self.glugs[i].onset_s <= t);
-        let (mut sum, mut weighted_hz) = (0.0, 0.0);
+        let mut sums = RingingSums {
+            components: [0.0; 2],
+            total: 0.0,
+            weighted_hz: 0.0,
+        };
         // Newest first: once even the largest glug would have decayed to nothing, every older
         // one has too (their contributions are below 1e-15 each).
         for &i in self.sorted[..started].iter().rev() {
@@ -336,16 +352,26 @@ impl<'a> EnvelopeSum<'a> {
             }
             for k in 0..2 {
                 let amplitude = glug.amplitudes[k].abs() * (-glug.decay_per_s[k] * tau).exp();
-                sum += amplitude;
-                weighted_hz += amplitude * glug.frequency_hz[k];
+                sums.components[k] += amplitude;
+                sums.total += amplitude;
+                sums.weighted_hz += amplitude * glug.frequency_hz[k];
             }
         }
-        let frequency_hz = (sum > 0.0).then(|| weighted_hz / sum);
-        (sum.min(self.limit()), frequency_hz)
+        sums
+    }
+
+    /// `envelope_at(t)` clamped to 0..1, and the felt frequency of what rings at `t` (see
+    /// [`Breakpoint::felt_frequency_hz`]), over the audible glugs.
+    fn at(&self, t: f64) -> (f64, Option<f64>) {
+        let RingingSums {
+            total, weighted_hz, ..
+        } = self.ringing_at(t);
+        let frequency_hz = (total > 0.0).then(|| weighted_hz / total);
+        (total.min(self.limit()), frequency_hz)
     }
 
     /// The largest value the envelope takes: the ceiling, at most 1 (full scale).
-    fn limit(&self) -> f64 {
+    pub(crate) fn limit(&self) -> f64 {
         self.ceiling.clamp(0.0, 1.0)
     }
 
@@ -375,8 +401,7 @@ impl<'a> EnvelopeSum<'a> {
 pub fn envelope_breakpoints(source: &ClipSource) -> Vec<Breakpoint> {
     let end_s = clip_end_s(source);
     let onsets = clip_onsets(source);
-    let audible = sorted_audible(source.glugs);
-    let envelope = EnvelopeSum::new(source, &audible);
+    let envelope = EnvelopeSum::new(source);
     let mut points: Vec<Breakpoint> = Vec::new();
     let push = |points: &mut Vec<Breakpoint>, time_s: f64, onset_of: Option<usize>| {
         let (amplitude, felt_frequency_hz) = envelope.at(time_s);

@@ -5,7 +5,7 @@
 //! Like the clips ([`super::clips`]), these are computed from the model's own units (each
 //! glug's onset, A1 = c·a, A2 = (1 − c)·a, B1, B2), never from the waveform.
 
-use super::clips::{clip_end_s, clip_onsets, ClipSource, Glug, ENVELOPE_FLOOR};
+use super::clips::{clip_end_s, clip_onsets, ClipSource, EnvelopeSum, ENVELOPE_FLOOR};
 
 /// The length (ms) of Android's waveform entries. Meta's Android renderer steps its envelopes
 /// by 10 ms; for the model's decays (B ≈ 40–45 /s) a step is a fall of about 4 dB, finer than
@@ -25,58 +25,24 @@ const MEAN_POINTS: usize = 8;
 /// Σ |A2|·e^(−B2·τ)]` over the glugs started by then, both scaled down together where their sum
 /// would pass the ceiling, so their sum is the felt envelope ([`super::clips::envelope_at`]).
 pub struct ComponentEnvelopes<'a> {
-    glugs: &'a [Glug],
-    /// Indices of the audible glugs, sorted by onset.
-    sorted: Vec<usize>,
-    limit: f64,
-    largest_amplitude: f64,
-    slowest_decay_per_s: f64,
+    envelope: EnvelopeSum<'a>,
 }
 
 impl<'a> ComponentEnvelopes<'a> {
     /// The envelopes of `source`'s glugs.
     pub fn new(source: &ClipSource<'a>) -> Self {
-        let glugs = source.glugs;
-        let mut sorted: Vec<usize> = (0..glugs.len())
-            .filter(|&i| super::clips::is_audible(&glugs[i]))
-            .collect();
-        sorted.sort_by(|&a, &b| glugs[a].onset_s.total_cmp(&glugs[b].onset_s));
-        let largest_amplitude = sorted
-            .iter()
-            .map(|&i| glugs[i].amplitudes[0].abs() + glugs[i].amplitudes[1].abs())
-            .fold(0.0, f64::max);
-        let slowest_decay_per_s = sorted
-            .iter()
-            .flat_map(|&i| glugs[i].decay_per_s)
-            .fold(f64::INFINITY, f64::min);
         Self {
-            glugs,
-            sorted,
-            limit: source.ceiling.clamp(0.0, 1.0),
-            largest_amplitude,
-            slowest_decay_per_s,
+            envelope: EnvelopeSum::new(source),
         }
     }
 
     /// `[low, high]`: the f1 and the f2 component's envelope at `t` (s).
     pub fn at(&self, t: f64) -> [f64; 2] {
-        let started = self.sorted.partition_point(|&i| self.glugs[i].onset_s <= t);
-        let mut sum = [0.0; 2];
-        // Newest first: once even the largest glug would have decayed to nothing, every older
-        // one has too.
-        for &i in self.sorted[..started].iter().rev() {
-            let glug = &self.glugs[i];
-            let tau = t - glug.onset_s;
-            if self.largest_amplitude * (-self.slowest_decay_per_s * tau).exp() < 1e-15 {
-                break;
-            }
-            for (k, component) in sum.iter_mut().enumerate() {
-                *component += glug.amplitudes[k].abs() * (-glug.decay_per_s[k] * tau).exp();
-            }
-        }
+        let sum = self.envelope.ringing_at(t).components;
         let total = sum[0] + sum[1];
-        if total > self.limit {
-            let scale = self.limit / total;
+        let limit = self.envelope.limit();
+        if total > limit {
+            let scale = limit / total;
             sum.map(|component| component * scale)
         } else {
             sum
