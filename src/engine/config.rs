@@ -29,6 +29,21 @@ impl Range {
         value >= self.min && value <= self.max
     }
 
+    /// `value` if it lies in the range, else the error that names `key` and the range: the
+    /// one check of a scene's and a model file's values.
+    pub fn check(&self, key: &'static str, value: f64) -> Result<f64, ValueError> {
+        if self.contains(value) {
+            Ok(value)
+        } else {
+            Err(ValueError::OutOfRange {
+                key,
+                value,
+                min: self.min,
+                max: self.max,
+            })
+        }
+    }
+
     /// Brings any f64 into range: NaN becomes the default, ±∞ and outliers the nearest bound.
     #[inline]
     pub fn sanitize(&self, value: f64) -> f64 {
@@ -123,6 +138,43 @@ impl Knob {
             ..self
         }
     }
+}
+
+/// A value of a scene or a model file that the model cannot take, named by its key.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ValueError {
+    /// Outside its allowed range.
+    #[error("`{key}` = {value} is out of range: allowed {min} to {max}")]
+    OutOfRange {
+        /// The key.
+        key: &'static str,
+        /// The value given.
+        value: f64,
+        /// Lowest allowed value.
+        min: f64,
+        /// Highest allowed value.
+        max: f64,
+    },
+    /// Not below another value it must lie below (V0 below the capacity).
+    #[error("`{key}` = {value} is out of range: it must lie below `{limit_key}` ({limit})")]
+    NotBelow {
+        /// The key.
+        key: &'static str,
+        /// The value given.
+        value: f64,
+        /// The key of the value it must lie below.
+        limit_key: &'static str,
+        /// That value.
+        limit: f64,
+    },
+    /// A list of points that is no curve of the bottle (MODEL.md §12).
+    #[error("`{key}`: {source}")]
+    Curve {
+        /// The key.
+        key: &'static str,
+        /// What was wrong.
+        source: CurveError,
+    },
 }
 
 /// A number the model takes, as every part of the product names and bounds it.
@@ -531,6 +583,21 @@ impl Default for ModelConfig {
 }
 
 impl ModelConfig {
+    /// The amplitude law's zero below the capacity, as a scene or a model file must give it
+    /// (MODEL.md §12).
+    pub fn check_silent_below(&self) -> Result<(), ValueError> {
+        if self.silent_below.fits(self.capacity_ml) {
+            Ok(())
+        } else {
+            Err(ValueError::NotBelow {
+                key: Constant::SilentBelow.quantity().scene_key,
+                value: Constant::SilentBelow.get(self),
+                limit_key: Constant::Capacity.quantity().scene_key,
+                limit: self.capacity_ml,
+            })
+        }
+    }
+
     /// The same constants with every random spread at zero (MODEL.md §7, "deterministic").
     pub fn deterministic(self) -> Self {
         Self {

@@ -14,7 +14,9 @@ mod presets;
 pub mod synthesis;
 
 pub use amplitude::{SilentBelow, PAPERS_SILENT_BELOW_ML};
-pub use config::{Constant, ConstantSpec, Curve, DrainMode, Knob, ModelConfig, Quantity, Range};
+pub use config::{
+    Constant, ConstantSpec, Curve, DrainMode, Knob, ModelConfig, Quantity, Range, ValueError,
+};
 pub use controls::{
     Control, ControlSource, ControlSpec, ControlValues, Controls, DeviceInput, Lane, PerControl,
 };

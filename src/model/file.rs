@@ -4,7 +4,7 @@
 use std::io::Read;
 use std::path::Path;
 
-use crate::engine::{Constant, Control, Curve, ModelConfig, PerControl, Quantity, Range};
+use crate::engine::{Constant, Control, Curve, ModelConfig, PerControl, Quantity, ValueError};
 use crate::text::printable;
 
 /// The largest model file read (bytes): a model is a few dozen lines; a larger file is no model.
@@ -65,38 +65,9 @@ pub enum ModelError {
         /// What such keys are.
         what: &'static str,
     },
-    /// A value outside its allowed range.
-    #[error("`{key}` = {value} is out of range: allowed {min} to {max}")]
-    OutOfRange {
-        /// The key.
-        key: &'static str,
-        /// The value given.
-        value: f64,
-        /// Lowest allowed value.
-        min: f64,
-        /// Highest allowed value.
-        max: f64,
-    },
-    /// V0 not below the capacity.
-    #[error("`{key}` = {value} is out of range: it must lie below `{limit_key}` ({limit})")]
-    NotBelow {
-        /// The key.
-        key: &'static str,
-        /// The value given.
-        value: f64,
-        /// The key of the value it must lie below.
-        limit_key: &'static str,
-        /// That value.
-        limit: f64,
-    },
-    /// A list of points that is no curve of the bottle (MODEL.md §12).
-    #[error("`{key}`: {source}")]
-    Curve {
-        /// The key.
-        key: &'static str,
-        /// What was wrong.
-        source: crate::engine::pour::CurveError,
-    },
+    /// A value the model cannot take: out of range, V0 not below the capacity, or no curve.
+    #[error(transparent)]
+    Value(#[from] ValueError),
 }
 
 /// A validated model file: its name and text (what the plugin saves), its keys as written (what
@@ -175,7 +146,7 @@ impl Model {
                     })?;
                     *curve.of_mut(&mut config.curves) = curve
                         .from_points(&points)
-                        .map_err(|source| ModelError::Curve { key, source })?;
+                        .map_err(|source| ValueError::Curve { key, source })?;
                 }
                 None => {
                     return Err(ModelError::NotAModelKey {
@@ -185,14 +156,7 @@ impl Model {
                 }
             }
         }
-        if !config.silent_below.fits(config.capacity_ml) {
-            return Err(ModelError::NotBelow {
-                key: Constant::SilentBelow.quantity().scene_key,
-                value: Constant::SilentBelow.get(&config),
-                limit_key: Constant::Capacity.quantity().scene_key,
-                limit: config.capacity_ml,
-            });
-        }
+        config.check_silent_below()?;
         Ok(Self {
             name: name.to_owned(),
             text: text.to_owned(),
@@ -292,17 +256,7 @@ pub fn curve_points(points: &[toml::Value]) -> Option<Vec<(f64, f64)>> {
 }
 
 fn check(quantity: &Quantity, value: f64) -> Result<f64, ModelError> {
-    let Range { min, max, .. } = quantity.range;
-    if quantity.range.contains(value) {
-        Ok(value)
-    } else {
-        Err(ModelError::OutOfRange {
-            key: quantity.scene_key,
-            value,
-            min,
-            max,
-        })
-    }
+    Ok(quantity.range.check(quantity.scene_key, value)?)
 }
 
 fn syntax(message: &str) -> ModelError {

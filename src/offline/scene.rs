@@ -10,8 +10,7 @@ use crate::device::axis::Axis;
 use crate::device::csv_lane::{read_csv_lane, CsvLaneError, CsvLaneSpec, MAX_CSV_LANE_BYTES};
 use crate::device::midi::{MidiMap, MidiSetting};
 use crate::device::midi_take::{read_midi_take, TakeError, TimedInput, MAX_TAKE_BYTES};
-use crate::engine::config::{self, Range};
-use crate::engine::pour::CurveError;
+use crate::engine::config::{self, Range, ValueError};
 use crate::engine::{
     Constant, Control, ControlSource, ControlValues, Controls, Curve, DrainMode, ModelConfig,
     PerControl, Preset, PresetValue, Quantity,
@@ -67,38 +66,9 @@ pub enum SceneError {
     /// control characters escaped.
     #[error("invalid scene: {0}")]
     Syntax(String),
-    /// A value outside its allowed range.
-    #[error("`{key}` = {value} is out of range: allowed {min} to {max}")]
-    OutOfRange {
-        /// The scene key.
-        key: &'static str,
-        /// The value given.
-        value: f64,
-        /// Lowest allowed value.
-        min: f64,
-        /// Highest allowed value.
-        max: f64,
-    },
-    /// A value that must lie below another one (V0 below the capacity).
-    #[error("`{key}` = {value} is out of range: it must lie below `{limit_key}` ({limit})")]
-    NotBelow {
-        /// The scene key.
-        key: &'static str,
-        /// The value given.
-        value: f64,
-        /// The key of the value it must lie below.
-        limit_key: &'static str,
-        /// That value.
-        limit: f64,
-    },
-    /// A list of points that is no curve of the bottle (MODEL.md §12).
-    #[error("`{key}`: {source}")]
-    Curve {
-        /// The scene key.
-        key: &'static str,
-        /// What was wrong.
-        source: CurveError,
-    },
+    /// A value the model cannot take: out of range, V0 not below the capacity, or no curve.
+    #[error(transparent)]
+    Value(#[from] ValueError),
     /// A CSV lane could not be read: the error names the file, line and column.
     #[error("`{key}`: {source}")]
     Csv {
@@ -567,12 +537,13 @@ impl SceneFile {
                 continue;
             };
             if byte > setting.max() && byte != crate::device::midi::OFF {
-                return Err(SceneError::OutOfRange {
+                return Err(ValueError::OutOfRange {
                     key: setting.key(),
                     value: byte as f64,
                     min: 0.0,
                     max: setting.max() as f64,
-                });
+                }
+                .into());
             }
             map.set_raw(setting, byte);
         }
@@ -620,20 +591,13 @@ impl SceneFile {
                 constant.set(&mut config, check(scene_key, value, range)?);
             }
         }
-        if !config.silent_below.fits(config.capacity_ml) {
-            return Err(SceneError::NotBelow {
-                key: Constant::SilentBelow.quantity().scene_key,
-                value: Constant::SilentBelow.get(&config),
-                limit_key: Constant::Capacity.quantity().scene_key,
-                limit: config.capacity_ml,
-            });
-        }
+        config.check_silent_below()?;
         for curve in Curve::ALL {
             let key = curve.scene_key();
             if let Some(points) = self.take::<Vec<toml::Value>>(key)? {
                 *curve.of_mut(&mut config.curves) = curve
                     .from_points(&curve_points_of(key, &points)?)
-                    .map_err(|source| SceneError::Curve { key, source })?;
+                    .map_err(|source| ValueError::Curve { key, source })?;
             }
         }
         config.drain = self.take::<DrainMode>(DRAIN)?.unwrap_or_default();
@@ -814,16 +778,7 @@ fn syntax(message: &str) -> SceneError {
 }
 
 fn check(key: &'static str, value: f64, range: Range) -> Result<f64, SceneError> {
-    if range.contains(value) {
-        Ok(value)
-    } else {
-        Err(SceneError::OutOfRange {
-            key,
-            value,
-            min: range.min,
-            max: range.max,
-        })
-    }
+    Ok(range.check(key, value)?)
 }
 
 /// A sample rate in range and a whole number of Hz.
