@@ -13,8 +13,9 @@ use sake_glug::offline::{
 use crate::clip_rules::{ahap, haptic};
 use crate::command::{files_in, sake_glug};
 
-/// A pour with the viscosity and gain automated, so that every mapping is exercised.
-const SCENE: &str = r#"
+/// A pour with the viscosity and gain automated, so that every mapping is exercised (the
+/// platform formats' tests render it too).
+pub(crate) const SCENE: &str = r#"
 seed = 7
 tilt_deg = [[0.0, 90.0], [0.4, 140.0], [2.5, 140.0], [2.6, 0.0]]
 viscosity_c = [[0.0, 0.1], [2.5, 0.9]]
@@ -23,7 +24,7 @@ gain_db = [[0.0, -3.0], [2.5, -9.0]]
 "#;
 
 /// Every unit the engine starts for `scene`, watched through the renderer's own observer.
-fn engine_units(scene: &Scene) -> Vec<UnitOnset> {
+pub(crate) fn engine_units(scene: &Scene) -> Vec<UnitOnset> {
     struct Units(Vec<UnitOnset>);
     impl RenderObserver for Units {
         fn unit_started(&mut self, onset: &UnitOnset, _voicing: Voicing) {
@@ -35,7 +36,7 @@ fn engine_units(scene: &Scene) -> Vec<UnitOnset> {
     units.0
 }
 
-fn onset_s(unit: &UnitOnset, scene: &Scene) -> f64 {
+pub(crate) fn onset_s(unit: &UnitOnset, scene: &Scene) -> f64 {
     (unit.sample as f64 + unit.fraction) / scene.sample_rate as f64
 }
 

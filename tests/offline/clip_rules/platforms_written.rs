@@ -4,41 +4,20 @@
 
 use std::path::{Path, PathBuf};
 
-use sake_glug::engine::{UnitOnset, Voicing};
 use sake_glug::offline::sinks::DUALSENSE_RATE_HZ;
 use sake_glug::offline::steps::ANDROID_STEP_MS;
-use sake_glug::offline::{
-    render_scene, render_to_files, Output, OutputFormat, OutputOptions, RenderError,
-    RenderObserver, Scene,
-};
+use sake_glug::offline::{render_to_files, Output, OutputFormat, OutputOptions, Scene};
 
 use super::{android_ogg, android_waveform, android_xml, dualsense, haps, rumble};
+use crate::clips_rendered::{engine_units, onset_s, SCENE};
 use crate::command::{files_in, sake_glug};
-
-/// A pour with the viscosity and the gain automated.
-const SCENE: &str = r#"
-seed = 7
-tilt_deg = [[0.0, 90.0], [0.4, 140.0], [2.5, 140.0], [2.6, 0.0]]
-viscosity_c = [[0.0, 0.1], [2.5, 0.9]]
-[output]
-gain_db = [[0.0, -3.0], [2.5, -9.0]]
-"#;
 
 /// The onsets (s) of the audible units the engine starts for `scene`.
 fn audible_onsets(scene: &Scene) -> Vec<f64> {
-    struct Units(Vec<UnitOnset>);
-    impl RenderObserver for Units {
-        fn unit_started(&mut self, onset: &UnitOnset, _voicing: Voicing) {
-            self.0.push(*onset);
-        }
-    }
-    let mut units = Units(Vec::new());
-    render_scene(scene, |_| Ok::<(), RenderError>(()), &mut units).unwrap();
-    units
-        .0
+    engine_units(scene)
         .iter()
         .filter(|unit| unit.amplitude > 0.0)
-        .map(|unit| (unit.sample as f64 + unit.fraction) / scene.sample_rate as f64)
+        .map(|unit| onset_s(unit, scene))
         .collect()
 }
 
