@@ -149,6 +149,28 @@ fn realtime_factors(name: &str, scene: &Scene, samples: usize, out: &mut Vec<f32
 }
 
 /// The shortest of `runs` timings of `f` (s).
+/// Runs `benches/SCRIPT` with `args` under `python` and returns the seconds it says its own
+/// timed part took (its one line of output, `seconds=…`).
+fn run_timed_script(python: &Path, script: &str, args: &[&std::ffi::OsStr]) -> Result<f64, String> {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("benches")
+        .join(script);
+    let output = Command::new(python)
+        .arg(&script)
+        .args(args)
+        .output()
+        .map_err(|e| e.to_string())?;
+    if !output.status.success() {
+        return Err(String::from_utf8_lossy(&output.stderr).into_owned());
+    }
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    stdout
+        .trim()
+        .strip_prefix("seconds=")
+        .and_then(|s| s.parse().ok())
+        .ok_or_else(|| format!("unexpected output from the script: {stdout}"))
+}
+
 fn best_of(runs: usize, f: &mut dyn FnMut()) -> f64 {
     (0..runs)
         .map(|_| {
@@ -191,24 +213,16 @@ fn numpy_synthesis(scene: &Scene, samples: usize) -> Result<(f64, f64), String> 
     let units_path = dir.path().join("units.f64");
     let out_path = dir.path().join("out.f32");
     std::fs::write(&units_path, &table).map_err(|e| e.to_string())?;
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/numpy_glug.py");
-    let output = Command::new(&python)
-        .arg(&script)
-        .arg(&units_path)
-        .arg(samples.to_string())
-        .arg(fs.to_string())
-        .arg(&out_path)
-        .output()
-        .map_err(|e| e.to_string())?;
-    if !output.status.success() {
-        return Err(String::from_utf8_lossy(&output.stderr).into_owned());
-    }
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let seconds: f64 = stdout
-        .trim()
-        .strip_prefix("seconds=")
-        .and_then(|s| s.parse().ok())
-        .ok_or_else(|| format!("unexpected output from the script: {stdout}"))?;
+    let seconds = run_timed_script(
+        &python,
+        "numpy_glug.py",
+        &[
+            units_path.as_os_str(),
+            samples.to_string().as_ref(),
+            fs.to_string().as_ref(),
+            out_path.as_os_str(),
+        ],
+    )?;
     let numpy: Vec<f32> = std::fs::read(&out_path)
         .map_err(|e| e.to_string())?
         .chunks_exact(4)

@@ -5,13 +5,12 @@
 //! from the starts `sake-glug fit` used, and how far the two fits lie apart.
 
 use std::path::Path;
-use std::process::Command;
 
 use criterion::Criterion;
 use sake_glug::fit::{fit_session, fit_units, Session, SessionFit, UnitFit};
 use sake_glug::offline::{render_scene_to_vec, Scene};
 
-use super::{best_of, python_with};
+use super::{best_of, python_with, run_timed_script};
 
 const RECORDING: &str = "sample_rate = 25000\nduration_s = 60.0\ntilt_deg = 135.0\n\
                          [output]\ndrain = \"follow\"\n";
@@ -142,24 +141,16 @@ fn scipy_fits(fit: &SessionFit, units: &[UnitFit]) -> Result<(f64, Vec<[f64; 7]>
     );
     std::fs::write(&units_path, &table).map_err(|e| e.to_string())?;
     std::fs::write(&windows_path, &windows).map_err(|e| e.to_string())?;
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/scipy_fit.py");
-    let output = Command::new(&python)
-        .arg(&script)
-        .arg(&units_path)
-        .arg(&windows_path)
-        .arg(fs.to_string())
-        .arg(&out_path)
-        .output()
-        .map_err(|e| e.to_string())?;
-    if !output.status.success() {
-        return Err(String::from_utf8_lossy(&output.stderr).into_owned());
-    }
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let seconds: f64 = stdout
-        .trim()
-        .strip_prefix("seconds=")
-        .and_then(|s| s.parse().ok())
-        .ok_or_else(|| format!("unexpected output from the script: {stdout}"))?;
+    let seconds = run_timed_script(
+        &python,
+        "scipy_fit.py",
+        &[
+            units_path.as_os_str(),
+            windows_path.as_os_str(),
+            fs.to_string().as_ref(),
+            out_path.as_os_str(),
+        ],
+    )?;
     let fitted: Vec<[f64; 7]> = std::fs::read(&out_path)
         .map_err(|e| e.to_string())?
         .chunks_exact(8 * 7)
