@@ -148,9 +148,8 @@ fn realtime_factors(name: &str, scene: &Scene, samples: usize, out: &mut Vec<f32
     )
 }
 
-/// The shortest of `runs` timings of `f` (s).
-/// Runs `benches/SCRIPT` with `args` under `python` and returns the seconds it says its own
-/// timed part took (its one line of output, `seconds=…`).
+/// Runs the script named `script` in `benches/` with `args` under `python` and returns the
+/// seconds it says its own timed part took (its one line of output, `seconds=…`).
 fn run_timed_script(python: &Path, script: &str, args: &[&std::ffi::OsStr]) -> Result<f64, String> {
     let script = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("benches")
@@ -171,6 +170,7 @@ fn run_timed_script(python: &Path, script: &str, args: &[&std::ffi::OsStr]) -> R
         .ok_or_else(|| format!("unexpected output from the script: {stdout}"))
 }
 
+/// The shortest of `runs` timings of `f` (s).
 fn best_of(runs: usize, f: &mut dyn FnMut()) -> f64 {
     (0..runs)
         .map(|_| {
