@@ -1,8 +1,8 @@
 """The units of a recording fitted one by one with SciPy's curve_fit: what a researcher would write.
 
 Called by benches/render.rs as `python scipy_fit.py UNITS.f64 WINDOWS.f64 SAMPLE_RATE OUT.f64`.
-UNITS.f64 holds one row of 9 little-endian f64 per unit: the first sample of its window, the
-window's length, and the seven numbers `sake-glug fit` started its Levenberg-Marquardt from
+UNITS.f64 holds one row of 10 little-endian f64 per unit: the first sample of its window, the
+number of samples given, every how many samples of the recording they are, and the seven numbers `sake-glug fit` started its Levenberg-Marquardt from
 (onset s, A1, A2, f1, f2, B1, B2). WINDOWS.f64 holds the windows' samples one after the other:
 the recording less the units fitted before (as `sake-glug fit` sees them, MODEL.md §13).
 
@@ -61,12 +61,12 @@ def fit_all(units, windows, sample_rate):
     fitted = np.full((len(units), 7), np.nan)
     offset = 0
     for index, row in enumerate(units):
-        first, length = int(row[0]), int(row[1])
+        first, length, stride = int(row[0]), int(row[1]), int(row[2])
         data = windows[offset : offset + length]
         offset += length
-        t = (first + np.arange(length)) / sample_rate
+        t = (first + stride * np.arange(length)) / sample_rate
         try:
-            params, _ = curve_fit(eq1, t, data, p0=row[2:9], jac=eq1_jacobian, method="lm")
+            params, _ = curve_fit(eq1, t, data, p0=row[3:10], jac=eq1_jacobian, method="lm")
         except (RuntimeError, ValueError):
             continue
         fitted[index] = params
@@ -75,7 +75,7 @@ def fit_all(units, windows, sample_rate):
 
 def main():
     units_path, windows_path, sample_rate, out_path = sys.argv[1:5]
-    units = np.fromfile(units_path, dtype="<f8").reshape(-1, 9)
+    units = np.fromfile(units_path, dtype="<f8").reshape(-1, 10)
     windows = np.fromfile(windows_path, dtype="<f8")
     start = time.perf_counter()
     fitted = fit_all(units, windows, float(sample_rate))

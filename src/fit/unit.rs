@@ -3,16 +3,19 @@
 //! from just before its onset to just before the next unit's. The start: the two poles of a
 //! matrix pencil (nalgebra's SVD and eigenvalues) nearest the recording's spectral peaks, the
 //! onset from a grid and the amplitudes by linear least squares; then all seven numbers refined
-//! together by Levenberg-Marquardt (the `levenberg-marquardt` crate). Units are fitted in order,
+//! together by Levenberg-Marquardt (the `levenberg-marquardt` crate), given the problem compressed
+//! to eight rows. The grid and the refinement read every k-th sample of the window, as many as
+//! eq. 1 needs (MODEL.md §13). Units are fitted in order,
 //! each fitted unit subtracted from the recording before the next is fitted, so that a unit
 //! starting while the last one rings is fitted alone.
 
 use std::f64::consts::TAU;
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, OMatrix, Owned, SVector, U7};
+use nalgebra::{DMatrix, DVector, Owned, SMatrix, SVector, U7, U8};
 
 type Vector7 = SVector<f64, 7>;
+type Matrix7 = SMatrix<f64, 7, 7>;
 use num_complex::Complex;
 
 use super::onsets::detect_onsets;
@@ -34,6 +37,14 @@ const ONSET_GRID_S: (f64, f64, f64) = (-0.004, 0.002, 0.00025);
 const PENCIL_S: f64 = 0.04;
 /// Samples per period of the highest component the pencil keeps (it decimates to this).
 const PENCIL_SAMPLES_PER_PERIOD: f64 = 8.0;
+/// The pencil's Hankel matrix has at most this many columns: a model of order 4 needs few, and
+/// the SVD's cost grows with their square.
+const PENCIL_MAX_COLUMNS: usize = 16;
+/// Samples per period of the highest component the least-squares fit keeps: it fits every k-th
+/// sample of its window, k as large as keeps this many. Eq. 1 has seven numbers; a 25 kHz window
+/// holds 83 samples a period of 300 Hz, and the fit's cost falls with k while its noise grows
+/// only as √k (MODEL.md §13).
+const FIT_SAMPLES_PER_PERIOD: f64 = 16.0;
 /// A pencil pole within this frequency ratio of a spectral peak is taken for that component.
 const POLE_MATCH_RATIO: f64 = 1.3;
 /// The decay assumed where the pencil finds none (1/s): the model's default B2.
@@ -62,8 +73,10 @@ pub struct UnitFit {
     pub decay_per_s: [f64; 2],
     /// The share of its window's energy the fit explains.
     pub r_squared: f64,
-    /// The samples fitted, `[first, end)`.
+    /// The window fitted, `[first, end)`…
     pub window: (usize, usize),
+    /// …of which every `stride`-th sample from `first` on was read (MODEL.md §13).
+    pub stride: usize,
     /// Where Levenberg-Marquardt started, `[onset (s), A1, A2, f1, f2, B1, B2]` (the pencil's
     /// poles, the onset grid and its amplitudes): another solver started here is compared fairly
     /// (benches/render.rs).
@@ -129,8 +142,12 @@ pub fn fit_units(samples: &[f64], sample_rate: u32) -> RecordingUnits {
     let mut residual = samples.to_vec();
     let mut units = Vec::with_capacity(onsets.len());
     let mut rejected = 0;
-    let step =
-        ((fs / (PENCIL_SAMPLES_PER_PERIOD * start_hz[1] * POLE_MATCH_RATIO)) as usize).max(1);
+    // Both keep a margin for a component found above its start.
+    let highest_hz = start_hz[1] * POLE_MATCH_RATIO;
+    let strides = Strides {
+        pencil: ((fs / (PENCIL_SAMPLES_PER_PERIOD * highest_hz)) as usize).max(1),
+        fit: ((fs / (FIT_SAMPLES_PER_PERIOD * highest_hz)) as usize).max(1),
+    };
     for (index, &onset) in onsets.iter().enumerate() {
         let first = onset.saturating_sub((BEFORE_ONSET_S * fs) as usize);
         let next = onsets.get(index + 1).copied().unwrap_or(samples.len());
@@ -142,7 +159,7 @@ pub fn fit_units(samples: &[f64], sample_rate: u32) -> RecordingUnits {
             rejected += 1;
             continue;
         }
-        match fit_unit(&residual, first, end, onset, fs, start_hz, step) {
+        match fit_unit(&residual, first, end, onset, fs, start_hz, strides) {
             Some(unit) => {
                 subtract(&mut residual, &unit, fs);
                 units.push(unit);
@@ -159,6 +176,13 @@ pub fn fit_units(samples: &[f64], sample_rate: u32) -> RecordingUnits {
     }
 }
 
+/// Every how many samples the pencil and the least-squares fit read a window.
+#[derive(Debug, Clone, Copy)]
+struct Strides {
+    pencil: usize,
+    fit: usize,
+}
+
 /// Fits the unit detected at `onset` in `signal[first..end]`; `None` if the fit is implausible.
 fn fit_unit(
     signal: &[f64],
@@ -167,10 +191,10 @@ fn fit_unit(
     onset: usize,
     fs: f64,
     start_hz: [f64; 2],
-    step: usize,
+    strides: Strides,
 ) -> Option<UnitFit> {
     let pencil_end = end.min(onset + (PENCIL_S * fs) as usize);
-    let poles = pencil_poles(&signal[onset..pencil_end], step, fs);
+    let poles = pencil_poles(&signal[onset..pencil_end], strides.pencil, fs);
     let mut frequency_hz = start_hz;
     let mut decay_per_s = [DECAY_GUESS_PER_S; 2];
     for k in 0..2 {
@@ -192,9 +216,18 @@ fn fit_unit(
             decay_per_s[k] = decay;
         }
     }
-    let data = &signal[first..end];
+    let window = Window {
+        data: signal[first..end]
+            .iter()
+            .step_by(strides.fit)
+            .copied()
+            .collect(),
+        first,
+        stride: strides.fit,
+        fs,
+    };
     let detected_s = onset as f64 / fs;
-    let (start_s, amplitude) = onset_grid(data, first, fs, detected_s, frequency_hz, decay_per_s);
+    let (start_s, amplitude) = onset_grid(&window, detected_s, frequency_hz, decay_per_s);
     let start = [
         start_s,
         amplitude[0],
@@ -204,12 +237,10 @@ fn fit_unit(
         decay_per_s[0],
         decay_per_s[1],
     ];
-    let problem = UnitProblem {
-        data,
-        first,
-        fs,
-        reference_s: start_s,
-        params: Vector7::from_column_slice(&[
+    let problem = UnitProblem::new(
+        &window,
+        start_s,
+        Vector7::from_column_slice(&[
             0.0,
             amplitude[0],
             amplitude[1],
@@ -218,7 +249,7 @@ fn fit_unit(
             decay_per_s[0],
             decay_per_s[1],
         ]),
-    };
+    );
     let (problem, _report) = LevenbergMarquardt::new()
         .with_patience(LM_PATIENCE)
         .minimize(problem);
@@ -230,6 +261,7 @@ fn fit_unit(
         decay_per_s: [p[5], p[6]],
         r_squared: 0.0,
         window: (first, end),
+        stride: strides.fit,
         start,
     };
     if unit.frequency_hz[0] > unit.frequency_hz[1] {
@@ -237,7 +269,7 @@ fn fit_unit(
         unit.frequency_hz.swap(0, 1);
         unit.decay_per_s.swap(0, 1);
     }
-    let energy: f64 = data.iter().map(|y| y * y).sum();
+    let energy: f64 = window.data.iter().map(|y| y * y).sum();
     let residual: f64 = problem.residuals()?.norm_squared();
     unit.r_squared = 1.0 - residual / energy.max(1e-300);
     let total = unit.amplitude_sum();
@@ -266,7 +298,7 @@ fn pencil_poles(segment: &[f64], step: usize, fs: f64) -> Vec<(f64, f64)> {
     const ORDER: usize = 4;
     let decimated: Vec<f64> = segment.iter().step_by(step).copied().collect();
     let len = decimated.len();
-    let pencil = len / 3;
+    let pencil = (len / 3).min(PENCIL_MAX_COLUMNS);
     if pencil < ORDER + 1 || len < pencil + ORDER + 2 {
         return Vec::new();
     }
@@ -294,37 +326,18 @@ fn pencil_poles(segment: &[f64], step: usize, fs: f64) -> Vec<(f64, f64)> {
 /// The onset on a grid around `detected_s` whose least-squares amplitudes (both positive if
 /// any onset gives that) leave the least residual; returns it and the amplitudes.
 fn onset_grid(
-    data: &[f64],
-    first: usize,
-    fs: f64,
+    window: &Window,
     detected_s: f64,
     frequency_hz: [f64; 2],
     decay_per_s: [f64; 2],
 ) -> (f64, [f64; 2]) {
     let (from, to, by) = ONSET_GRID_S;
     let mut best: Option<(bool, f64, f64, [f64; 2])> = None;
-    let mut columns = [vec![0.0; data.len()], vec![0.0; data.len()]];
+    let sums = GridSums::new(window, detected_s + from, frequency_hz, decay_per_s);
     let steps = ((to - from) / by).round() as usize;
     for step in 0..=steps {
         let onset_s = detected_s + from + by * step as f64;
-        for (k, column) in columns.iter_mut().enumerate() {
-            oscillate(
-                column,
-                first,
-                fs,
-                onset_s,
-                frequency_hz[k],
-                decay_per_s[k],
-                |z, _| z.im,
-            );
-        }
-        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-        let (g00, g01, g11) = (
-            dot(&columns[0], &columns[0]),
-            dot(&columns[0], &columns[1]),
-            dot(&columns[1], &columns[1]),
-        );
-        let (b0, b1) = (dot(&columns[0], data), dot(&columns[1], data));
+        let [g00, g01, g11, b0, b1] = sums.at(window, onset_s);
         let det = g00 * g11 - g01 * g01;
         if det.is_nan() || det.abs() <= 1e-300 {
             continue;
@@ -348,30 +361,116 @@ fn onset_grid(
     })
 }
 
-/// Writes `value(z, τ)` to `out[n]` for z = e^((−B + i2πf)τ), τ = (first + n)/fs − onset_s, by
-/// one complex rotation per sample; 0 where τ < 0.
-fn oscillate(
-    out: &mut [f64],
-    first: usize,
-    fs: f64,
-    onset_s: f64,
-    frequency_hz: f64,
-    decay_per_s: f64,
-    value: impl Fn(Complex<f64>, f64) -> f64,
-) {
-    let rate = Complex::new(-decay_per_s, TAU * frequency_hz);
-    let step = (rate / fs).exp();
-    let start = ((onset_s * fs).ceil().max(first as f64) as usize).saturating_sub(first);
-    let zeros = start.min(out.len());
-    out[..zeros].iter_mut().for_each(|y| *y = 0.0);
-    if start >= out.len() {
-        return;
+/// What the onset grid needs of every onset t0 in O(1): each component's column is
+/// Im(c_k·E_k(n)) from the onset's first sample on, with E_k(n) = e^(s_k(t_n − T)) from the grid's
+/// earliest onset T and the constant c_k = e^(s_k(T − t0)), s_k = −B_k + i2πf_k. So the Gram matrix
+/// and the columns' products with the data are sums over the suffix n ≥ n(t0) of products of E and
+/// y, here summed once from the window's end (Im(a)·Im(b) = ½Re(a·b̄) − ½Re(a·b)).
+struct GridSums {
+    rate: [Complex<f64>; 2],
+    earliest_s: f64,
+    /// For each n (and one past the end): the sums from n on of y·E0, y·E1, E0·Ē0, E1·Ē1, E0²,
+    /// E1², E0·Ē1, E0·E1.
+    suffix: Vec<[Complex<f64>; 8]>,
+}
+
+impl GridSums {
+    fn new(
+        window: &Window,
+        earliest_s: f64,
+        frequency_hz: [f64; 2],
+        decay_per_s: [f64; 2],
+    ) -> Self {
+        let rate = [0, 1].map(|k| Complex::new(-decay_per_s[k], TAU * frequency_hz[k]));
+        let zero = Complex::new(0.0, 0.0);
+        let mut suffix = vec![[zero; 8]; window.data.len() + 1];
+        let mut columns = [vec![zero; window.data.len()], vec![zero; window.data.len()]];
+        for k in 0..2 {
+            window.rotate(earliest_s, frequency_hz[k], decay_per_s[k], |n, z, _| {
+                columns[k][n] = z
+            });
+        }
+        for n in (0..window.data.len()).rev() {
+            let (e0, e1, y) = (columns[0][n], columns[1][n], window.data[n]);
+            let terms = [
+                e0 * y,
+                e1 * y,
+                e0 * e0.conj(),
+                e1 * e1.conj(),
+                e0 * e0,
+                e1 * e1,
+                e0 * e1.conj(),
+                e0 * e1,
+            ];
+            let mut sums = suffix[n + 1];
+            sums.iter_mut()
+                .zip(terms)
+                .for_each(|(sum, term)| *sum += term);
+            suffix[n] = sums;
+        }
+        Self {
+            rate,
+            earliest_s,
+            suffix,
+        }
     }
-    let tau0 = (first + start) as f64 / fs - onset_s;
-    let mut z = (rate * tau0).exp();
-    for (n, y) in out[start..].iter_mut().enumerate() {
-        *y = value(z, tau0 + n as f64 / fs);
-        z *= step;
+
+    /// `[g00, g01, g11, b0, b1]`: the columns' Gram matrix and their products with the data for
+    /// the onset `onset_s` (not before the earliest).
+    fn at(&self, window: &Window, onset_s: f64) -> [f64; 5] {
+        let [ye0, ye1, e00, e11, e0e0, e1e1, e01, e0e1] = self.suffix[window.first_after(onset_s)];
+        let c = self
+            .rate
+            .map(|rate| (rate * (self.earliest_s - onset_s)).exp());
+        [
+            0.5 * ((c[0] * c[0].conj() * e00).re - (c[0] * c[0] * e0e0).re),
+            0.5 * ((c[0] * c[1].conj() * e01).re - (c[0] * c[1] * e0e1).re),
+            0.5 * ((c[1] * c[1].conj() * e11).re - (c[1] * c[1] * e1e1).re),
+            (c[0] * ye0).im,
+            (c[1] * ye1).im,
+        ]
+    }
+}
+
+/// The samples a unit is fitted to: every `stride`-th sample of the recording from `first` on.
+struct Window {
+    data: Vec<f64>,
+    first: usize,
+    stride: usize,
+    fs: f64,
+}
+
+impl Window {
+    /// The recording's sample index of `data[n]`.
+    fn index(&self, n: usize) -> usize {
+        self.first + n * self.stride
+    }
+
+    /// The first n whose sample lies at or after `onset_s`, at most `data.len()`.
+    fn first_after(&self, onset_s: f64) -> usize {
+        let onset = (onset_s * self.fs).ceil().max(self.first as f64) - self.first as f64;
+        ((onset / self.stride as f64).ceil() as usize).min(self.data.len())
+    }
+
+    /// For each n from the onset on, `each(n, z, τ)` with z = e^((−B + i2πf)τ) and τ the time of
+    /// sample n after `onset_s`: one complex rotation per sample.
+    fn rotate(
+        &self,
+        onset_s: f64,
+        frequency_hz: f64,
+        decay_per_s: f64,
+        mut each: impl FnMut(usize, Complex<f64>, f64),
+    ) {
+        let rate = Complex::new(-decay_per_s, TAU * frequency_hz);
+        let period = self.stride as f64 / self.fs;
+        let step = (rate * period).exp();
+        let start = self.first_after(onset_s);
+        let tau0 = self.index(start) as f64 / self.fs - onset_s;
+        let mut z = (rate * tau0).exp();
+        for n in start..self.data.len() {
+            each(n, z, tau0 + (n - start) as f64 * period);
+            z *= step;
+        }
     }
 }
 
@@ -380,101 +479,276 @@ fn subtract(signal: &mut [f64], unit: &UnitFit, fs: f64) {
     let slowest = unit.decay_per_s[0].min(unit.decay_per_s[1]).max(1.0);
     let first = ((unit.onset_s * fs).ceil().max(0.0) as usize).min(signal.len());
     let end = (first + (-SUBTRACT_UNTIL.ln() / slowest * fs) as usize).min(signal.len());
-    let mut model = vec![0.0; end - first];
+    // The unit's span at full rate, as a window of its own.
+    let span = Window {
+        data: vec![0.0; end - first],
+        first,
+        stride: 1,
+        fs,
+    };
     for k in 0..2 {
         let amplitude = unit.amplitude[k];
-        let mut component = vec![0.0; end - first];
-        oscillate(
-            &mut component,
-            first,
-            fs,
+        span.rotate(
             unit.onset_s,
             unit.frequency_hz[k],
             unit.decay_per_s[k],
-            |z, _| amplitude * z.im,
+            |n, z, _| signal[first + n] -= amplitude * z.im,
         );
-        model.iter_mut().zip(&component).for_each(|(m, c)| *m += c);
     }
-    signal[first..end]
-        .iter_mut()
-        .zip(&model)
-        .for_each(|(y, m)| *y -= m);
 }
 
 /// Eq. 1 in one window, its parameters `[onset shift (ms), A1, A2, f1, f2, B1, B2]`.
+///
+/// Handed to Levenberg-Marquardt compressed: the step it takes depends on the window's residuals
+/// r and Jacobian J only through JᵀJ, Jᵀr and |r|², so the problem it sees is the eight residuals
+/// [u; t] with the Jacobian [R; 0], where RᵀR = JᵀJ (Cholesky), u = R⁻ᵀJᵀr and t² = |r|² − |u|²:
+/// the same sum of squares and the same linear model of it at every step, from one pass over
+/// the window per evaluation instead of a QR factorisation of a window-long J.
 struct UnitProblem<'a> {
-    data: &'a [f64],
-    first: usize,
-    fs: f64,
+    window: &'a Window,
     /// The onset the shift is measured from (s).
     reference_s: f64,
     params: Vector7,
+    /// The compressed problem at `params`: Levenberg-Marquardt asks for the residuals and then
+    /// the Jacobian at the same point.
+    compressed: std::cell::Cell<Option<Compressed>>,
+}
+
+/// The problem at one point: [`UnitProblem`]'s R and [u; t].
+#[derive(Debug, Clone, Copy)]
+struct Compressed {
+    residuals: SVector<f64, 8>,
+    jacobian: SMatrix<f64, 8, 7>,
 }
 
 impl UnitProblem<'_> {
+    fn new(window: &Window, reference_s: f64, params: Vector7) -> UnitProblem<'_> {
+        UnitProblem {
+            window,
+            reference_s,
+            params,
+            compressed: std::cell::Cell::new(None),
+        }
+    }
+
     fn onset_s(&self) -> f64 {
         self.reference_s + self.params[0] / 1000.0
     }
 
-    /// For each component k, `each(k, n, z, τ)` at every sample n from the onset on.
-    fn components(&self, mut each: impl FnMut(usize, usize, Complex<f64>, f64)) {
+    /// For every sample n of the window, `each(r_n, J_n)`: its residual (eq. 1 less the
+    /// recording) and its row of the Jacobian (zero before the onset).
+    fn rows(&self, mut each: impl FnMut(f64, &Vector7)) {
         let onset_s = self.onset_s();
-        let mut column = vec![Complex::new(0.0, 0.0); self.data.len()];
-        let mut taus = vec![f64::NAN; self.data.len()];
-        for k in 0..2 {
-            let (hz, decay) = (self.params[3 + k], self.params[5 + k]);
-            let rate = Complex::new(-decay, TAU * hz);
-            let step = (rate / self.fs).exp();
-            let start = ((onset_s * self.fs).ceil().max(self.first as f64) as usize)
-                .saturating_sub(self.first)
-                .min(self.data.len());
-            let tau0 = (self.first + start) as f64 / self.fs - onset_s;
-            let mut z = (rate * tau0).exp();
-            for n in start..self.data.len() {
-                column[n] = z;
-                taus[n] = tau0 + (n - start) as f64 / self.fs;
-                z *= step;
-            }
-            for n in start..self.data.len() {
-                each(k, n, column[n], taus[n]);
-            }
+        let data = &self.window.data;
+        let start = self.window.first_after(onset_s);
+        let silent = Vector7::zeros();
+        for &y in &data[..start] {
+            each(-y, &silent);
         }
+        if start == data.len() {
+            return;
+        }
+        let period = self.window.stride as f64 / self.window.fs;
+        let tau0 = self.window.index(start) as f64 / self.window.fs - onset_s;
+        let mut z = [Complex::new(0.0, 0.0); 2];
+        let mut step = z;
+        let mut rate = z;
+        for k in 0..2 {
+            rate[k] = Complex::new(-self.params[5 + k], TAU * self.params[3 + k]);
+            step[k] = (rate[k] * period).exp();
+            z[k] = (rate[k] * tau0).exp();
+        }
+        for (n, &y) in data[start..].iter().enumerate() {
+            let tau = tau0 + n as f64 * period;
+            let mut row = Vector7::zeros();
+            let mut model = 0.0;
+            for k in 0..2 {
+                let a = self.params[1 + k];
+                model += a * z[k].im;
+                // d/d onset = −dq/dτ, the onset in ms.
+                row[0] -= a * (rate[k] * z[k]).im / 1000.0;
+                row[1 + k] = z[k].im;
+                row[3 + k] = a * z[k].re * TAU * tau;
+                row[5 + k] = -a * z[k].im * tau;
+                z[k] *= step[k];
+            }
+            each(model - y, &row);
+        }
+    }
+
+    /// The compressed problem at `params` (cached); `None` if anything in it is not finite.
+    fn compressed(&self) -> Option<Compressed> {
+        if let Some(compressed) = self.compressed.get() {
+            return Some(compressed);
+        }
+        let (mut normal, mut gradient, mut squares) = (Matrix7::zeros(), Vector7::zeros(), 0.0);
+        self.rows(|residual, row| {
+            normal.syger(1.0, row, row, 1.0);
+            gradient.axpy(residual, row, 1.0);
+            squares += residual * residual;
+        });
+        let (upper, explained) = match normal.cholesky() {
+            Some(cholesky) => {
+                let lower = cholesky.l();
+                let explained = lower.solve_lower_triangular(&gradient)?;
+                (lower.transpose(), explained)
+            }
+            // JᵀJ singular (a component with no amplitude moves nothing): R and u from a QR of
+            // the whole window, which needs no inverse.
+            None => {
+                let rows = self.window.data.len();
+                let (mut jacobian, mut residuals) = (DMatrix::zeros(rows, 7), DVector::zeros(rows));
+                let mut n = 0;
+                self.rows(|residual, row| {
+                    jacobian.set_row(n, &row.transpose());
+                    residuals[n] = residual;
+                    n += 1;
+                });
+                let qr = jacobian.qr();
+                let explained = qr.q().tr_mul(&residuals);
+                let upper = qr.r();
+                (
+                    Matrix7::from_fn(|i, j| upper.get((i, j)).copied().unwrap_or(0.0)),
+                    Vector7::from_fn(|i, _| explained.get(i).copied().unwrap_or(0.0)),
+                )
+            }
+        };
+        let mut residuals = SVector::<f64, 8>::zeros();
+        residuals.fixed_rows_mut::<7>(0).copy_from(&explained);
+        residuals[7] = (squares - explained.norm_squared()).max(0.0).sqrt();
+        let mut jacobian = SMatrix::<f64, 8, 7>::zeros();
+        jacobian.fixed_rows_mut::<7>(0).copy_from(&upper);
+        let compressed = Compressed {
+            residuals,
+            jacobian,
+        };
+        let finite = residuals
+            .iter()
+            .chain(jacobian.iter())
+            .all(|v| v.is_finite());
+        finite.then(|| {
+            self.compressed.set(Some(compressed));
+            compressed
+        })
     }
 }
 
-impl LeastSquaresProblem<f64, Dyn, U7> for UnitProblem<'_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, U7>;
+impl LeastSquaresProblem<f64, U8, U7> for UnitProblem<'_> {
+    type ResidualStorage = Owned<f64, U8>;
+    type JacobianStorage = Owned<f64, U8, U7>;
     type ParameterStorage = Owned<f64, U7>;
 
     fn set_params(&mut self, params: &Vector7) {
         self.params = *params;
+        self.compressed.set(None);
     }
 
     fn params(&self) -> Vector7 {
         self.params
     }
 
-    fn residuals(&self) -> Option<DVector<f64>> {
-        let mut residuals = DVector::from_iterator(self.data.len(), self.data.iter().map(|y| -y));
-        let amplitude = [self.params[1], self.params[2]];
-        self.components(|k, n, z, _| residuals[n] += amplitude[k] * z.im);
-        residuals.iter().all(|r| r.is_finite()).then_some(residuals)
+    fn residuals(&self) -> Option<SVector<f64, 8>> {
+        self.compressed().map(|c| c.residuals)
     }
 
-    fn jacobian(&self) -> Option<OMatrix<f64, Dyn, U7>> {
-        let mut jacobian = OMatrix::<f64, Dyn, U7>::zeros(self.data.len());
-        let amplitude = [self.params[1], self.params[2]];
-        let omega = [TAU * self.params[3], TAU * self.params[4]];
-        let decay = [self.params[5], self.params[6]];
-        self.components(|k, n, z, tau| {
-            let a = amplitude[k];
-            // d/d onset = −dq/dτ, the onset in ms.
-            jacobian[(n, 0)] -= a * (omega[k] * z.re - decay[k] * z.im) / 1000.0;
-            jacobian[(n, 1 + k)] = z.im;
-            jacobian[(n, 3 + k)] = a * z.re * TAU * tau;
-            jacobian[(n, 5 + k)] = -a * z.im * tau;
+    fn jacobian(&self) -> Option<SMatrix<f64, 8, 7>> {
+        self.compressed().map(|c| c.jacobian)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The window's samples of one component of eq. 1 from `onset_s`, sample by sample.
+    fn column(window: &Window, onset_s: f64, hz: f64, decay: f64) -> Vec<f64> {
+        (0..window.data.len())
+            .map(|n| {
+                let tau = window.index(n) as f64 / window.fs - onset_s;
+                if tau < 0.0 {
+                    0.0
+                } else {
+                    (-decay * tau).exp() * (TAU * hz * tau).sin()
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_onset_grids_sums_equal_the_columns_products_at_every_onset() {
+        let fs = 25_000.0;
+        let data: Vec<f64> = (0..700)
+            .map(|n| ((n * 7919) % 113) as f64 / 56.0 - 1.0)
+            .collect();
+        let window = Window {
+            data,
+            first: 1_000,
+            stride: 3,
+            fs,
+        };
+        let (hz, decay) = ([83.0, 310.0], [31.0, 55.0]);
+        let earliest_s = 1_000.0 / fs + 0.0004;
+        let sums = GridSums::new(&window, earliest_s, hz, decay);
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        for step in 0..40 {
+            // Onsets on and between samples, some past the first of the window.
+            let onset_s = earliest_s + step as f64 * 0.000_137;
+            let columns = [0, 1].map(|k| column(&window, onset_s, hz[k], decay[k]));
+            let direct = [
+                dot(&columns[0], &columns[0]),
+                dot(&columns[0], &columns[1]),
+                dot(&columns[1], &columns[1]),
+                dot(&columns[0], &window.data),
+                dot(&columns[1], &window.data),
+            ];
+            for (summed, direct) in sums.at(&window, onset_s).iter().zip(direct) {
+                assert!(
+                    (summed - direct).abs() <= 1e-9 * direct.abs().max(1.0),
+                    "onset {onset_s}: {summed} against {direct}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_compressed_problem_keeps_the_sum_of_squares_and_the_normal_equations() {
+        let fs = 25_000.0;
+        let data: Vec<f64> = (0..600)
+            .map(|n| ((n * 104_729) % 97) as f64 / 48.0 - 1.0)
+            .collect();
+        let window = Window {
+            data,
+            first: 200,
+            stride: 2,
+            fs,
+        };
+        let params = Vector7::from_column_slice(&[0.3, 0.8, 0.2, 80.0, 300.0, 30.0, 45.0]);
+        let problem = UnitProblem::new(&window, 200.0 / fs + 0.001, params);
+        let (mut rows, mut residuals) = (Vec::new(), Vec::new());
+        problem.rows(|residual, row| {
+            residuals.push(residual);
+            rows.push(*row);
         });
-        jacobian.iter().all(|j| j.is_finite()).then_some(jacobian)
+        let jacobian = DMatrix::from_fn(rows.len(), 7, |i, j| rows[i][j]);
+        let residuals = DVector::from_vec(residuals);
+        let compressed = problem.compressed().expect("finite");
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0);
+        assert!(close(
+            compressed.residuals.norm_squared(),
+            residuals.norm_squared()
+        ));
+        let normal = jacobian.transpose() * &jacobian;
+        let gradient = jacobian.transpose() * &residuals;
+        let compressed_normal = compressed.jacobian.transpose() * compressed.jacobian;
+        let compressed_gradient = compressed.jacobian.transpose() * compressed.residuals;
+        for i in 0..7 {
+            assert!(close(compressed_gradient[i], gradient[i]), "Jᵀr[{i}]");
+            for j in 0..7 {
+                assert!(
+                    close(compressed_normal[(i, j)], normal[(i, j)]),
+                    "JᵀJ[{i},{j}]"
+                );
+            }
+        }
     }
 }
