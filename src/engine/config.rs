@@ -138,6 +138,16 @@ impl Knob {
             ..self
         }
     }
+
+    /// The step the value snaps to: 10^−decimals.
+    pub fn step(&self) -> f64 {
+        10f64.powi(-self.decimals)
+    }
+
+    /// The step as its decimal text (`0.01`, `1`): what `sake-glug parameters` shows.
+    pub fn step_text(&self) -> String {
+        format!("{:.*}", self.decimals.max(0) as usize, self.step())
+    }
 }
 
 /// A value of a scene or a model file that the model cannot take, named by its key.

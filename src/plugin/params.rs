@@ -54,7 +54,7 @@ pub fn float_param(quantity: &Quantity) -> FloatParam {
     };
     FloatParam::new(quantity.name, quantity.range.default as f32, range)
         .with_unit(quantity.unit)
-        .with_step_size(10f64.powi(-knob.decimals) as f32)
+        .with_step_size(knob.step() as f32)
         .with_value_to_string(Arc::new(move |value| format(&knob, value)))
         .with_string_to_value(Arc::new(parse_number))
 }

@@ -1,9 +1,18 @@
--- Bounces Sake Glug's VST3 in Ardour (headless `ardour7-lua`, dummy backend, 48 kHz, 1024-sample
--- cycles): a MIDI track with the plugin, its Tilt automated through the points of GLUG_POINTS
--- (one "sample degrees" pair a line), exported as 32-bit float WAV to GLUG_OUT/bounce.wav.
--- Also writes GLUG_OUT/delivered.txt: the list's points as Ardour kept them ("point SAMPLE
--- VALUE", on a MIDI track rounded to its beat grid) and its value at every cycle boundary
--- ("cycle SAMPLE VALUE"), from which the test rebuilds what the plugin was handed.
+-- Bounces Sake Glug's VST3 in Ardour (headless `ardour7-lua`, dummy backend, 48 kHz): a MIDI
+-- track with the plugin, its Tilt automated through the points of GLUG_POINTS (one "sample
+-- degrees" pair a line), exported as 32-bit float WAV to GLUG_OUT/bounce.wav.
+-- Also writes GLUG_OUT/delivered.txt: the list's points as Ardour kept them ("point SAMPLE VALUE",
+-- on a MIDI track rounded to its beat grid), the engine's cycle ("cycle SAMPLES"), and for every
+-- cycle of the export the parameter queue Ardour 7.3 hands the VST3 ("queue START OFFSET VALUE",
+-- Tilt in degrees before the plugin normalises it). Ardour builds that queue in
+-- PluginInsert::connect_and_run (libs/ardour/plugin_insert.cc in Ardour's sources): a VST3's
+-- cycle is never split (automate_and_run); it is handed the list's value at the cycle's start
+-- (offset 0), then each point strictly inside the cycle (the test's points lie on whole samples)
+-- at its own offset with the list's value there (only the points: none is interpolated between
+-- them), then the value at the cycle's end at offset CYCLE, one past its last sample
+-- (libs/ardour/vst3_plugin.cc queues each as it comes; a later value at the same offset replaces
+-- an earlier one). The values come from the list's own evaluation (eval, as its rt_safe_eval), so
+-- they are Ardour's to the last bit.
 -- Needs the plugin scanned first and the export preset GLUG_PRESET installed (the test does both).
 local points_file = assert(os.getenv("GLUG_POINTS"))
 local length = assert(tonumber(os.getenv("GLUG_LENGTH")))
@@ -33,12 +42,25 @@ plugin:to_automatable()
   :set_automation_state(ARDOUR.AutoState.Play)
 
 local log = io.open(out .. "/delivered.txt", "w")
+local kept = {}
 for event in list:events():iter() do
-  log:write(string.format("point %d %.17g\n", event.when:samples(), event.value))
+  local at = event.when:samples()
+  kept[#kept + 1] = { at = at, when = event.when }
+  log:write(string.format("point %d %.17g\n", at, event.value))
 end
-for cycle = 0, length // 1024 + 1 do
-  local at = cycle * 1024
-  log:write(string.format("cycle %d %.17g\n", at, list:eval(Temporal.timepos_t(at))))
+local cycle = Session:get_block_size()
+log:write(string.format("cycle %d\n", cycle))
+local function queue(start, offset, when)
+  log:write(string.format("queue %d %d %.17g\n", start, offset, list:eval(when)))
+end
+for start = 0, length - 1, cycle do
+  queue(start, 0, Temporal.timepos_t(start))
+  for _, point in ipairs(kept) do
+    if start < point.at and point.at < start + cycle then
+      queue(start, point.at - start, point.when)
+    end
+  end
+  queue(start, cycle, Temporal.timepos_t(start + cycle))
 end
 log:close()
 

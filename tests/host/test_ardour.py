@@ -2,15 +2,20 @@
 Tilt automation bounced from a MIDI track and compared with the offline renderer.
 
 - A stepped Tilt bounces to exactly the samples of `sake-glug render` of the same steps.
-- A ramped Tilt does not: Ardour hands a VST3 its automation once per 1024-sample cycle (the
-  value at the cycle's start, the list's points inside it, and the value at its end, which
-  nice-plug applies at the cycle's last sample), and the plugin plays those values as steps.
-  The test measures what that does against the offline render of the true ramp and of those
-  steps, and checks README.md's figures are these (SAKE_GLUG_WRITE_DOCS=1 rewrites them).
+- A ramped Tilt bounces to exactly the samples of `sake-glug render` of the automation as Ardour
+  delivered it: once per cycle, a parameter queue of the value at the cycle's start, the list's
+  points inside it, and the value at its end (ardour_bounce.lua logs each queue and says where
+  Ardour builds it). nice-plug applies each point as a step at its offset (the end one, an
+  offset past the cycle, at its last sample), the value normalised in f32 and snapped to the
+  knob's step, and the engine plays the decimal the knob shows.
+- Against the offline render of the ramp itself the bounce differs: glugs move. The test
+  measures how much and checks README.md's figures are these (SAKE_GLUG_WRITE_DOCS=1 rewrites
+  them).
 
 Needs Ardour 7 (Debian `ardour`), `cargo xtask bundle sake_glug --release` and the release CLI.
 """
 
+import math
 import os
 import re
 import shutil
@@ -29,9 +34,7 @@ SCANNER = Path("/usr/lib/ardour7/ardour-vst3-scanner")
 ARDOUR = shutil.which("ardour7-lua")
 
 SAMPLE_RATE = 48000
-CYCLE = 1024
 LENGTH = 5 * SAMPLE_RATE
-TILT_MAX = 180.0
 # A float-WAV export preset of our own (Ardour ships none that writes 32-bit float at the
 # session's rate), on Ardour's "BWAV 32float" format.
 PRESET_ID = "5a4e9c1e-6b1f-4c0e-9d52-5ac3e61a0001"
@@ -80,7 +83,8 @@ def ardour_home(tmp_path_factory):
 
 
 def bounce(env, tmp_path, points):
-    """Ardour's export of the plugin under `points`, and what Ardour says it delivered."""
+    """Ardour's export of the plugin under `points`, and what Ardour says it delivered: the
+    list's points as it kept them, its cycle, and each cycle's queue (start, offset, value)."""
     (tmp_path / "points.txt").write_text("".join(f"{at} {value}\n" for at, value in points))
     out = tmp_path / "out"
     out.mkdir()
@@ -110,14 +114,16 @@ def bounce(env, tmp_path, points):
         assert file.samplerate == SAMPLE_RATE
         samples = file.read(file.frames)
     assert np.array_equal(samples[0], samples[-1]), "the channels differ"
-    points, cycles = [], {}
+    points, cycle, queues = [], None, []
     for line in (out / "delivered.txt").read_text().splitlines():
-        kind, at, value = line.split()
+        kind, *fields = line.split()
         if kind == "point":
-            points.append((int(at), float(value)))
+            points.append((int(fields[0]), float(fields[1])))
+        elif kind == "cycle":
+            cycle = int(fields[0])
         else:
-            cycles[int(at)] = float(value)
-    return samples[0], points, cycles
+            queues.append((int(fields[0]), int(fields[1]), float(fields[2])))
+    return samples[0], points, cycle, queues
 
 
 def steps_lane(steps):
@@ -142,22 +148,48 @@ def offline(tmp_path, name, tilt_lane):
         return file.read(file.frames)[0]
 
 
-def as_the_plugin_reads(degrees):
-    """A value as it reaches the plugin: Ardour's float, normalised by the plugin in f32 and read
-    back as f32 (nice-plug's linear range)."""
-    normalised = np.float32(np.float32(degrees) / np.float32(TILT_MAX))
-    return float(np.float32(normalised * np.float32(TILT_MAX)))
+def tilt_knob():
+    """Tilt's range and step as `sake-glug parameters` shows them: (min, max, step text)."""
+    table = subprocess.run([CLI, "parameters"], check=True, capture_output=True, text=True).stdout
+    rows = [[cell.strip() for cell in line.strip("|").split("|")] for line in table.splitlines()]
+    header = rows[0]
+    (tilt,) = [row for row in rows if row[header.index("ID")] == "`tilt`"]
+    number = r"-?[0-9.]+"
+    low, high = re.match(rf"({number})–({number})", tilt[header.index("range")]).groups()
+    step = re.match(number, tilt[header.index("step")]).group(0)
+    return float(low), float(high), step
 
 
-def delivered_steps(points, cycles):
-    """What Ardour hands the plugin each cycle, as steps: the value at the cycle's start, the
-    points inside it, the value at its end on its last sample."""
-    steps = []
-    for start in range(0, LENGTH, CYCLE):
-        steps.append((start, cycles[start]))
-        steps.extend((at, value) for at, value in points if start < at < start + CYCLE)
-        steps.append((start + CYCLE - 1, cycles[start + CYCLE]))
-    return [(at, as_the_plugin_reads(value)) for at, value in steps]
+def round_half_away(x):
+    """Rust's `round`: halves away from zero (Python's `round` takes halves to even)."""
+    whole = math.floor(abs(x))
+    return math.copysign(whole + (abs(x) - whole >= 0.5), x)
+
+
+def as_the_plugin_plays(degrees, knob):
+    """A value of Ardour's queue as the engine plays it. Ardour keeps it as a float and has the
+    plugin normalise it (nice-plug's linear range, in f32); nice-plug turns the normalised value
+    back into degrees in f32 and snaps it to the knob's step (in f32, Rust's rounding); the
+    engine plays the decimal the knob shows (src/plugin/params.rs, `exact`)."""
+    f32 = np.float32
+    low, high, step_text = knob
+    plain = np.clip(f32(degrees), f32(low), f32(high))
+    normalised = f32((plain - f32(low)) / (f32(high) - f32(low)))
+    plain = f32(np.clip(normalised, f32(0), f32(1)) * (f32(high) - f32(low)) + f32(low))
+    step = f32(float(step_text))
+    snapped = np.clip(f32(f32(round_half_away(float(f32(plain / step)))) * step), low, high)
+    scale = 10.0 ** len(step_text.partition(".")[2])
+    return round_half_away(float(snapped) * scale) / scale + 0.0  # -0.0 shows as 0
+
+
+def delivered_steps(cycle, queues, knob):
+    """Ardour's queues as the steps the plugin plays: each value from its offset in its cycle on,
+    an offset past the cycle's end on its last sample (nice-plug's VST3 wrapper clamps an event
+    into the buffer); at one sample the later value is the one played."""
+    return [
+        (start + min(offset, cycle - 1), as_the_plugin_plays(value, knob))
+        for start, offset, value in queues
+    ]
 
 
 def first_sound(samples):
@@ -170,7 +202,7 @@ def difference_db(a, b):
 
 
 def test_a_stepped_tilt_bounces_to_the_offline_render_to_the_sample(ardour_home, tmp_path):
-    bounced, points, _ = bounce(ardour_home, tmp_path, STEP)
+    bounced, points, _, _ = bounce(ardour_home, tmp_path, STEP)
     assert points == [(at, value) for at, value in STEP]
     # A step is two points at one time offline; in Ardour a point 25 samples before, which the
     # plugin is handed as a step at the later point's sample.
@@ -179,31 +211,41 @@ def test_a_stepped_tilt_bounces_to_the_offline_render_to_the_sample(ardour_home,
     assert np.array_equal(bounced, rendered)
 
 
-def ramp_figures(bounced, true_ramp, as_delivered):
+def ramp_figures(bounced, true_ramp, cycle, steps):
     ms = lambda samples: f"{samples * 1000 / SAMPLE_RATE:.1f} ms"  # noqa: E731
     late = first_sound(true_ramp) - first_sound(bounced)
+    changes = sum(after != before for (_, before), (_, after) in zip(steps, steps[1:]))
     return (
         "<!-- generated:vst3-ramps:begin -->\n"
-        f"Measured in Ardour 7 (1024-sample cycles, 48 kHz), Tilt ramped 90°→135° over 0.5 s: "
-        f"against the offline render of the ramp itself, the bounce's first glug comes "
-        f"{abs(late)} samples ({ms(abs(late))}) {'earlier' if late > 0 else 'later'} and the "
-        f"largest difference is {difference_db(bounced, true_ramp):+.1f} dB of the peak; against "
-        f"the offline render of the steps Ardour handed the plugin, "
-        f"{difference_db(bounced, as_delivered):+.1f} dB.\n"
+        f"Measured in Ardour 7 ({cycle}-sample cycles, {SAMPLE_RATE // 1000} kHz), Tilt ramped "
+        f"90°→135° over 0.5 s: the plugin plays it as {changes} steps, and the bounce is, to "
+        f"the sample, the offline render of those steps. Against the offline render "
+        f"of the ramp itself, the bounce's first glug comes {abs(late)} samples "
+        f"({ms(abs(late))}) {'earlier' if late > 0 else 'later'} and the largest difference is "
+        f"{difference_db(bounced, true_ramp):+.1f} dB of the peak.\n"
         "<!-- generated:vst3-ramps:end -->"
     )
 
 
-def test_a_ramped_tilt_arrives_as_steps_per_host_cycle(ardour_home, tmp_path):
-    bounced, points, cycles = bounce(ardour_home, tmp_path, RAMP)
-    as_delivered = offline(tmp_path, "delivered", steps_lane(delivered_steps(points, cycles)))
-    # The ramp itself, sample by sample, as a CLAP host or the offline renderer plays it.
+def test_a_ramped_tilt_bounces_to_the_offline_render_of_what_ardour_delivered(
+    ardour_home, tmp_path
+):
+    bounced, _, cycle, queues = bounce(ardour_home, tmp_path, RAMP)
+    knob = tilt_knob()
+    steps = delivered_steps(cycle, queues, knob)
+    as_delivered = offline(tmp_path, "delivered", steps_lane(steps))
+    assert len(bounced) == len(as_delivered) == LENGTH
+    assert np.array_equal(bounced, as_delivered), (
+        f"the bounce is not the automation Ardour delivered: "
+        f"{np.count_nonzero(bounced != as_delivered)} samples differ, from sample "
+        f"{np.flatnonzero(bounced != as_delivered)[0]}, by up to "
+        f"{difference_db(bounced, as_delivered):+.1f} dB"
+    )
+    # The ramp itself, sample by sample, as a CLAP host or the offline renderer plays it: the
+    # steps move the glugs.
     true_ramp = offline(tmp_path, "ramp", "[[0.0, 0.0], [0.5, 0.0], [0.5, 90.0], [1.0, 135.0]]")
-    # The steps explain the bounce far better than the ramp does: the bounce is the steps, up
-    # to what Ardour does inside a cycle (below a tenth of a sample of glug timing).
-    assert difference_db(bounced, as_delivered) < -40
-    assert difference_db(bounced, true_ramp) > difference_db(bounced, as_delivered) + 20
-    figures = ramp_figures(bounced, true_ramp, as_delivered)
+    assert first_sound(bounced) != first_sound(true_ramp)
+    figures = ramp_figures(bounced, true_ramp, cycle, steps)
     readme = REPO / "README.md"
     text = readme.read_text()
     block = re.compile(

@@ -1,7 +1,7 @@
 //! `sake-glug parameters`: every control and model constant as the engine's tables declare it
-//! (plugin parameter id, scene key, name, range, default), as the Markdown table the README
-//! shows; a constant the plugin has no parameter for shows as set by scenes only. `cargo xtask
-//! docs` writes it there; a test checks the README holds it.
+//! (plugin parameter id, scene key, name, range, the step a parameter snaps to, default), as the
+//! Markdown table the README shows; a constant the plugin has no parameter for shows as set by
+//! scenes only. `cargo xtask docs` writes it there; a test checks the README holds it.
 
 use std::process::ExitCode;
 
@@ -23,8 +23,8 @@ pub fn run(_args: ParametersArgs) -> ExitCode {
 /// settings (its Model group), in the plugin's order.
 fn table() -> String {
     let mut rows = vec![
-        "| ID | scene key | name | range | default | notes |".to_owned(),
-        "|---|---|---|---|---|---|".to_owned(),
+        "| ID | scene key | name | range | step | default | notes |".to_owned(),
+        "|---|---|---|---|---|---|---|".to_owned(),
     ];
     let quantities = Control::ALL
         .iter()
@@ -34,9 +34,10 @@ fn table() -> String {
     rows.push(row(
         &SEED,
         &format!("{}–{}", SEED.range.min, SEED.range.max),
+        &SEED.knob.step_text(),
         &format!("{}", SEED.range.default),
     ));
-    rows.push(row(&DRAIN, "Simulate / Follow", "Simulate"));
+    rows.push(row(&DRAIN, "Simulate / Follow", "—", "Simulate"));
     rows.push(number_row(&CEILING_DB));
     rows.join("\n") + "\n"
 }
@@ -57,9 +58,16 @@ fn number_row(quantity: &Quantity) -> String {
         }
         range
     };
+    // Scenes take any value in range; only a parameter snaps.
+    let step = if quantity.param_id.is_empty() {
+        "—".to_owned()
+    } else {
+        format!("{}{unit}", quantity.knob.step_text())
+    };
     row(
         quantity,
         &range,
+        &step,
         &format!("{}{unit}", shown(engine.default)),
     )
 }
@@ -70,13 +78,13 @@ fn shown(value: f64) -> String {
     text.trim_end_matches('0').trim_end_matches('.').to_owned()
 }
 
-fn row(quantity: &Quantity, range: &str, default: &str) -> String {
+fn row(quantity: &Quantity, range: &str, step: &str, default: &str) -> String {
     let code_or_dash = |text: &str| match text {
         "" => "—".to_owned(),
         text => format!("`{text}`"),
     };
     format!(
-        "| {} | {} | {} | {range} | {default} | {} |",
+        "| {} | {} | {} | {range} | {step} | {default} | {} |",
         code_or_dash(quantity.param_id),
         code_or_dash(quantity.scene_key),
         quantity.name,
