@@ -11,6 +11,8 @@ mod dry_run;
 #[cfg(feature = "audio")]
 mod jack_out;
 mod log;
+#[cfg(feature = "audio")]
+mod mix;
 mod session;
 mod spec;
 mod stimuli;
