@@ -3,7 +3,7 @@
 //! start of the session to its end.
 //!
 //! The stimuli are rendered before the client is activated and handed to its process callback
-//! whole; the session then starts a trial through one atomic word, and the callback reports the
+//! whole, in the [`Mix`] that fills each cycle; the session then starts a trial through one atomic word, and the callback reports the
 //! frame the trial started at and that it ended through two more. The callback neither
 //! allocates nor locks.
 
@@ -11,14 +11,12 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use jack::{AudioOut, Client, ClientOptions, Control, Port, PortFlags};
-use rand::{RngExt, SeedableRng};
-use rand_xoshiro::Xoshiro256PlusPlus;
-
+use super::mix::{Mix, Timeline};
 use super::session::{Presented, Presenter};
 use super::spec::Channels;
 use super::trials::Trial;
 use super::StudyError;
+use jack::{AudioOut, Client, ClientOptions, Control, Port, PortFlags};
 
 /// A JACK client, not yet playing: its sample rate decides the stimuli's.
 pub struct JackOutput {
@@ -41,8 +39,7 @@ pub struct JackPlayer {
     client: jack::AsyncClient<(), jack::contrib::ClosureProcessHandler<(), Callback>>,
     shared: Arc<Shared>,
     generation: u64,
-    lengths: Vec<u64>,
-    gap: u64,
+    timeline: Timeline,
     sample_rate: u32,
 }
 
@@ -86,25 +83,15 @@ impl JackOutput {
                     .map_err(|error| audio_error("cannot register a port", error))?,
             );
         }
-        let roles: Vec<(bool, bool)> = (1..=channels.count())
-            .map(|channel| {
-                (
-                    channels.actuator.contains(&channel),
-                    channels.headphones.contains(&channel),
-                )
-            })
-            .collect();
         let names: Vec<String> = ports
             .iter()
             .map(|port| port.name().unwrap_or_default())
             .collect();
         let shared = Arc::new(Shared::default());
-        let lengths: Vec<u64> = stimuli.iter().map(|s| s.len() as u64).collect();
-        // Uniform on ±a has an RMS of a/√3.
-        let noise_peak = noise_dbfs.map_or(0.0, |db| 10f64.powf(db / 20.0) * 3f64.sqrt()) as f32;
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(0);
-        // The trial playing: its generation, first and second stimulus, and its onset frame.
-        let mut playing: Option<(u64, usize, usize, jack::Frames)> = None;
+        let mut mix = Mix::new(stimuli, gap_samples, channels, noise_dbfs);
+        let timeline = mix.timeline().clone();
+        // The trial playing: its generation and its onset frame.
+        let mut playing: Option<(u64, jack::Frames)> = None;
         let mut served = 0u64;
         let callback_shared = Arc::clone(&shared);
         let callback: Callback = Box::new(move |_client, scope| {
@@ -114,51 +101,22 @@ impl JackOutput {
             let generation = request >> 32;
             if playing.is_none() && generation > served {
                 served = generation;
-                let first = ((request >> 16) & 0xffff) as usize;
-                let second = (request & 0xffff) as usize;
-                playing = Some((generation, first, second, now));
+                mix.begin(
+                    ((request >> 16) & 0xffff) as usize,
+                    (request & 0xffff) as usize,
+                );
+                playing = Some((generation, now));
                 callback_shared
                     .onset_frame
                     .store(now as u64, Ordering::Release);
             }
             // The position follows JACK's frame clock, so a cycle the server skips (an xrun)
             // loses its samples but moves nothing later: the logged frames stay true.
-            let start = playing.map(|(_, _, _, onset)| now.wrapping_sub(onset) as u64);
-            for (port, &(actuator, headphone)) in ports.iter_mut().zip(&roles) {
-                let out = port.as_mut_slice(scope);
-                out.fill(0.0);
-                if actuator {
-                    if let (Some((_, first, second, _)), Some(start)) = (playing, start) {
-                        let first = &stimuli[first];
-                        let second = &stimuli[second];
-                        let second_at = first.len() as u64 + gap_samples;
-                        for (offset, sample) in out.iter_mut().enumerate() {
-                            let position = start + offset as u64;
-                            *sample = if position < first.len() as u64 {
-                                first[position as usize]
-                            } else if position >= second_at {
-                                second
-                                    .get((position - second_at) as usize)
-                                    .copied()
-                                    .unwrap_or(0.0)
-                            } else {
-                                0.0
-                            };
-                        }
-                    }
-                }
-                if headphone && noise_peak > 0.0 {
-                    for sample in out.iter_mut() {
-                        *sample = noise_peak * (2.0 * rng.random::<f32>() - 1.0);
-                    }
-                }
-            }
-            if let (Some((generation, first, second, _)), Some(start)) = (playing, start) {
-                let total =
-                    stimuli[first].len() as u64 + gap_samples + stimuli[second].len() as u64;
-                if start + frames as u64 >= total {
+            let into_trial = playing.map_or(0, |(_, onset)| now.wrapping_sub(onset) as u64);
+            let outputs = ports.iter_mut().map(|port| port.as_mut_slice(scope));
+            if mix.fill(into_trial, frames, outputs) {
+                if let Some((generation, _)) = playing.take() {
                     callback_shared.ended.store(generation, Ordering::Release);
-                    playing = None;
                 }
             }
             Control::Continue
@@ -179,8 +137,7 @@ impl JackOutput {
             client: active,
             shared,
             generation: 0,
-            lengths,
-            gap: gap_samples,
+            timeline,
             sample_rate,
         })
     }
@@ -191,7 +148,7 @@ impl Presenter for JackPlayer {
         self.generation += 1;
         let request = (self.generation << 32) | ((trial.first as u64) << 16) | trial.second as u64;
         self.shared.request.store(request, Ordering::Release);
-        let length = self.lengths[trial.first] + self.gap + self.lengths[trial.second];
+        let (second_onset, length) = self.timeline.of(trial.first, trial.second);
         // Far longer than the trial: a server that stopped running our callback.
         let give_up = Instant::now()
             + Duration::from_secs_f64(2.0 * length as f64 / self.sample_rate as f64 + 5.0);
@@ -205,16 +162,15 @@ impl Presenter for JackPlayer {
         }
         let client = self.client.as_client();
         let first = self.shared.onset_frame.load(Ordering::Acquire);
-        let second = first + self.lengths[trial.first] + self.gap;
         // Frame times are 32-bit and wrap (after a day at 48 kHz), as JACK's own do.
-        let end = (second + self.lengths[trial.second]) as jack::Frames;
+        let end = (first + length) as jack::Frames;
         // The end on JACK's clock (µs), and how long ago that was: the response time counts
         // from the last sample played, not from when this thread noticed.
         let end_us = client.frames_to_time(end);
         let now_us = client.time();
         let since = Duration::from_micros(now_us.saturating_sub(end_us));
         Ok(Presented {
-            onset_frames: Some((first, second)),
+            onset_frames: Some((first, first + second_onset)),
             ended: Instant::now()
                 .checked_sub(since)
                 .unwrap_or_else(Instant::now),

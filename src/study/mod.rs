@@ -3,14 +3,19 @@
 //! A [`Spec`] file names the stimuli (scenes, presets or model files with scene keys over them)
 //! and the design; [`plan_trials`] orders a participant's trials from a seed; [`render_stimuli`]
 //! renders each stimulus once with the offline renderer and matches their levels; a [`Session`]
-//! presents the trials through a [`Presenter`] (a JACK server with feature `audio`, or
-//! [`Silent`] for a dry run, whose files [`write_dry_run`] writes), reads each answer and
-//! appends it to the [`TrialLog`] at once. `sake-glug analyze` reads that log.
+//! presents the trials through a [`Presenter`] (with feature `audio` a JACK server or an ALSA
+//! device, whose samples come from one mix; or [`Silent`] for a dry run, whose files
+//! [`write_dry_run`] writes), reads each answer and appends it to the [`TrialLog`] at once.
+//! `sake-glug analyze` reads that log.
 
+#[cfg(feature = "audio")]
+mod alsa_out;
 mod dry_run;
 #[cfg(feature = "audio")]
 mod jack_out;
 mod log;
+#[cfg(feature = "audio")]
+mod mix;
 mod session;
 mod spec;
 mod stimuli;
@@ -18,6 +23,8 @@ mod trials;
 
 use std::path::PathBuf;
 
+#[cfg(feature = "audio")]
+pub use alsa_out::{AlsaOutput, AlsaPlayer};
 pub use dry_run::{write_dry_run, TRIAL_LIST};
 #[cfg(feature = "audio")]
 pub use jack_out::{JackOutput, JackPlayer};

@@ -12,8 +12,9 @@ use super::StudyError;
 /// When a trial's stimuli played.
 #[derive(Debug, Clone, Copy)]
 pub struct Presented {
-    /// The audio interface's frames at which the first and the second stimulus started (JACK
-    /// frame time); `None` when nothing was played (a dry run).
+    /// The audio interface's frames at which the first and the second stimulus started (JACK's
+    /// frame time, or frames written to an ALSA device since the session started); `None` when
+    /// nothing was played (a dry run).
     pub onset_frames: Option<(u64, u64)>,
     /// The moment the last sample of the second stimulus was played, from which the response
     /// time counts.
@@ -86,7 +87,7 @@ impl Session<'_> {
     pub fn run(
         &self,
         from: usize,
-        presenter: &mut impl Presenter,
+        presenter: &mut dyn Presenter,
         log: &mut TrialLog,
         input: &mut impl BufRead,
         prompt: &mut impl Write,

@@ -1,14 +1,17 @@
-"""`sake-glug experiment` under a real JACK server (dummy driver), answers piped on stdin.
+"""`sake-glug experiment` on JACK and on ALSA, answers piped on stdin.
 
-A recorder client records the runner's three output channels in the same JACK cycles, so the
-frames the log gives for each stimulus's onset compare directly with the recording. Checked:
-each trial's two stimuli sit on the actuator channel at the logged frames, sample for sample
-what the dry run of the same spec and participant writes (the level-matched stimuli), with
-equal peaks; the actuator channel is silent everywhere else; the masking noise is on the
-headphone channels alone, at its level, and none of the stimulus leaks into them.
+On JACK: a real JACK server (dummy driver), where a recorder client records the runner's three
+output channels in the same JACK cycles, so the frames the log gives for each stimulus's onset
+compare directly with the recording. On ALSA: ALSA's `file` PCM, which writes what it is given
+into a WAV file (its slave is `null`: no sound card), whose frame n is the n-th frame written,
+the runner's position. Checked on both: each trial's two stimuli sit on the actuator channel at
+the logged frames, sample for sample what the dry run of the same spec and participant writes
+(the level-matched stimuli), with equal peaks; the actuator channel is silent everywhere else;
+the masking noise is on the headphone channels alone, at its level, and none of the stimulus
+leaks into them. A device ALSA does not know is refused with a message naming it.
 
-Needs `jackd` (Debian's jackd2) and the release `sake-glug` built with JACK
-(`cargo build --release --bin sake-glug --no-default-features --features cli,audio`).
+Needs the release `sake-glug` built with audio (`cargo build --release --bin sake-glug
+--no-default-features --features cli,audio`), and `jackd` (Debian's jackd2) for the JACK test.
 """
 
 import csv
@@ -52,12 +55,38 @@ viscosity_c = 1.0
 CLIENT = "experiment-under-test"
 
 
-def read_f32_wav(path):
-    """A mono 32-bit float WAV's samples (the format the dry run writes)."""
+def read_f32_wavs_channels(path):
+    """A 32-bit float WAV's channels and sample rate (ALSA's `file` PCM interleaves them).
+
+    Only the sample size is checked: ALSA's `file` PCM labels float samples as integer PCM."""
     data = Path(path).read_bytes()
+    fmt = data.index(b"fmt ") + 8
+    channels, rate, bits = (int.from_bytes(data[fmt + a : fmt + b], "little")
+                            for a, b in ((2, 4), (4, 8), (14, 16)))
+    assert bits == 32, f"{path}: {bits}-bit samples"
     at = data.index(b"data")
     size = int.from_bytes(data[at + 4 : at + 8], "little")
-    return np.frombuffer(data[at + 8 : at + 8 + size], dtype="<f4")
+    samples = np.frombuffer(data[at + 8 : at + 8 + size], dtype="<f4")
+    return list(samples.reshape(-1, channels).T), rate
+
+
+def read_f32_wav(path):
+    """A mono 32-bit float WAV's samples (the format the dry run writes)."""
+    (samples,), _ = read_f32_wavs_channels(path)
+    return samples
+
+
+def dry_run(tmp_path):
+    """Writes the spec and runs its dry run for participant p1: the stimuli as they must be
+    heard, in `dry/`."""
+    assert CLI.exists(), f"{CLI} is missing: build it with --features cli,audio"
+    (tmp_path / "study.toml").write_text(SPEC)
+    dry = subprocess.run(
+        [CLI, "experiment", "study.toml", "--participant", "p1", "--log", "dry.csv",
+         "--dry-run", "dry"],
+        cwd=tmp_path, input="\n" + "1\n" * 6, capture_output=True, text=True, timeout=120,
+    )
+    assert dry.returncode == 0, dry.stderr
 
 
 @pytest.fixture(scope="module")
@@ -80,14 +109,7 @@ def jack_server():
 def test_the_runner_plays_level_matched_stimuli_at_the_logged_frames(jack_server, tmp_path):
     import jack
 
-    (tmp_path / "study.toml").write_text(SPEC)
-    # The dry run of the same spec and participant: the stimuli as they must be heard.
-    dry = subprocess.run(
-        [CLI, "experiment", "study.toml", "--participant", "p1", "--log", "dry.csv",
-         "--dry-run", "dry"],
-        cwd=tmp_path, input="\n" + "1\n" * 6, capture_output=True, text=True, timeout=120,
-    )
-    assert dry.returncode == 0, dry.stderr
+    dry_run(tmp_path)
 
     recorder = jack.Client("recorder", servername=jack_server, no_start_server=True)
     inputs = [recorder.inports.register(f"in_{channel}") for channel in (1, 2, 3)]
@@ -126,8 +148,6 @@ def test_the_runner_plays_level_matched_stimuli_at_the_logged_frames(jack_server
         recorder.close()
 
     rows = list(csv.DictReader(open(tmp_path / "log.csv")))
-    trials = list(csv.DictReader(open(tmp_path / "dry" / "trials.csv")))
-    assert len(rows) == 6
     # Each cycle's samples at its frame; a cycle the recorder missed (a busy machine) stays NaN.
     start = chunks[0][0]
     length = chunks[-1][0] + len(chunks[-1][1][0]) - start
@@ -145,9 +165,71 @@ def test_the_runner_plays_level_matched_stimuli_at_the_logged_frames(jack_server
             continue
         for channel, array in zip(recorded, arrays):
             channel[frame - start : frame - start + len(array)] = array
+    print(f"cycles recorded {len(chunks)}, frames missed {np.isnan(recorded[0]).sum()} of "
+          f"{length}, cycles without the runner {runner_missed}")
+    check_recording(tmp_path, rows, recorded, start)
+
+
+def test_the_runner_plays_on_alsa_level_matched_stimuli_at_the_logged_frames(tmp_path):
+    dry_run(tmp_path)
+    recording = tmp_path / "out.wav"
+    began = time.monotonic()
+    # Answers typed ahead: each is read once its trial has ended.
+    runner = subprocess.run(
+        [CLI, "experiment", "study.toml", "--participant", "p1", "--log", "log.csv",
+         "--audio", "alsa", "--alsa-device", f"file:FILE={recording},FORMAT=wav"],
+        cwd=tmp_path, input="\n" + "x\n1\n2\n" * 3, capture_output=True, text=True,
+        timeout=120,
+    )
+    took = time.monotonic() - began
+    assert runner.returncode == 0, runner.stderr
+    assert runner.stdout.count("Please answer 1 or 2") == 3
+    recorded, rate = read_f32_wavs_channels(recording)
+    assert rate == 48000 and len(recorded) == 3
+    seconds = len(recorded[0]) / rate
+    print(f"recorded {len(recorded[0])} frames ({seconds:.2f} s) in a run of {took:.2f} s")
+    # The `file` PCM takes samples as fast as they come; the runner then keeps to the clock,
+    # so that the recording lasts no longer than the session did (give or take the period it
+    # writes ahead).
+    assert seconds <= took + 0.1
+    rows = list(csv.DictReader(open(tmp_path / "log.csv")))
+    check_recording(tmp_path, rows, recorded, 0)
+
+
+def test_an_alsa_device_alsa_does_not_know_is_refused_by_name(tmp_path):
+    assert CLI.exists(), f"{CLI} is missing: build it with --features cli,audio"
+    (tmp_path / "study.toml").write_text(SPEC)
+    result = subprocess.run(
+        [CLI, "experiment", "study.toml", "--participant", "p1", "--log", "log.csv",
+         "--audio", "alsa", "--alsa-device", "sake-glug-no-such-device"],
+        cwd=tmp_path, input="\n", capture_output=True, text=True, timeout=120,
+    )
+    assert result.returncode == 1, result.stderr
+    assert "error: ALSA device `sake-glug-no-such-device`: cannot open it" in result.stderr
+    assert not (tmp_path / "log.csv").exists(), "nothing was logged"
+
+
+@pytest.mark.parametrize("options, says", [
+    (["--alsa-device", "hw:1"], "--alsa-device names an ALSA device: add `--audio alsa`"),
+    (["--audio", "alsa", "--client-name", "x"], "--client-name names a JACK client"),
+])
+def test_an_option_of_the_other_audio_interface_is_refused(tmp_path, options, says):
+    assert CLI.exists(), f"{CLI} is missing: build it with --features cli,audio"
+    (tmp_path / "study.toml").write_text(SPEC)
+    result = subprocess.run(
+        [CLI, "experiment", "study.toml", "--participant", "p1", "--log", "log.csv", *options],
+        cwd=tmp_path, capture_output=True, text=True, timeout=60,
+    )
+    assert result.returncode == 2 and says in result.stderr, result.stderr
+
+
+def check_recording(tmp_path, rows, recorded, start):
+    """The runner's three channels as recorded from frame `start` of its output (NaN where a
+    frame was not recorded) hold the stimuli of the logged trials at their logged frames and
+    the noise on the headphone channels alone."""
+    trials = list(csv.DictReader(open(tmp_path / "dry" / "trials.csv")))
+    assert len(rows) == 6
     missed = np.isnan(recorded[0])
-    print(f"cycles recorded {len(chunks)}, frames missed {missed.sum()} of {length}, "
-          f"cycles without the runner {runner_missed}")
     actuator = recorded[0]
     stimulus_mask = np.zeros(len(actuator), dtype=bool)
     peaks = {}

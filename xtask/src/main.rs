@@ -81,7 +81,7 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             // assertions it needs.
             cargo(&["test", "--workspace", "--no-fail-fast", "--all-features"])?;
             build_bundles()?;
-            // Built once, with what the host tests need of it: a study played on JACK.
+            // Built once, with what the host tests need of it: a study played on JACK and ALSA.
             build_cli_with("cli,audio")?;
             build_standalone()?;
             host_tests()?;

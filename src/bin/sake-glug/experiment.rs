@@ -4,12 +4,19 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 
 use sake_glug::study::{
     order_seed, plan_trials, render_stimuli, write_dry_run, Equalize, Session, Silent, Spec,
     StudyError, TrialLog,
 };
+#[cfg(feature = "audio")]
+use sake_glug::study::{AlsaOutput, Channels, JackOutput, Presenter};
+
+/// The JACK client's name unless `--client-name` gives one.
+const CLIENT_NAME: &str = "sake-glug-experiment";
+/// The ALSA device unless `--alsa-device` names one.
+const ALSA_DEVICE: &str = "default";
 
 #[derive(Args, Debug)]
 pub struct ExperimentArgs {
@@ -34,9 +41,111 @@ pub struct ExperimentArgs {
     /// The headphones' output channels, which carry the masking noise: overrides the spec's.
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
     headphones: Option<Vec<u16>>,
-    /// The JACK client's name.
-    #[arg(long, default_value = "sake-glug-experiment")]
-    client_name: String,
+    /// Where the trials play: a running JACK server, or an ALSA device (`--alsa-device`).
+    #[arg(long, value_enum, default_value_t = Audio::Jack)]
+    audio: Audio,
+    /// With `--audio jack`: the JACK client's name [default: sake-glug-experiment].
+    #[arg(long, value_name = "NAME")]
+    client_name: Option<String>,
+    /// With `--audio alsa`: the ALSA device (a PCM name: `default`, `hw:1`, `plughw:CARD=USB`,
+    /// …) [default: default].
+    #[arg(long, value_name = "NAME")]
+    alsa_device: Option<String>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Audio {
+    /// A running JACK server.
+    Jack,
+    /// An ALSA device.
+    Alsa,
+}
+
+/// The audio interface the options name.
+#[derive(Debug)]
+#[cfg_attr(
+    not(feature = "audio"),
+    expect(
+        dead_code,
+        reason = "checked, so that a build without audio refuses the same options"
+    )
+)]
+enum Interface {
+    Jack { client_name: String },
+    Alsa { device: String },
+}
+
+impl ExperimentArgs {
+    /// Refuses an option of the other interface's (`--client-name` is JACK's, `--alsa-device`
+    /// ALSA's), so that neither is silently ignored.
+    fn interface(&self) -> Result<Interface, StudyError> {
+        match (self.audio, &self.client_name, &self.alsa_device) {
+            (Audio::Jack, _, Some(_)) => Err(StudyError::Audio(
+                "--alsa-device names an ALSA device: add `--audio alsa` (without it the session \
+                 plays on JACK)"
+                    .into(),
+            )),
+            (Audio::Alsa, Some(_), _) => Err(StudyError::Audio(
+                "--client-name names a JACK client, and `--audio alsa` plays on an ALSA device: \
+                 name it with --alsa-device"
+                    .into(),
+            )),
+            (Audio::Jack, client_name, None) => Ok(Interface::Jack {
+                client_name: client_name.as_deref().unwrap_or(CLIENT_NAME).to_owned(),
+            }),
+            (Audio::Alsa, None, device) => Ok(Interface::Alsa {
+                device: device.as_deref().unwrap_or(ALSA_DEVICE).to_owned(),
+            }),
+        }
+    }
+}
+
+/// The audio interface opened, not yet playing: its sample rate is the stimuli's.
+#[cfg(feature = "audio")]
+enum Output {
+    Jack(JackOutput),
+    Alsa(AlsaOutput),
+}
+
+#[cfg(feature = "audio")]
+impl Output {
+    /// Reaches the interface; an ALSA device is asked for the scenes' sample rate and the
+    /// spec's channel count.
+    fn open(interface: &Interface, spec: &Spec) -> Result<Self, StudyError> {
+        match interface {
+            Interface::Jack { client_name } => JackOutput::open(client_name).map(Self::Jack),
+            Interface::Alsa { device } => AlsaOutput::open(
+                device,
+                spec.channels.count(),
+                spec.stimuli[0].scene.sample_rate,
+            )
+            .map(Self::Alsa),
+        }
+    }
+
+    fn sample_rate(&self) -> u32 {
+        match self {
+            Self::Jack(output) => output.sample_rate(),
+            Self::Alsa(output) => output.sample_rate(),
+        }
+    }
+
+    fn start(
+        self,
+        stimuli: Vec<Vec<f32>>,
+        gap_samples: u64,
+        channels: &Channels,
+        noise_dbfs: Option<f64>,
+    ) -> Result<Box<dyn Presenter>, StudyError> {
+        Ok(match self {
+            Self::Jack(output) => {
+                Box::new(output.start(stimuli, gap_samples, channels, noise_dbfs)?)
+            }
+            Self::Alsa(output) => {
+                Box::new(output.start(stimuli, gap_samples, channels, noise_dbfs)?)
+            }
+        })
+    }
 }
 
 pub fn run(args: ExperimentArgs) -> ExitCode {
@@ -62,6 +171,7 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
             message: "--participant: give a non-empty ID without control characters".into(),
         }));
     }
+    let interface = args.interface().map_err(usage)?;
     if let Some(actuator) = args.actuator {
         spec.channels.actuator = actuator;
     }
@@ -88,7 +198,7 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
     #[cfg(feature = "audio")]
     let output = match args.dry_run {
         Some(_) => None,
-        None => Some(sake_glug::study::JackOutput::open(&args.client_name).map_err(|e| (1, e))?),
+        None => Some(Output::open(&interface, &spec).map_err(|e| (1, e))?),
     };
     #[cfg(feature = "audio")]
     let sample_rate = output
@@ -102,14 +212,14 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
             return Err((
                 2,
                 StudyError::Audio(
-                    "this build plays no audio: build it with `--features audio` (JACK), or \
-                     run the session without it with `--dry-run DIR`"
+                    "this build plays no audio: build it with `--features audio` (JACK and \
+                     ALSA), or run the session without it with `--dry-run DIR`"
                         .into(),
                 ),
             ));
         }
-        // JACK's client name means nothing without JACK.
-        let _ = args.client_name;
+        // The interface means nothing without audio.
+        let _ = interface;
         spec.stimuli[0].scene.sample_rate
     };
 
@@ -176,7 +286,7 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
             let mut player = output
                 .start(stimuli, gap, &spec.channels, spec.noise_dbfs)
                 .map_err(|e| (1, e))?;
-            session.run(done, &mut player, &mut log, &mut input, &mut prompt)
+            session.run(done, player.as_mut(), &mut log, &mut input, &mut prompt)
         }
         #[cfg(not(feature = "audio"))]
         None => unreachable!("refused above without --dry-run"),
