@@ -1,7 +1,7 @@
 //! What a case checks ([`Property`]), the verdicts ([`Check`], [`Outcome`]), and the checks
 //! every group shares, judged from a [`Run`].
 
-use super::harness::Run;
+use super::harness::{Run, ENERGY_SPAN_S};
 use super::{Scale, StabilityCase};
 use crate::engine::synthesis::MAX_COMPONENTS;
 use crate::reports::timing::TimedRender;
@@ -11,8 +11,6 @@ pub const MAX_TIME_RATIO: f64 = 5.0;
 /// Consecutive spans' energy may grow by at most this fraction (beats between components of one
 /// unit move energy between spans a little; growth means instability).
 pub(super) const ENERGY_TOLERANCE: f64 = 0.01;
-/// Span over which energy is summed: whole cycles of 80 Hz and 300 Hz.
-pub(super) const ENERGY_SPAN_S: f64 = 0.1;
 
 /// A property a stability case checks; each describes itself for the report.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

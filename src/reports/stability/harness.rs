@@ -3,12 +3,14 @@
 
 use std::ops::Range;
 
-use super::checks::ENERGY_SPAN_S;
 use super::Scale;
 use crate::engine::config::OUTPUT_RAMP_S;
 use crate::engine::ControlValues;
 use crate::engine::{ControlSource, DrainMode, Engine, ModelConfig, Synthesis};
 use crate::reports::timing::{self, RenderSpec, TimedRender};
+
+/// Span over which energy is summed unless a case sets its own: whole cycles of 80 Hz and 300 Hz.
+pub(super) const ENERGY_SPAN_S: f64 = 0.1;
 
 /// The inputs of a case as a function of the sample index.
 pub(super) type Inputs = Box<dyn Fn(u64) -> ControlValues>;
