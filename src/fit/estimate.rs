@@ -161,7 +161,7 @@ pub fn fit_session(session: &Session) -> Result<SessionFit, FitError> {
         }
         let pocket_ml = pocket.map_or(Constant::Pocket.range().default, |(b, _)| b);
         for &i in &members {
-            complete_without_weight(&mut recordings[i], pocket_ml);
+            complete_without_weight(&mut recordings[i], pocket_ml, &mut warnings);
         }
         rates.insert(liquid.to_owned(), tilt_rates(&recordings, &members));
     }
@@ -315,8 +315,13 @@ fn pocket_of(recordings: &[RecordingFit], members: &[usize]) -> Option<(f64, Vec
 }
 
 /// A recording without a weight log drains at pocket / median interval from its start volume,
-/// pouring from a pocket's time before its first unit.
-fn complete_without_weight(recording: &mut RecordingFit, pocket_ml: f64) {
+/// pouring from a pocket's time before its first unit. Units that count past an empty bottle
+/// (the recording is not the pour its session says) are given no volume, and that is warned.
+fn complete_without_weight(
+    recording: &mut RecordingFit,
+    pocket_ml: f64,
+    warnings: &mut Vec<String>,
+) {
     if recording.weight.is_some() || recording.units.len() < 3 {
         return;
     }
@@ -334,8 +339,24 @@ fn complete_without_weight(recording: &mut RecordingFit, pocket_ml: f64) {
         r_squared: f64::NAN,
         slope_error: f64::NAN,
     };
+    let mut past_empty = 0;
     for unit in &mut recording.units {
-        unit.volume_ml = line.at(unit.fit.onset_s).max(0.0);
+        let volume_ml = line.at(unit.fit.onset_s);
+        unit.volume_ml = if volume_ml >= 0.0 {
+            volume_ml
+        } else {
+            past_empty += 1;
+            f64::NAN
+        };
+    }
+    if past_empty > 0 {
+        warnings.push(format!(
+            "`{}`: {} units of {pocket_ml} ml pour more than its start_ml = {start_ml} ml; the \
+             {past_empty} counted past an empty bottle have no volume (a weight log, or the \
+             recording's own pocket, would tell)",
+            recording.spec.key,
+            recording.units.len(),
+        ));
     }
     let span_s = (
         recording.units[0].fit.onset_s,
@@ -680,6 +701,32 @@ fn fit_liquid(
         in_model: true,
     });
     let mut kept_default = Vec::new();
+    let silent_key = Constant::SilentBelow.quantity().scene_key;
+    let law = amplitude_law(&units);
+    if let Some(estimate) = estimates
+        .iter_mut()
+        .find(|e| e.key == silent_key && e.in_model)
+    {
+        // A line whose slope its own error cannot tell from 0 has no zero worth a number.
+        let flat = law.filter(|line| line.slope <= Z_95 * line.slope_error);
+        if let Some(line) = flat {
+            kept_default.push((
+                silent_key.to_owned(),
+                format!(
+                    "Asum does not fall measurably with V (slope {:.3e} ± {:.3e} per ml)",
+                    line.slope,
+                    Z_95 * line.slope_error
+                ),
+            ));
+            estimate.in_model = false;
+        } else if estimate.value >= capacity_ml {
+            kept_default.push((
+                silent_key.to_owned(),
+                "the fitted zero lies above the capacity".into(),
+            ));
+            estimate.in_model = false;
+        }
+    }
     for estimate in &mut estimates {
         if !estimate.in_model {
             continue;
@@ -694,19 +741,6 @@ fn fit_liquid(
                 estimate.key, estimate.value, range.min, range.max
             ));
             estimate.value = range.sanitize(estimate.value);
-        }
-    }
-    let silent_key = Constant::SilentBelow.quantity().scene_key;
-    if let Some(estimate) = estimates
-        .iter_mut()
-        .find(|e| e.key == silent_key && e.in_model)
-    {
-        if estimate.value >= capacity_ml {
-            kept_default.push((
-                silent_key.to_owned(),
-                "the fitted zero lies above the capacity".into(),
-            ));
-            estimate.in_model = false;
         }
     }
     for (key, why) in [
@@ -748,10 +782,10 @@ fn fit_liquid(
     LiquidFit {
         liquid: liquid.to_owned(),
         units: units.len(),
-        amplitude_law: amplitude_law(&units),
         estimates,
         kept_default,
         model_toml,
+        amplitude_law: law,
     }
 }
 

@@ -139,3 +139,42 @@ fn clipping_and_a_single_tilt_are_warned_about() {
         "{kept:?}"
     );
 }
+
+/// A bottle kept full (follow mode) glugs for ever at one amplitude: counted at the default
+/// pocket, its units pour far more than it holds. Those units get no volume, and a law through
+/// the others with no measurable slope gives no zero: `silent_below_ml` keeps its default rather
+/// than a number brought into range.
+#[test]
+fn a_pour_longer_than_its_bottle_and_a_flat_amplitude_law_are_warned_about() {
+    let rendered = render(
+        "sample_rate = 25000\ntilt_deg = 135.0\nduration_s = 10.0\n[output]\ndrain = \"follow\"\n",
+    );
+    let folder = tempfile::tempdir().unwrap();
+    let take = Take {
+        name: "full",
+        rendered: &rendered,
+        tilt_deg: 135.0,
+        liquid: None,
+        weight: false,
+        noise_db: Some(-30.0),
+    };
+    let fit = fit(&write_session(folder.path(), 300.0, &[take]));
+    let warnings = fit.warnings.join("\n");
+    assert_has(
+        &warnings,
+        &["`recording[0]`", "pour more than its start_ml", "no volume"],
+    );
+    assert!(!warnings.contains("silent_below_ml"), "{warnings}");
+    let liquid = &fit.liquids[0];
+    let (_, why) = liquid
+        .kept_default
+        .iter()
+        .find(|(key, _)| key == "amplitude.silent_below_ml")
+        .unwrap_or_else(|| panic!("kept: {:?}", liquid.kept_default));
+    assert_has(why, &["does not fall measurably with V"]);
+    assert!(
+        !liquid.model_toml.contains("silent_below_ml ="),
+        "{}",
+        liquid.model_toml
+    );
+}
