@@ -6,7 +6,7 @@
 
 use std::ops::{Index, IndexMut};
 
-use super::config::{Knob, Quantity, Range};
+use super::quantity::{Knob, Quantity, Range};
 
 /// How a tilt device reaches a control: the MIDI setting that names its CC, and its OSC address.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

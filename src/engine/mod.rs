@@ -8,15 +8,15 @@
 mod amplitude;
 pub mod config;
 mod controls;
+pub mod curves;
 mod output;
 pub mod pour;
 mod presets;
+mod quantity;
 pub mod synthesis;
 
 pub use amplitude::{SilentBelow, PAPERS_SILENT_BELOW_ML};
-pub use config::{
-    Constant, ConstantSpec, Curve, DrainMode, Knob, ModelConfig, Quantity, Range, ValueError,
-};
+pub use config::{Constant, ConstantSpec, Curve, DrainMode, ModelConfig};
 pub use controls::{
     Control, ControlSource, ControlSpec, ControlValues, Controls, DeviceInput, Lane, PerControl,
 };
@@ -24,6 +24,7 @@ use output::OutputStage;
 use pour::MAX_ONSETS_PER_SAMPLE;
 pub use pour::{Outflow, Pour, PourStats, UnitOnset};
 pub use presets::{Preset, PresetValue, PRESETS};
+pub use quantity::{Knob, Quantity, Range, ValueError};
 pub use synthesis::{AnchoredF32, RecursiveF32, RecursiveF64, Synthesis, GRID};
 
 /// How the engine voiced a unit as it started: what a table of units or a clip needs to know

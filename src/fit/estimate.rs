@@ -11,8 +11,8 @@ use super::spectrum::Spectrum;
 use super::stats::{bootstrap, iqr, median, Line, NORMAL_IQR};
 use super::unit::{fit_units, UnitFit};
 use super::weight::WeightLog;
-use crate::engine::config::Range;
-use crate::engine::pour::REFERENCE_TILT_DEG;
+use crate::engine::curves::REFERENCE_TILT_DEG;
+use crate::engine::Range;
 use crate::engine::{Constant, Control, Curve, ModelConfig};
 
 /// An interval between units longer than this many times the median counts a missed unit, one
@@ -398,7 +398,7 @@ fn tilt_rates(recordings: &[RecordingFit], members: &[usize]) -> Vec<(f64, f64)>
 /// it, else the nearest tilt's through the default h.
 fn rate_at_reference(
     rates: &[(f64, f64)],
-    default_h: &crate::engine::pour::TiltCurve,
+    default_h: &crate::engine::curves::TiltCurve,
 ) -> Option<f64> {
     if let Some(&(_, k)) = rates
         .iter()
@@ -499,7 +499,7 @@ fn curve_or_default(
     curve: Curve,
     mut measured: Vec<(f64, f64)>,
     tilts: usize,
-    defaults: &crate::engine::pour::BottleCurves,
+    defaults: &crate::engine::curves::BottleCurves,
     warnings: &mut Vec<String>,
 ) -> Option<Vec<(f64, f64)>> {
     let key = curve.scene_key();

@@ -10,11 +10,12 @@ use crate::device::axis::Axis;
 use crate::device::csv_lane::{read_csv_lane, CsvLaneError, CsvLaneSpec, MAX_CSV_LANE_BYTES};
 use crate::device::midi::{MidiMap, MidiSetting};
 use crate::device::midi_take::{read_midi_take, TakeError, TimedInput, MAX_TAKE_BYTES};
-use crate::engine::config::{self, Range, ValueError};
+use crate::engine::config;
 use crate::engine::{
     Constant, Control, ControlSource, ControlValues, Controls, Curve, DrainMode, ModelConfig,
     PerControl, Preset, PresetValue, Quantity,
 };
+use crate::engine::{Range, ValueError};
 use crate::model::{curve_points, Model};
 use crate::text::printable;
 

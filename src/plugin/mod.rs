@@ -2,6 +2,7 @@
 //! the parameters, hands MIDI and the transport to [`RealtimeEngine`] and keeps no DSP of its own.
 
 mod feed;
+mod loaded_model;
 mod model;
 mod osc_input;
 mod params;
@@ -14,7 +15,8 @@ mod transport;
 mod editor;
 
 pub use feed::{Feed, UnitView, Visible, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
-pub use model::{model_values, LoadedModel, ModelLayer, MODEL_KEY, MODEL_NAME_KEY};
+pub use loaded_model::{LoadedModel, ModelLayer, MODEL_KEY, MODEL_NAME_KEY};
+pub use model::model_values;
 pub use osc_input::{OscInput, OscSettings, OscStatus, DEFAULT_AXIS, DEFAULT_OSC_INTERFACE};
 pub use params::{
     exact, float_param, format, migrate_state, parse_number, GlugParams, ModelParams, STATE_VERSION,

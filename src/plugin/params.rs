@@ -15,9 +15,10 @@ use nice_plug::plugin::ParamValue;
 use nice_plug::prelude::*;
 
 use crate::device::midi::{MidiMap, MidiSetting};
-use crate::engine::config::{self, Knob, Quantity, CEILING_DB};
+use crate::engine::config::{self, CEILING_DB};
 use crate::engine::{Constant, Control, ControlValues, DrainMode, ModelConfig, PerControl};
-use crate::plugin::model::{saved_model, LoadedModel, MODEL_KEY, MODEL_NAME_KEY};
+use crate::engine::{Knob, Quantity};
+use crate::plugin::loaded_model::{saved_model, LoadedModel, MODEL_KEY, MODEL_NAME_KEY};
 use crate::plugin::osc_input::OscSettings;
 
 /// The decimal number that `value` shows as on a knob with `decimals` decimals: what the engine

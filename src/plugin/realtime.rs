@@ -5,7 +5,8 @@ use crate::device::live::{LiveControls, LiveReader};
 use crate::device::midi::{CcDecoder, DeviceAction, MidiInput, MidiMap, Overrides};
 use crate::engine::{ControlValues, Controls, Engine, ModelConfig};
 use crate::plugin::feed::{Feed, ScopeWriter, Visible};
-use crate::plugin::model::{layered_config, layered_controls, ModelLayer};
+use crate::plugin::loaded_model::ModelLayer;
+use crate::plugin::model::{layered_config, layered_controls};
 use crate::plugin::params::GlugParams;
 use crate::plugin::transport::TransportWatch;
 

@@ -2,7 +2,7 @@
 //! §12: with curves of its own, the same by those.
 
 use crate::support::{pour_onsets, tilt_only};
-use sake_glug::engine::pour::BottleCurves;
+use sake_glug::engine::curves::BottleCurves;
 use sake_glug::engine::{ControlValues, Curve, ModelConfig, Pour};
 
 /// `curve`'s default value at `tilt_deg`.

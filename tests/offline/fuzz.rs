@@ -7,7 +7,8 @@
 use proptest::prelude::*;
 
 use crate::support::fuzz::{self, any_number, toml_number};
-use sake_glug::engine::config::{self, Range};
+use sake_glug::engine::config;
+use sake_glug::engine::Range;
 use sake_glug::engine::{Constant, Control, Lane, Quantity};
 use sake_glug::offline::{Automation, Scene};
 

@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use sake_glug::engine::pour::{BottleCurves, TiltCurve};
-use sake_glug::engine::{DrainMode, ModelConfig, SilentBelow};
+use sake_glug::engine::curves::BottleCurves;
+use sake_glug::engine::{Curve, DrainMode, ModelConfig, SilentBelow};
 use sake_glug::offline::{Automation, Scene, SceneError};
 
 fn fixtures(kind: &str) -> Vec<(String, String)> {
@@ -91,9 +91,15 @@ fn the_full_fixture_reads_every_key_with_its_own_value() {
             silent_below: SilentBelow::Ml(150.0),
             amplitude_spread: 0.0,
             curves: BottleCurves {
-                rest: TiltCurve::new(&[(60.0, 1.0), (90.0, 0.4), (120.0, 0.0)]).unwrap(),
-                submerged: TiltCurve::new(&[(70.0, 0.9), (130.0, 0.0)]).unwrap(),
-                drain: TiltCurve::new(&[(45.0, 0.0), (135.0, 1.0), (180.0, 0.5)]).unwrap(),
+                rest: Curve::Rest
+                    .from_points(&[(60.0, 1.0), (90.0, 0.4), (120.0, 0.0)])
+                    .unwrap(),
+                submerged: Curve::Submerged
+                    .from_points(&[(70.0, 0.9), (130.0, 0.0)])
+                    .unwrap(),
+                drain: Curve::Drain
+                    .from_points(&[(45.0, 0.0), (135.0, 1.0), (180.0, 0.5)])
+                    .unwrap(),
             },
             seed: 42,
             drain: DrainMode::Follow,

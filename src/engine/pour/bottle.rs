@@ -1,8 +1,8 @@
 //! The bottle's residual volume and its tilt-dependent drain (MODEL.md §2, §3, §8).
 
-use super::curves::CurveSegment;
 use crate::engine::config::{DrainMode, ModelConfig};
 use crate::engine::controls::ControlValues;
+use crate::engine::curves::CurveSegment;
 
 /// What one sample of pouring did.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,21 +2,18 @@
 //! (MODEL.md §3, §4, §7, §8). Every synthesis path, fast or reference, is driven by this.
 
 mod bottle;
-mod curves;
 mod exact;
 mod onsets;
 mod randomness;
 mod span;
 
 pub use bottle::Outflow;
-pub use curves::{
-    BottleCurves, CurveError, CurveSegment, TiltCurve, MAX_CURVE_POINTS, REFERENCE_TILT_DEG,
-};
 pub use onsets::MAX_ONSETS_PER_SAMPLE;
 pub use randomness::UnitShape;
 
-use crate::engine::config::{ModelConfig, Range};
+use crate::engine::config::ModelConfig;
 use crate::engine::controls::{Control, ControlValues, Controls, Lane, PerControl};
+use crate::engine::quantity::Range;
 use bottle::{fill_ml, Bottle, SpanLevels, SPAN};
 use exact::Direction;
 use onsets::OnsetDetector;

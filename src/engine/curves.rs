@@ -3,8 +3,6 @@
 
 use std::ops::RangeInclusive;
 
-use crate::engine::controls::Control;
-
 /// The most points a curve holds (MODEL.md §12). Curves sit inline in the model's constants,
 /// which the plugin hands to the engine on every `process()` call: a fixed size keeps them
 /// `Copy` and free of allocation. Sixteen is more than any measured bottle needs (the default
@@ -99,17 +97,16 @@ pub struct CurveSegment(usize, usize);
 
 impl TiltCurve {
     /// The curve through `points` (tilt in degrees, value), checked as MODEL.md §12 asks: two to
-    /// [`MAX_CURVE_POINTS`] points, tilts strictly increasing within the tilt's range 0…180°,
-    /// values within 0…1.
-    pub fn new(points: &[(f64, f64)]) -> Result<Self, CurveError> {
+    /// [`MAX_CURVE_POINTS`] points, tilts strictly increasing within `tilts` (the tilt control's
+    /// range, which its table declares), values within 0…1.
+    pub fn new(points: &[(f64, f64)], tilts: RangeInclusive<f64>) -> Result<Self, CurveError> {
         let count = points.len();
         if !(MIN_CURVE_POINTS..=MAX_CURVE_POINTS).contains(&count) {
             return Err(CurveError::PointCount { count });
         }
-        let tilts = Control::Tilt.range();
         let mut previous = f64::NEG_INFINITY;
         for (index, &(tilt_deg, value)) in points.iter().enumerate() {
-            if !(tilts.contains(tilt_deg) && tilt_deg > previous) {
+            if !(tilts.contains(&tilt_deg) && tilt_deg > previous) {
                 return Err(CurveError::Tilt { index, tilt_deg });
             }
             if !VALUES.contains(&value) {
@@ -292,7 +289,7 @@ mod tests {
 
     #[test]
     fn a_curve_is_checked_as_model_md_12_asks() {
-        let curve = |points: &[(f64, f64)]| TiltCurve::new(points);
+        let curve = |points: &[(f64, f64)]| TiltCurve::new(points, 0.0..=180.0);
         assert_eq!(curve(&[(0.0, 0.5), (180.0, 1.0)]).unwrap().at(90.0), 0.75);
         assert_eq!(curve(DRAIN.points()), Ok(DRAIN));
         assert_eq!(
@@ -330,7 +327,7 @@ mod tests {
     #[test]
     fn a_curve_is_held_to_its_anchor() {
         assert_eq!(DRAIN.through(REFERENCE_TILT_DEG, 1.0), Ok(DRAIN));
-        let low = TiltCurve::new(&[(90.0, 0.5), (180.0, 0.9)]).unwrap();
+        let low = TiltCurve::new(&[(90.0, 0.5), (180.0, 0.9)], 0.0..=180.0).unwrap();
         assert_eq!(
             low.through(REFERENCE_TILT_DEG, 1.0),
             Err(CurveError::Anchor {
