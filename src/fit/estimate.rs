@@ -351,11 +351,12 @@ fn complete_without_weight(
     }
     if past_empty > 0 {
         warnings.push(format!(
-            "`{}`: {} units of {pocket_ml} ml pour more than its start_ml = {start_ml} ml; the \
-             {past_empty} counted past an empty bottle have no volume (a weight log, or the \
-             recording's own pocket, would tell)",
+            "`{}`: its {} units, a {pocket_ml} ml pocket each, pour {:.0} ml, more than its \
+             start_ml = {start_ml} ml; the {past_empty} counted past an empty bottle have no \
+             volume (a weight log would give the pocket)",
             recording.spec.key,
             recording.units.len(),
+            recording.units.len() as f64 * pocket_ml,
         ));
     }
     let span_s = (

@@ -162,7 +162,11 @@ fn a_pour_longer_than_its_bottle_and_a_flat_amplitude_law_are_warned_about() {
     let warnings = fit.warnings.join("\n");
     assert_has(
         &warnings,
-        &["`recording[0]`", "pour more than its start_ml", "no volume"],
+        &[
+            "`recording[0]`",
+            "more than its start_ml = 300 ml",
+            "no volume",
+        ],
     );
     assert!(!warnings.contains("silent_below_ml"), "{warnings}");
     let liquid = &fit.liquids[0];
