@@ -1,5 +1,6 @@
 //! No pointer to nowhere: every repository path that README.md, docs/*.md and the comments of the
-//! code name exists, and every `--test`, `--bench` and `--bin` names a target of Cargo.toml.
+//! code name exists, every `--test`, `--bench` and `--bin` names a target of Cargo.toml, and the
+//! README's map of the code ("How it is built") puts every source file of `src/` where it is.
 //!
 //! It reads files only, so it needs none of the crate's features.
 
@@ -98,6 +99,131 @@ fn every_cargo_target_named_exists() {
         stale.len(),
         stale.join("\n")
     );
+}
+
+#[test]
+fn the_readme_map_puts_every_source_file_where_it_is() {
+    let map = readme_map();
+    assert!(map.len() > 10, "the map was not found: the scan is broken");
+    let mut wrong = Vec::new();
+    // Each file of src/ is named by the deepest entry that holds it: its own line, or its
+    // folder's, whose text lists it. A folder's `mod.rs` is its front door, which the map's
+    // preamble names once for all.
+    for file in files_under("src", "rs") {
+        let file = file.display().to_string();
+        let Some(entry) = map
+            .iter()
+            .filter(|entry| {
+                entry.path == file || (entry.is_folder() && file.starts_with(&entry.path))
+            })
+            .max_by_key(|entry| entry.path.len())
+        else {
+            wrong.push(format!("{file}: no entry of the map holds it"));
+            continue;
+        };
+        let name = file.rsplit('/').next().unwrap_or(&file);
+        if entry.path != file && name != "mod.rs" && !entry.names().any(|named| named == name) {
+            wrong.push(format!(
+                "{file}: README.md:{} ({}) does not name {name}",
+                entry.line, entry.path
+            ));
+        }
+    }
+    // Each file a folder's entry names is in that folder, at some depth.
+    for entry in map.iter().filter(|entry| entry.is_folder()) {
+        let held = files_under(&entry.path, "rs");
+        for named in entry.names() {
+            let here = held
+                .iter()
+                .any(|file| file.file_name().is_some_and(|file| file == named));
+            if !here {
+                wrong.push(format!(
+                    "README.md:{}: {named} is not in {}",
+                    entry.line, entry.path
+                ));
+            }
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "the README's map of the code is wrong in {} places:\n{}",
+        wrong.len(),
+        wrong.join("\n")
+    );
+}
+
+/// One entry of the README's map of `src/`: a folder (ending in `/`) or a file, the line it
+/// starts on, and its text with the lines that continue it.
+struct MapEntry {
+    path: String,
+    line: usize,
+    text: String,
+}
+
+impl MapEntry {
+    fn is_folder(&self) -> bool {
+        self.path.ends_with('/')
+    }
+
+    /// The Rust file names the entry's text gives (`bottle.rs`), without a folder.
+    fn names(&self) -> impl Iterator<Item = &str> {
+        self.text
+            .split(|c: char| !(c.is_ascii_alphanumeric() || "_-./".contains(c)))
+            .filter(|word| word.ends_with(".rs") && !word.contains('/'))
+    }
+}
+
+/// The entries of the README's map under `src/`: the fenced block after "## How it is built",
+/// where a top-level entry starts in the first column, an entry inside a folder's two spaces in,
+/// and a line further in continues the entry above.
+fn readme_map() -> Vec<MapEntry> {
+    let readme = read(Path::new("README.md"));
+    let lines: Vec<&str> = readme.lines().collect();
+    let heading = lines
+        .iter()
+        .position(|line| *line == "## How it is built")
+        .expect("README.md has a \"## How it is built\" section");
+    let fence = heading
+        + lines[heading..]
+            .iter()
+            .position(|line| line.starts_with("```"))
+            .expect("the section has a fenced map");
+    let (mut entries, mut folder) = (Vec::<MapEntry>::new(), String::new());
+    for (index, line) in lines.iter().enumerate().skip(fence + 1) {
+        if line.starts_with("```") {
+            break;
+        }
+        let indent = line.len() - line.trim_start().len();
+        let (first, rest) = line
+            .trim_start()
+            .split_once(' ')
+            .unwrap_or((line.trim_start(), ""));
+        let path = match indent {
+            0 => {
+                folder = if first.ends_with('/') {
+                    first.to_owned()
+                } else {
+                    String::new()
+                };
+                first.to_owned()
+            }
+            2 => format!("{folder}{first}"),
+            _ => {
+                if let Some(entry) = entries.last_mut() {
+                    entry.text.push(' ');
+                    entry.text.push_str(line.trim());
+                }
+                continue;
+            }
+        };
+        entries.push(MapEntry {
+            path,
+            line: index + 1,
+            text: rest.trim().to_owned(),
+        });
+    }
+    entries.retain(|entry| entry.path.starts_with("src/"));
+    entries
 }
 
 /// Every line of README.md and docs/*.md, and every comment line of the Rust sources.
