@@ -2,8 +2,9 @@
 
 Called by benches/render.rs as `python scipy_fit.py UNITS.f64 WINDOWS.f64 SAMPLE_RATE OUT.f64`.
 UNITS.f64 holds one row of 10 little-endian f64 per unit: the first sample of its window, the
-number of samples given, every how many samples of the recording they are, and the seven numbers `sake-glug fit` started its Levenberg-Marquardt from
-(onset s, A1, A2, f1, f2, B1, B2). WINDOWS.f64 holds the windows' samples one after the other:
+number of samples given, the stride between them (every k-th sample of the recording), and the
+seven numbers `sake-glug fit` started its Levenberg-Marquardt from (onset s, A1, A2, f1, f2, B1,
+B2). WINDOWS.f64 holds the windows' samples one after the other:
 the recording less the units fitted before (as `sake-glug fit` sees them, MODEL.md §13).
 
 Each window is fitted with eq. 1 (MODEL.md §5), q(τ) = A1·e^(−B1τ)·sin(2πf1τ) +
