@@ -55,7 +55,7 @@ viscosity_c = 1.0
 CLIENT = "experiment-under-test"
 
 
-def read_f32_wavs_channels(path):
+def read_f32_wav_channels(path):
     """A 32-bit float WAV's channels and sample rate (ALSA's `file` PCM interleaves them).
 
     Only the sample size is checked: ALSA's `file` PCM labels float samples as integer PCM."""
@@ -72,7 +72,7 @@ def read_f32_wavs_channels(path):
 
 def read_f32_wav(path):
     """A mono 32-bit float WAV's samples (the format the dry run writes)."""
-    (samples,), _ = read_f32_wavs_channels(path)
+    (samples,), _ = read_f32_wav_channels(path)
     return samples
 
 
@@ -184,7 +184,7 @@ def test_the_runner_plays_on_alsa_level_matched_stimuli_at_the_logged_frames(tmp
     took = time.monotonic() - began
     assert runner.returncode == 0, runner.stderr
     assert runner.stdout.count("Please answer 1 or 2") == 3
-    recorded, rate = read_f32_wavs_channels(recording)
+    recorded, rate = read_f32_wav_channels(recording)
     assert rate == 48000 and len(recorded) == 3
     seconds = len(recorded[0]) / rate
     print(f"recorded {len(recorded[0])} frames ({seconds:.2f} s) in a run of {took:.2f} s")
