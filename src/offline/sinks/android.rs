@@ -31,7 +31,8 @@ pub(super) fn open_waveform<'a>(
     )
 }
 
-/// The clip as Android's vibration XML (schema `vibration.xsd`): one `<waveform-effect>` of
+/// The clip as Android's vibration XML (schema `vibration.xsd`, root `<vibration-effect>` as
+/// Android 15's `VibrationXmlParser` reads it): one `<waveform-effect>` of
 /// `<waveform-entry durationMs amplitude>`, played once (no `<repeating>`). A comment names
 /// the render; the scene's name is left out of it, as a name may hold what a comment cannot.
 pub fn android_xml(source: &ClipSource) -> String {
@@ -45,7 +46,7 @@ pub fn android_xml(source: &ClipSource) -> String {
         source.seed,
         clip_onsets(source).len()
     );
-    xml.push_str("<vibration>\n  <waveform-effect>\n");
+    xml.push_str("<vibration-effect>\n  <waveform-effect>\n");
     for step in &steps {
         let _ = writeln!(
             xml,
@@ -53,7 +54,7 @@ pub fn android_xml(source: &ClipSource) -> String {
             step.duration_ms, step.amplitude
         );
     }
-    xml.push_str("  </waveform-effect>\n</vibration>\n");
+    xml.push_str("  </waveform-effect>\n</vibration-effect>\n");
     xml
 }
 

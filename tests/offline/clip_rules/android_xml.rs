@@ -1,6 +1,8 @@
 //! Validator of Android's vibration XML, as `VibrationXmlParser` reads it: the elements,
 //! attributes and ranges of its schema (frameworks/base `core/xsd/vibrator/vibration/
-//! vibration.xsd`, version 2.0), and its fixtures.
+//! vibration.xsd`, version 2.0, as Android 15 ships it) and the checks its parser adds
+//! (`VibrationEffectXmlParser`, `SerializedAmplitudeStepWaveform`), and its fixtures. The
+//! schema's 2023 draft had the root `<vibration>`, which the parser refuses.
 
 use roxmltree::{Document, Node};
 
@@ -8,20 +10,26 @@ use super::{check_fixtures, Violation};
 
 rules! {
     MalformedXml => "malformed_xml": "the file is well-formed XML",
-    WrongRoot => "wrong_root": "the root element is <vibration>, in no namespace",
+    WrongRoot => "wrong_root":
+        "the root element is <vibration-effect>, in no namespace (the root \
+         VibrationXmlParser.parseVibrationEffect and VibrationEffect.parseFromXml read)",
     NotOneEffect => "not_one_effect":
-        "<vibration> holds one <waveform-effect>, one <predefined-effect>, or one or more \
-         <primitive-effect>, and no other element",
+        "<vibration-effect> holds one <waveform-effect>, one <predefined-effect>, or one or \
+         more <primitive-effect>, and no other element",
+    UnexpectedAttribute => "unexpected_attribute":
+        "<vibration-effect>, <waveform-effect> and <repeating> have no attribute",
     UnknownElement => "unknown_element":
         "a <waveform-effect> holds <waveform-entry> elements, then at most one <repeating> \
          of one or more <waveform-entry>, and nothing else",
     EmptyWaveform => "empty_waveform":
-        "a <waveform-effect> has at least one entry (the schema's assertion)",
+        "a <waveform-effect>'s entries last longer than 0 ms together (the schema's assertion \
+         as the parser checks it: \"total duration zero\")",
     MissingAttribute => "missing_attribute":
         "every <waveform-entry> has the required durationMs and amplitude, and no other \
          attribute",
     DurationNotNonNegativeInteger => "duration_not_non_negative_integer":
-        "durationMs is an xs:nonNegativeInteger",
+        "durationMs is an xs:nonNegativeInteger that fits a Java int (the parser reads it as \
+         one)",
     AmplitudeOutOfRange => "amplitude_out_of_range":
         "amplitude is an integer from 0 to 255, or `default`",
 }
@@ -55,8 +63,12 @@ fn entry(node: Node, violations: &mut Vec<Violation<Rule>>) -> Option<Entry> {
             format!("{at}: {names:?}"),
         ));
     }
-    let duration_ms = duration.trim().parse::<u64>();
-    if duration_ms.is_err() {
+    let duration_ms = duration
+        .trim()
+        .parse::<i32>()
+        .ok()
+        .and_then(|ms| u64::try_from(ms).ok());
+    if duration_ms.is_none() {
         violations.push(violation(
             Rule::DurationNotNonNegativeInteger,
             format!("{at}: durationMs={duration:?}"),
@@ -70,7 +82,7 @@ fn entry(node: Node, violations: &mut Vec<Violation<Rule>>) -> Option<Entry> {
         violations.push(violation(Rule::AmplitudeOutOfRange, at));
     }
     Some(Entry {
-        duration_ms: duration_ms.ok()?,
+        duration_ms: duration_ms?,
         amplitude: amplitude?,
     })
 }
@@ -85,13 +97,22 @@ fn read(text: &str, violations: &mut Vec<Violation<Rule>>) -> Vec<Entry> {
         }
     };
     let root = document.root_element();
-    if root.tag_name().name() != "vibration" || root.tag_name().namespace().is_some() {
+    if root.tag_name().name() != "vibration-effect" || root.tag_name().namespace().is_some() {
         violations.push(violation(
             Rule::WrongRoot,
             format!("root {:?}", root.tag_name()),
         ));
         return Vec::new();
     }
+    let without_attributes = |node: Node, violations: &mut Vec<Violation<Rule>>| {
+        if let Some(attribute) = node.attributes().next() {
+            violations.push(violation(
+                Rule::UnexpectedAttribute,
+                format!("<{}> has {}", node.tag_name().name(), attribute.name()),
+            ));
+        }
+    };
+    without_attributes(root, violations);
     let effects: Vec<Node> = elements(root).collect();
     let names: Vec<&str> = effects.iter().map(|n| n.tag_name().name()).collect();
     let one_effect = match names.as_slice() {
@@ -106,16 +127,17 @@ fn read(text: &str, violations: &mut Vec<Violation<Rule>>) -> Vec<Entry> {
         .iter()
         .filter(|n| n.tag_name().name() == "waveform-effect")
     {
-        let mut count = 0;
+        without_attributes(*effect, violations);
+        let first_entry = entries.len();
         let mut repeating = false;
         for child in elements(*effect) {
             match child.tag_name().name() {
                 "waveform-entry" if !repeating => {
-                    count += 1;
                     entries.extend(entry(child, violations));
                 }
                 "repeating" if !repeating => {
                     repeating = true;
+                    without_attributes(child, violations);
                     let inner: Vec<Node> = elements(child).collect();
                     if inner.is_empty()
                         || inner
@@ -128,15 +150,15 @@ fn read(text: &str, violations: &mut Vec<Violation<Rule>>) -> Vec<Entry> {
                         .into_iter()
                         .filter(|n| n.tag_name().name() == "waveform-entry")
                     {
-                        count += 1;
                         entries.extend(entry(node, violations));
                     }
                 }
                 other => violations.push(violation(Rule::UnknownElement, other.to_owned())),
             }
         }
-        if count == 0 {
-            violations.push(violation(Rule::EmptyWaveform, "no entry"));
+        let total_ms: u64 = entries[first_entry..].iter().map(|e| e.duration_ms).sum();
+        if total_ms == 0 {
+            violations.push(violation(Rule::EmptyWaveform, "total duration 0 ms"));
         }
     }
     entries
