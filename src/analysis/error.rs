@@ -90,9 +90,10 @@ impl AnalysisError {
 
     pub(crate) fn design(files: &[impl AsRef<Path>], message: impl Into<String>) -> Self {
         let names: Vec<String> = files.iter().map(|file| shown(file.as_ref())).collect();
+        // A design message quotes stimulus and participant names, which come from the logs.
         Self::Design {
             files: names.join(", "),
-            message: message.into(),
+            message: printable(&message.into()).into_owned(),
         }
     }
 }

@@ -121,3 +121,38 @@ fn trials_at_fewer_than_two_levels_or_answers_that_never_change_are_refused() {
         &["log.csv", "no finite fit"],
     );
 }
+
+/// Names in a log are the participant's or the runner's text: the report shows them with their
+/// control characters escaped, so a log cannot steer the terminal it is read on.
+#[test]
+fn names_with_control_characters_are_shown_escaped() {
+    let folder = tempfile::tempdir().unwrap();
+    let bell = "ring\u{7}";
+    let escape = "red\u{1b}[31m";
+    let paired = format!("{PAIRED_HEADER}p1,{bell},{escape},{bell}\np1,{escape},{bell},{bell}\n");
+    std::fs::write(folder.path().join("paired.csv"), paired).unwrap();
+    let constant = "participant,level,chose_comparison\n\
+                    p\u{1b}]0;x\u{7},0.2,0\np\u{1b}]0;x\u{7},0.2,1\np\u{1b}]0;x\u{7},0.3,1\n\
+                    p\u{1b}]0;x\u{7},0.4,1\np\u{1b}]0;x\u{7},0.4,0\np\u{1b}]0;x\u{7},0.5,1\n";
+    std::fs::write(folder.path().join("constant.csv"), constant).unwrap();
+    for args in [
+        ["paired", "paired.csv"].as_slice(),
+        ["constant", "constant.csv", "--resamples", "20"].as_slice(),
+    ] {
+        let output = analyze(folder.path(), args);
+        let stdout = String::from_utf8(output.stdout).unwrap();
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        assert!(
+            stdout.chars().all(|c| !c.is_control() || c == '\n'),
+            "{args:?}: a raw control character in:\n{stdout:?}"
+        );
+        assert!(
+            stdout.contains("\\u{1b}"),
+            "{args:?}: the name is shown escaped"
+        );
+    }
+}

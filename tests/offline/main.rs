@@ -18,6 +18,7 @@ mod memory;
 mod model_files;
 mod presets;
 mod readme;
+mod research_fuzz;
 mod scene_files;
 mod study;
 mod tables;

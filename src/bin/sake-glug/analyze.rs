@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Subcommand};
+use sake_glug::text::printable;
 
 use sake_glug::analysis::{
     analyze_constant_logs, analyze_paired_logs, constant_json, draw_constant_plot,
@@ -137,7 +138,13 @@ fn matrix_text(title: &str, names: &[String], cell: impl Fn(usize, usize) -> Str
 }
 
 fn paired_text(analysis: &PairedAnalysis) -> String {
-    let names = &analysis.stimuli;
+    // The names come from the logs: shown with their control characters escaped.
+    let names: Vec<String> = analysis
+        .stimuli
+        .iter()
+        .map(|name| printable(name).into_owned())
+        .collect();
+    let names = &names;
     let mut text = format!(
         "{} trials, {} participant(s), {} stimuli\n\n",
         analysis.trials,
@@ -220,7 +227,7 @@ fn constant_text(analysis: &ConstantAnalysis) -> String {
     text += &format!("\nall participants ({} resamples)\n", pooled.resamples);
     text += &fit_text(pooled);
     for (name, fit) in &analysis.participants {
-        text += &format!("\n{name}\n");
+        text += &format!("\n{}\n", printable(name));
         text += &match fit {
             Ok(fit) => fit_text(fit),
             Err(error) => format!("  {error}\n"),
