@@ -114,6 +114,9 @@ const CONSTANT_LOG: &str = "participant,trial,design,first,second,answer,rt_s,se
     p1,9,constant,standard,comparison,comparison,0.6,3,0.49,1\n";
 
 proptest! {
+    // No regression files written next to the sources, as in tests/support/fuzz.rs.
+    #![proptest_config(ProptestConfig { failure_persistence: None, ..ProptestConfig::default() })]
+
     #[test]
     fn a_mutated_model_file_loads_or_is_refused_cleanly(
         edits in prop::collection::vec(edit(), 1..8),
