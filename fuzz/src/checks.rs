@@ -13,8 +13,7 @@ use sake_glug::device::csv_lane::{read_csv_lane, CsvLaneSpec};
 use sake_glug::device::midi_take::read_midi_take;
 use sake_glug::device::osc::{decode_osc, OscControl};
 use sake_glug::engine::config::{self, CEILING_DB};
-use sake_glug::engine::Quantity;
-use sake_glug::engine::{Constant, Control, DrainMode};
+use sake_glug::engine::{Constant, Control, DrainMode, Quantity};
 use sake_glug::offline::{Automation, Scene, MAX_DURATION_S};
 use sake_glug::plugin::parse_number;
 

@@ -13,9 +13,8 @@ use crate::device::midi_take::{read_midi_take, TakeError, TimedInput, MAX_TAKE_B
 use crate::engine::config;
 use crate::engine::{
     Constant, Control, ControlSource, ControlValues, Controls, Curve, DrainMode, ModelConfig,
-    PerControl, Preset, PresetValue, Quantity,
+    PerControl, Preset, PresetValue, Quantity, Range, ValueError,
 };
-use crate::engine::{Range, ValueError};
 use crate::model::{curve_points, Model};
 use crate::text::printable;
 

@@ -16,8 +16,9 @@ use nice_plug::prelude::*;
 
 use crate::device::midi::{MidiMap, MidiSetting};
 use crate::engine::config::{self, CEILING_DB};
-use crate::engine::{Constant, Control, ControlValues, DrainMode, ModelConfig, PerControl};
-use crate::engine::{Knob, Quantity};
+use crate::engine::{
+    Constant, Control, ControlValues, DrainMode, Knob, ModelConfig, PerControl, Quantity,
+};
 use crate::plugin::loaded_model::{saved_model, LoadedModel, MODEL_KEY, MODEL_NAME_KEY};
 use crate::plugin::osc_input::OscSettings;
 

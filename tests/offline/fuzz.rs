@@ -8,8 +8,7 @@ use proptest::prelude::*;
 
 use crate::support::fuzz::{self, any_number, toml_number};
 use sake_glug::engine::config;
-use sake_glug::engine::Range;
-use sake_glug::engine::{Constant, Control, Lane, Quantity};
+use sake_glug::engine::{Constant, Control, Lane, Quantity, Range};
 use sake_glug::offline::{Automation, Scene};
 
 /// Every numeric key of a scene, the table it sits in, and the range of its numbers: the

@@ -144,7 +144,6 @@ fn paired_text(analysis: &PairedAnalysis) -> String {
         .iter()
         .map(|name| printable(name).into_owned())
         .collect();
-    let names = &names;
     let mut text = format!(
         "{} trials, {} participant(s), {} stimuli\n\n",
         analysis.trials,
@@ -152,20 +151,22 @@ fn paired_text(analysis: &PairedAnalysis) -> String {
         names.len()
     );
     let diagonal = |i: usize, j: usize, value: String| if i == j { "-".into() } else { value };
-    text += &matrix_text("times the row was chosen over the column", names, |i, j| {
-        diagonal(i, j, analysis.counts[i][j].to_string())
-    });
-    text += &matrix_text("\nproportions", names, |i, j| {
+    text += &matrix_text(
+        "times the row was chosen over the column",
+        &names,
+        |i, j| diagonal(i, j, analysis.counts[i][j].to_string()),
+    );
+    text += &matrix_text("\nproportions", &names, |i, j| {
         diagonal(i, j, format!("{:.3}", analysis.proportions[i][j]))
     });
     text += &matrix_text(
         "\nz (proportions clipped to [1/2n, 1 − 1/2n])",
-        names,
+        &names,
         |i, j| format!("{:.3}", analysis.z[i][j]),
     );
     text += &matrix_text(
         "\npredicted proportions Φ(Sᵢ − Sⱼ)",
-        names,
+        &names,
         |i, j| diagonal(i, j, format!("{:.3}", analysis.predicted[i][j])),
     );
     text += "\nscale (Case V, lowest 0)\n";
