@@ -3,7 +3,7 @@
 //! pouring in follow mode. Beside each, measured in the same run: the memory limit (merely
 //! filling a buffer of the same length) and the same glug train synthesised unit by unit with
 //! NumPy (`benches/numpy_glug.py`, when a Python with NumPy is found: the project's `.venv`, then
-//! `python3`). Then the fit of a minute's recording by `sake_glug::fit` against SciPy's
+//! `python3`). Then the fit of a minute's recording by `sake_glug_fit` against SciPy's
 //! `curve_fit` of the same units (`render/fit.rs`, `benches/scipy_fit.py`).
 //!
 //! Criterion reports its own statistics; the lines the project quotes are printed after each
@@ -16,10 +16,9 @@ use std::process::Command;
 use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use sake_glug::engine::{UnitOnset, Voicing};
-use sake_glug::offline::{render_scene, RenderError, RenderObserver, Scene};
+use sake_glug_engine::{UnitOnset, Voicing};
+use sake_glug_render::{render_scene, RenderError, RenderObserver, Scene};
 
-#[cfg(feature = "fit")]
 #[path = "render/fit.rs"]
 mod fit;
 
@@ -113,7 +112,6 @@ fn bench(c: &mut Criterion) {
         println!("{line}");
         writeln!(report, "{line}").expect("a String takes any text");
     }
-    #[cfg(feature = "fit")]
     {
         let line = fit::fit_versus_scipy(c);
         println!("{line}");

@@ -14,7 +14,7 @@ use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use sake_glug::engine::{ControlValues, Controls, DrainMode, Engine, Lane, ModelConfig};
+use sake_glug_engine::{ControlValues, Controls, DrainMode, Engine, Lane, ModelConfig};
 
 const FS: f64 = 48_000.0;
 const BLOCK: usize = 4096;

@@ -1,14 +1,14 @@
 //! The fit of a minute's recording (issue 17): a 60 s, 25 kHz render of the default model held
 //! full at 135° (follow mode, 12 units a second) with noise 40 dB below the glugs, written as a
-//! WAV file and fitted by `sake_glug::fit` as `sake-glug fit` does; beside it, measured in the
+//! WAV file and fitted by `sake_glug_fit` as `sake-glug fit` does; beside it, measured in the
 //! same run, the same units fitted one by one by SciPy's `curve_fit` (`benches/scipy_fit.py`)
 //! from the starts `sake-glug fit` used, and how far the two fits lie apart.
 
 use std::path::Path;
 
 use criterion::Criterion;
-use sake_glug::fit::{fit_session, fit_units, Session, SessionFit, UnitFit};
-use sake_glug::offline::{render_scene_to_vec, Scene};
+use sake_glug_fit::{fit_session, fit_units, FitSession, SessionFit, UnitFit};
+use sake_glug_render::{render_scene_to_vec, Scene};
 
 use super::{best_of, python_with, run_timed_script};
 
@@ -21,7 +21,7 @@ const NOISE_DB: f64 = -40.0;
 pub fn fit_versus_scipy(c: &mut Criterion) -> String {
     let folder = tempfile::tempdir().expect("a temporary folder");
     let session_path = write_recording(folder.path());
-    let session = Session::load(&session_path).expect("the benchmark's session is valid");
+    let session = FitSession::load(&session_path).expect("the benchmark's session is valid");
     let fit = fit_session(&session).expect("the benchmark's recording fits");
     let mut group = c.benchmark_group("fit of a 60 s, 25 kHz recording");
     group.sample_size(10);

@@ -8,14 +8,14 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use sake_glug::device::axis::Axis;
-use sake_glug::device::csv_lane::{read_csv_lane, CsvLaneSpec};
-use sake_glug::device::midi_take::read_midi_take;
-use sake_glug::device::osc::{decode_osc, OscControl};
-use sake_glug::engine::config::{self, CEILING_DB};
-use sake_glug::engine::{Constant, Control, DrainMode, Quantity};
-use sake_glug::offline::{Automation, Scene, MAX_DURATION_S};
-use sake_glug::plugin::parse_number;
+use sake_glug_device::axis::Axis;
+use sake_glug_device::csv_lane::{read_csv_lane, CsvLaneSpec};
+use sake_glug_device::midi_take::read_midi_take;
+use sake_glug_device::osc::{decode_osc, OscControl};
+use sake_glug_engine::config::{self, CEILING_DB};
+use sake_glug_engine::{Constant, Control, DrainMode, Quantity};
+use sake_glug_plugin::parse_number;
+use sake_glug_render::{Automation, Scene, MAX_DURATION_S};
 
 use crate::clap_host::ClapInstance;
 

@@ -12,12 +12,12 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
-use sake_glug::analysis::{
-    analyze_constant_logs, analyze_paired_logs, constant_json, paired_json, FitOptions,
+use sake_glug_analysis::{
+    analyze_constant_logs, analyze_paired_logs, constant_json, paired_json, PsychometricOptions,
 };
-use sake_glug::engine::{Preset, PRESETS};
-use sake_glug::fit::{fit_session, Session};
-use sake_glug::offline::{
+use sake_glug_engine::{Preset, PRESETS};
+use sake_glug_fit::{fit_session, FitSession};
+use sake_glug_render::{
     render_scene, render_tables_until, Column, RenderError, RenderObserver, Scene, SceneError,
     StateRate, StateRow, TablesError, UnitRow,
 };
@@ -260,7 +260,7 @@ fn columns<'py, R>(
 #[pyfunction]
 fn fit(py: Python<'_>, session: PathBuf) -> PyResult<Bound<'_, PyAny>> {
     let fitted = py
-        .detach(|| Session::load(&session).and_then(|session| fit_session(&session)))
+        .detach(|| FitSession::load(&session).and_then(|session| fit_session(&session)))
         .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
     let liquids: serde_json::Map<String, serde_json::Value> = fitted
         .liquids
@@ -321,8 +321,8 @@ fn analyze_constant(
     seed: Option<u64>,
     lapse: Option<f64>,
 ) -> PyResult<Bound<'_, PyAny>> {
-    let defaults = FitOptions::default();
-    let options = FitOptions {
+    let defaults = PsychometricOptions::default();
+    let options = PsychometricOptions {
         resamples: resamples.unwrap_or(defaults.resamples),
         seed: seed.unwrap_or(defaults.seed),
         max_lapse: lapse.unwrap_or(defaults.max_lapse),

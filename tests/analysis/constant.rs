@@ -5,7 +5,7 @@ use std::fmt::Write;
 
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
-use sake_glug::analysis::{count_levels, fit_psychometric, FitOptions, POINT_PERCENTS};
+use sake_glug_analysis::{count_levels, fit_psychometric, PsychometricOptions, POINT_PERCENTS};
 use statrs::distribution::{Binomial, DiscreteCDF};
 
 use crate::{analyze, json_of};
@@ -50,7 +50,7 @@ fn coverage(studies: u64, resamples: usize) -> ([u64; 3], u64) {
     let mut covered = [0; 3];
     let mut fitted = 0;
     for study in 0..studies {
-        let options = FitOptions {
+        let options = PsychometricOptions {
             resamples,
             seed: 1_000_000 + study,
             max_lapse: 0.0,

@@ -3,7 +3,7 @@
 
 use std::fmt::Write;
 
-use sake_glug::analysis::{scale_paired, PairedTrial};
+use sake_glug_analysis::{scale_paired, PairedTrial};
 use statrs::distribution::{ContinuousCDF, Normal};
 
 use crate::{analyze, json_of};

@@ -3,7 +3,7 @@
 //! B of a pour are the same at every σ_A.
 
 use crate::support::pour_onsets;
-use sake_glug::engine::{ControlValues, Controls, Engine, ModelConfig, Pour, UnitOnset};
+use sake_glug_engine::{ControlValues, Controls, Engine, ModelConfig, Pour, UnitOnset};
 
 const FS: f64 = 48_000.0;
 
@@ -11,7 +11,7 @@ const FS: f64 = 48_000.0;
 /// 700 units at every V down past V0, where a(V) is 0.
 fn minute_of_units(config: ModelConfig) -> Vec<UnitOnset> {
     let config = ModelConfig {
-        drain: sake_glug::engine::DrainMode::Follow,
+        drain: sake_glug_engine::DrainMode::Follow,
         ..config
     };
     let controls = |sample: u64| ControlValues {
@@ -134,7 +134,7 @@ fn the_ceiling_holds_whatever_the_spread() {
 #[test]
 fn a_v0_of_its_own_silences_the_units_below_it_and_scales_those_above() {
     let own = ModelConfig {
-        silent_below: sake_glug::engine::SilentBelow::Ml(200.0),
+        silent_below: sake_glug_engine::SilentBelow::Ml(200.0),
         ..ModelConfig::default().deterministic()
     };
     let units = minute_of_units(own);

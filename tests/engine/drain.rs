@@ -2,8 +2,8 @@
 //! §12: with curves of its own, the same by those.
 
 use crate::support::{pour_onsets, tilt_only};
-use sake_glug::engine::curves::BottleCurves;
-use sake_glug::engine::{ControlValues, Curve, ModelConfig, Pour};
+use sake_glug_engine::curves::BottleCurves;
+use sake_glug_engine::{ControlValues, Curve, ModelConfig, Pour};
 
 /// `curve`'s default value at `tilt_deg`.
 fn default_at(curve: Curve, tilt_deg: f64) -> f64 {

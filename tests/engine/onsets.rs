@@ -1,7 +1,7 @@
 //! MODEL.md §4: one unit per pocket of glugging outflow, timed independently of the sample rate.
 
 use crate::support::{pour_onsets, tilt_only};
-use sake_glug::engine::{ControlValues, ModelConfig};
+use sake_glug_engine::{ControlValues, ModelConfig};
 
 fn default_pour(sample: u64, sample_rate: f64) -> ControlValues {
     let t = sample as f64 / sample_rate;

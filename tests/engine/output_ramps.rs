@@ -3,9 +3,9 @@
 //! sample: the same samples at every block size, through silence as well.
 
 use crate::support::{error_db, largest_step, reference_render, render_in_blocks};
-use sake_glug::engine::config::OUTPUT_RAMP_S;
-use sake_glug::engine::{ControlValues, Controls, Engine, Lane, ModelConfig};
-use sake_glug::offline::Scene;
+use sake_glug_engine::config::OUTPUT_RAMP_S;
+use sake_glug_engine::{ControlValues, Controls, Engine, Lane, ModelConfig};
+use sake_glug_render::Scene;
 
 const RATE: f64 = 48_000.0;
 /// Where the gain or the ceiling moves: a unit of the pour below rings there.

@@ -3,8 +3,8 @@
 //! the very same units: same sample, same sub-sample fraction, volume, amplitude and shape, bit
 //! for bit, over scenes that cross every kind of boundary, at any block size.
 
-use sake_glug::engine::{Engine, Pour, UnitOnset};
-use sake_glug::offline::{LaneBuffers, Scene};
+use sake_glug_engine::{Engine, Pour, UnitOnset};
+use sake_glug_render::{LaneBuffers, Scene};
 
 /// Steps and ramps of every input, refills, rest and submerged levels crossed both ways, follow
 /// mode, floods of onsets, pocket volumes that are not nice numbers, odd sample rates.

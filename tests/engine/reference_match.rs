@@ -8,8 +8,8 @@
 use crate::support::{
     error_db, reference_controls, reference_render, render_controls, render_in_blocks,
 };
-use sake_glug::engine::{ControlValues, ModelConfig};
-use sake_glug::offline::Scene;
+use sake_glug_engine::{ControlValues, ModelConfig};
+use sake_glug_render::Scene;
 
 fn assert_matches_reference(scene_text: &str, seconds: f64) {
     let scene = Scene::parse(scene_text).unwrap();
@@ -143,7 +143,7 @@ fn a_short_flood_is_started_by_the_contracts_caps() {
     )
     .unwrap();
     let len = 24_000;
-    let window = sake_glug::engine::synthesis::reference::evaluate(
+    let window = sake_glug_engine::synthesis::reference::evaluate(
         48_000.0,
         scene.config,
         &scene,
@@ -166,7 +166,7 @@ fn assert_controls_match(
     config: ModelConfig,
     vary: impl Fn(f64, &mut ControlValues, &mut f64),
 ) {
-    let fs = sake_glug::engine::Engine::new(sample_rate, config).sample_rate();
+    let fs = sake_glug_engine::Engine::new(sample_rate, config).sample_rate();
     let controls = move |sample: u64| {
         let mut values = ControlValues {
             tilt_deg: 135.0,

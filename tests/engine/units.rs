@@ -2,9 +2,9 @@
 //! (1 − c)·a(V); a(V) follows the paper's fit and is zero below ≈ 84 ml of 300.
 
 use rustfft::{num_complex::Complex, FftPlanner};
-use sake_glug::engine::pour::UnitShape;
-use sake_glug::engine::GRID;
-use sake_glug::engine::{
+use sake_glug_engine::pour::UnitShape;
+use sake_glug_engine::GRID;
+use sake_glug_engine::{
     AnchoredF32, Controls, DrainMode, Engine, Lane, ModelConfig, Synthesis, UnitOnset,
 };
 

@@ -2,7 +2,7 @@
 //! engine renders silence without walking the pour or the bank, and gives the very samples of a
 //! run that cannot take that shortcut; a unit sounds until −120 dB and is not computed after.
 
-use sake_glug::engine::{ControlValues, Controls, Engine, Lane, ModelConfig, GRID};
+use sake_glug_engine::{ControlValues, Controls, Engine, Lane, ModelConfig, GRID};
 
 const FS: f64 = 48_000.0;
 

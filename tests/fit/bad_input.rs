@@ -1,13 +1,13 @@
 //! Every bad input of a session refused with its file and key, or warned about.
 
-use sake_glug::fit::{fit_session, FitError, Session};
+use sake_glug_fit::{fit_session, FitError, FitSession};
 
 use super::*;
 
 fn session_error(folder: &Path, text: &str) -> String {
     let path = folder.join("session.toml");
     std::fs::write(&path, text).unwrap();
-    match Session::load(&path).and_then(|session| fit_session(&session)) {
+    match FitSession::load(&path).and_then(|session| fit_session(&session)) {
         Ok(_) => panic!("the session was accepted"),
         Err(error) => error.to_string(),
     }
@@ -88,7 +88,7 @@ fn a_rising_weight_log_is_refused_with_its_line() {
         point.0 = time;
     }
     write_weight(&folder.path().join("pour.csv"), &filling, 1.0);
-    let error = fit_session(&Session::load(&path).unwrap()).unwrap_err();
+    let error = fit_session(&FitSession::load(&path).unwrap()).unwrap_err();
     assert!(
         matches!(error, FitError::WeightLog { line: 3, .. }),
         "{error}"

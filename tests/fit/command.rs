@@ -182,7 +182,7 @@ fn a_good_session_writes_the_model_the_report_and_the_plot_and_the_model_renders
         ],
     );
     assert_refused(&output, 0, &[]);
-    sake_glug::model::Model::load(&model).expect("the fitted model is a model file");
+    sake_glug_model_file::ModelFile::load(&model).expect("the fitted model is a model file");
 }
 
 #[test]

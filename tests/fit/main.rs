@@ -8,9 +8,9 @@ mod round_trip;
 
 use std::path::{Path, PathBuf};
 
-use sake_glug::engine::{UnitOnset, Voicing};
-use sake_glug::fit::{fit_session, Session, SessionFit};
-use sake_glug::offline::{render_scene, BottleReport, RenderError, RenderObserver, Scene};
+use sake_glug_engine::{UnitOnset, Voicing};
+use sake_glug_fit::{fit_session, FitSession, SessionFit};
+use sake_glug_render::{render_scene, BottleReport, RenderError, RenderObserver, Scene};
 
 /// A render's samples, the engine's units and its volume 5 times a second (a scale's log).
 pub struct Rendered {
@@ -173,7 +173,7 @@ pub fn write_session(folder: &Path, capacity_ml: f64, takes: &[Take]) -> PathBuf
 
 /// Fits the session at `path`.
 pub fn fit(path: &Path) -> SessionFit {
-    let session = Session::load(path).expect("a valid session");
+    let session = FitSession::load(path).expect("a valid session");
     fit_session(&session).expect("the session fits")
 }
 

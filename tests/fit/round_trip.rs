@@ -1,8 +1,8 @@
 //! Known models rendered, fitted, and found again. Tolerances (MODEL.md §13): f within 2 %, c
 //! within 0.02, B within 15 %, outflow rates within 2 %, V0 within 5 ml.
 
-use sake_glug::fit::{write_fit, FitOutputs};
-use sake_glug::offline::Scene;
+use sake_glug_fit::{write_fit, FitOutputs};
+use sake_glug_render::Scene;
 
 use super::*;
 
@@ -135,9 +135,9 @@ fn a_known_model_at_two_tilts_comes_back() {
     );
     relative("pocket", estimate(&fit, 0, "bottle.pocket_ml"), 7.0, 0.1);
     let model = Scene::parse(&fit.liquids[0].model_toml).expect("the model is a scene");
-    let h = sake_glug::engine::Curve::Drain.of(&model.config.curves);
+    let h = sake_glug_engine::Curve::Drain.of(&model.config.curves);
     close("h(100°)", h.at(100.0), 0.5, 0.01);
-    let r = sake_glug::engine::Curve::Rest.of(&model.config.curves);
+    let r = sake_glug_engine::Curve::Rest.of(&model.config.curves);
     // The default rest curve's 0.083 at 100° (25 ml of 300), 0 at 135°.
     close("r(100°)", r.at(100.0), 0.0833, 0.01);
     close("r(135°)", r.at(135.0), 0.0, 0.01);

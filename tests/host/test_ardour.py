@@ -170,7 +170,7 @@ def as_the_plugin_plays(degrees, knob):
     """A value of Ardour's queue as the engine plays it. Ardour keeps it as a float and has the
     plugin normalise it (nice-plug's linear range, in f32); nice-plug turns the normalised value
     back into degrees in f32 and snaps it to the knob's step (in f32, Rust's rounding); the
-    engine plays the decimal the knob shows (src/plugin/params.rs, `exact`)."""
+    engine plays the decimal the knob shows (crates/plugin/src/params.rs, `exact`)."""
     f32 = np.float32
     low, high, step_text = knob
     plain = np.clip(f32(degrees), f32(low), f32(high))

@@ -43,7 +43,7 @@ SCENE_KEYS = {
     "B2": ("glug", "b2_per_s"),
 }
 
-# The IDs the plugin saves its parameters under (src/plugin/params.rs).
+# The IDs the plugin saves its parameters under (crates/plugin/src/params.rs).
 PARAMETER_IDS = {
     "Viscosity": "visc",
     "Pour time": "pour",

@@ -3,7 +3,7 @@
 use std::time::Duration;
 
 use crate::command::{files_in, sake_glug, sake_glug_within};
-use sake_glug::offline::{render_scene, render_scene_to_vec, RenderError, Scene};
+use sake_glug_render::{render_scene, render_scene_to_vec, RenderError, Scene};
 
 #[test]
 fn with_no_scene_it_renders_the_default_pour_to_pour_wav() {

@@ -4,8 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-use sake_glug::engine::{UnitOnset, Voicing};
-use sake_glug::offline::{
+use sake_glug_engine::{UnitOnset, Voicing};
+use sake_glug_render::{
     render_scene, render_to_files, Output, OutputError, OutputOptions, RenderError, RenderObserver,
     Scene, WavError,
 };

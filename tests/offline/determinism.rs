@@ -2,8 +2,8 @@
 
 use crate::support::render_in_blocks;
 use crate::support::BUSY_SCENE;
-use sake_glug::offline::render_scene_to_vec;
-use sake_glug::offline::Scene;
+use sake_glug_render::render_scene_to_vec;
+use sake_glug_render::Scene;
 
 #[test]
 fn block_size_never_changes_a_sample() {

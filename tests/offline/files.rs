@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use sake_glug::offline::{
+use sake_glug_render::{
     render_to_files, Output, OutputError, OutputOptions, RenderObserver, Scene,
 };
 

@@ -7,9 +7,9 @@
 use proptest::prelude::*;
 
 use crate::support::fuzz::{self, any_number, toml_number};
-use sake_glug::engine::config;
-use sake_glug::engine::{Constant, Control, Lane, Quantity, Range};
-use sake_glug::offline::{Automation, Scene};
+use sake_glug_engine::config;
+use sake_glug_engine::{Constant, Control, Lane, Quantity, Range};
+use sake_glug_render::{Automation, Scene};
 
 /// Every numeric key of a scene, the table it sits in, and the range of its numbers: the
 /// controls' and constants' from the engine's tables, and the scene's own.
@@ -126,7 +126,7 @@ fn assert_valid(scene: &Scene) -> Result<(), TestCaseError> {
     prop_assert!(config::SAMPLE_RATE_HZ.contains(scene.sample_rate as f64));
     prop_assert!(scene
         .duration_s
-        .is_none_or(|d| d > 0.0 && d <= sake_glug::offline::MAX_DURATION_S));
+        .is_none_or(|d| d > 0.0 && d <= sake_glug_render::MAX_DURATION_S));
     prop_assert!(in_range(&scene.lanes.tilt_deg, Control::Tilt.range()));
     prop_assert!(in_range(&scene.lanes.viscosity, Control::Viscosity.range()));
     prop_assert!(in_range(&scene.lanes.fill_percent, Control::Fill.range()));

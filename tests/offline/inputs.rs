@@ -7,9 +7,9 @@ use std::process::Command;
 use std::sync::mpsc;
 use std::time::Duration;
 
-use sake_glug::device::csv_lane::MAX_CSV_LANE_BYTES;
-use sake_glug::device::midi_take::MAX_TAKE_BYTES;
-use sake_glug::offline::{InputFile, InputFileError, Scene, SceneError, MAX_SCENE_BYTES};
+use sake_glug_device::csv_lane::MAX_CSV_LANE_BYTES;
+use sake_glug_device::midi_take::MAX_TAKE_BYTES;
+use sake_glug_render::{InputFile, InputFileError, Scene, SceneError, MAX_SCENE_BYTES};
 
 use crate::command::sake_glug_within;
 

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use crate::command::{files_in, sake_glug, sake_glug_within};
-use sake_glug::model::{Model, ModelError};
+use sake_glug_model_file::{ModelFile, ModelFileError};
 
 const MODEL: &str = "\
 viscosity_c = 0.3712
@@ -98,7 +98,7 @@ fn render_with_a_model_is_the_merged_scene_written_out_by_hand() {
     let built_in = render(path, &["render", "--model", "model.toml", "-o", "d.wav"]);
     std::fs::write(
         path.join("default.toml"),
-        format!("{}{MODEL}", sake_glug::offline::DEFAULT_SCENE),
+        format!("{}{MODEL}", sake_glug_render::DEFAULT_SCENE),
     )
     .unwrap();
     assert!(built_in == render(path, &["render", "default.toml", "-o", "e.wav"]));
@@ -120,9 +120,9 @@ fn a_model_holds_only_the_bottle_and_the_liquid() {
         ("[output]\ndrain = \"follow\"", "`output.drain`"),
         ("[glug]\nf1_hz_typo = 3.0", "`glug.f1_hz_typo`"),
     ] {
-        let error = Model::parse("m", text).unwrap_err();
+        let error = ModelFile::parse("m", text).unwrap_err();
         assert!(
-            matches!(error, ModelError::NotAModelKey { .. }),
+            matches!(error, ModelFileError::NotAModelKey { .. }),
             "{text}: {error:?}"
         );
         let message = error.to_string();
@@ -143,10 +143,10 @@ fn a_model_holds_only_the_bottle_and_the_liquid() {
         ("[glug]\nf1_hz = \"high\"", "`glug.f1_hz`"),
         ("f1_hz = ", "invalid model"),
     ] {
-        let message = Model::parse("m", text).unwrap_err().to_string();
+        let message = ModelFile::parse("m", text).unwrap_err().to_string();
         assert!(message.contains(expected), "{text}: {message}");
     }
-    let model = Model::parse("m", "viscosity_c = 1\n[glug]\nf2_hz = 310").unwrap();
+    let model = ModelFile::parse("m", "viscosity_c = 1\n[glug]\nf2_hz = 310").unwrap();
     assert_eq!(
         model.controls().viscosity,
         Some(1.0),

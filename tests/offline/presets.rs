@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use sake_glug::engine::{ControlValues, ModelConfig, Preset, PRESETS};
-use sake_glug::offline::Scene;
+use sake_glug_engine::{ControlValues, ModelConfig, Preset, PRESETS};
+use sake_glug_render::Scene;
 
 #[test]
 fn every_preset_file_is_the_presets_own_scene() {

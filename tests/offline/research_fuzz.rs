@@ -1,5 +1,5 @@
 //! Property-based fuzz tests for the files a researcher hands the product besides scenes: model
-//! files (`Model::parse`), study specs (`Spec::parse`), fit sessions (`Session::parse`) and study
+//! files (`ModelFile::parse`), study specs (`Spec::parse`), fit sessions (`FitSession::parse`) and study
 //! logs (`analyze_paired_logs`, `analyze_constant_logs`). The libFuzzer targets (fuzz/) cover the
 //! renderer's and the plugin's inputs; these parsers came later, so each is fuzzed here from a
 //! valid file, mutated: text replaced, inserted or removed at any place, with the bytes that break
@@ -14,10 +14,10 @@ use std::path::{Path, PathBuf};
 
 use proptest::prelude::*;
 
-use sake_glug::analysis::{analyze_constant_logs, analyze_paired_logs, FitOptions};
-use sake_glug::fit::Session;
-use sake_glug::model::Model;
-use sake_glug::study::Spec;
+use sake_glug_analysis::{analyze_constant_logs, analyze_paired_logs, PsychometricOptions};
+use sake_glug_fit::FitSession;
+use sake_glug_model_file::ModelFile;
+use sake_glug_study::Spec;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
@@ -122,7 +122,7 @@ proptest! {
         edits in prop::collection::vec(edit(), 1..8),
     ) {
         let text = mutate(&read("tests/fixtures/models/fitted.toml"), &edits);
-        if let Err(error) = Model::parse("fitted.toml", &text) {
+        if let Err(error) = ModelFile::parse("fitted.toml", &text) {
             assert_clean("model file", &error.to_string());
         }
     }
@@ -146,7 +146,7 @@ proptest! {
     ) {
         let folder = tempfile::tempdir().unwrap();
         let text = mutate(SESSION, &edits);
-        if let Err(error) = Session::parse(&text, &folder.path().join("session.toml")) {
+        if let Err(error) = FitSession::parse(&text, &folder.path().join("session.toml")) {
             assert_clean("fit session", &error.to_string());
         }
     }
@@ -161,7 +161,7 @@ proptest! {
         let base = if constant { CONSTANT_LOG } else { PAIRED_LOG };
         std::fs::write(&log, mutate(base, &edits)).unwrap();
         let refused = if constant {
-            let options = FitOptions { resamples: 20, ..FitOptions::default() };
+            let options = PsychometricOptions { resamples: 20, ..PsychometricOptions::default() };
             analyze_constant_logs(&[&log], &options).err()
         } else {
             analyze_paired_logs(&[&log]).err()
@@ -176,20 +176,20 @@ proptest! {
 /// are, so a refusal above is the edit's doing.
 #[test]
 fn the_bases_are_valid() {
-    Model::parse("fitted.toml", &read("tests/fixtures/models/fitted.toml")).unwrap();
+    ModelFile::parse("fitted.toml", &read("tests/fixtures/models/fitted.toml")).unwrap();
     for name in ["paired-waves", "viscosity-constant"] {
         let path = PathBuf::from(ROOT).join(format!("experiments/{name}.toml"));
         Spec::load(&path).unwrap();
     }
     let folder = tempfile::tempdir().unwrap();
-    Session::parse(SESSION, &folder.path().join("session.toml")).unwrap();
+    FitSession::parse(SESSION, &folder.path().join("session.toml")).unwrap();
     for (base, constant) in [(PAIRED_LOG, false), (CONSTANT_LOG, true)] {
         let log = folder.path().join("log.csv");
         std::fs::write(&log, base).unwrap();
         if constant {
-            let options = FitOptions {
+            let options = PsychometricOptions {
                 resamples: 20,
-                ..FitOptions::default()
+                ..PsychometricOptions::default()
             };
             analyze_constant_logs(&[&log], &options).unwrap();
         } else {

@@ -3,9 +3,9 @@
 
 use std::path::Path;
 
-use sake_glug::engine::curves::BottleCurves;
-use sake_glug::engine::{Curve, DrainMode, ModelConfig, SilentBelow};
-use sake_glug::offline::{Automation, Scene, SceneError};
+use sake_glug_engine::curves::BottleCurves;
+use sake_glug_engine::{Curve, DrainMode, ModelConfig, SilentBelow};
+use sake_glug_render::{Automation, Scene, SceneError};
 
 fn fixtures(kind: &str) -> Vec<(String, String)> {
     let directory = Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use sake_glug::study::{
+use sake_glug_study::{
     level_of, order_seed, plan_trials, render_stimuli, Design, Equalize, Spec, StudyError,
 };
 

@@ -6,9 +6,9 @@
 use std::fs;
 use std::path::Path;
 
-use sake_glug::engine::synthesis::reference;
-use sake_glug::engine::{Pour, UnitOnset, Voicing};
-use sake_glug::offline::{
+use sake_glug_engine::synthesis::reference;
+use sake_glug_engine::{Pour, UnitOnset, Voicing};
+use sake_glug_render::{
     csv_header, render_scene, render_tables, render_to_files, Output, OutputFormat, OutputOptions,
     RenderError, RenderObserver, Scene, StateRate, StateRow, UnitRow,
 };
@@ -52,7 +52,7 @@ fn read_table(path: &Path) -> (String, Vec<Vec<f64>>) {
     (head, rows)
 }
 
-fn values<R>(columns: &[sake_glug::offline::Column<R>], row: &R) -> Vec<f64> {
+fn values<R>(columns: &[sake_glug_render::Column<R>], row: &R) -> Vec<f64> {
     columns.iter().map(|column| (column.value)(row)).collect()
 }
 

@@ -5,7 +5,7 @@
 
 use crate::clap_host::{ClapInstance, ParamChange};
 use crate::host::TestHost;
-use sake_glug::engine::{ControlValues, Controls, Engine, Lane};
+use sake_glug_engine::{ControlValues, Controls, Engine, Lane};
 
 const RATE: f64 = 48_000.0;
 const TOTAL: usize = 96_000;

@@ -62,7 +62,7 @@ impl ClapInstance {
             request_process: Some(ignore),
             request_callback: Some(ignore),
         });
-        let entry = &sake_glug::plugin::clap_entry;
+        let entry = &sake_glug_plugin::clap_entry;
         unsafe {
             assert!((entry.init.unwrap())(c"".as_ptr()));
             let factory = (entry.get_factory.unwrap())(CLAP_PLUGIN_FACTORY_ID.as_ptr())

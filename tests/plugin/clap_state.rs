@@ -56,7 +56,7 @@ fn a_state_saved_before_state_versions_loads_with_the_same_values() {
     }
     let version: u8 = serde_json::from_str(now["fields"]["state_version"].as_str().unwrap())
         .expect("the version is saved");
-    assert_eq!(version, sake_glug::plugin::STATE_VERSION);
+    assert_eq!(version, sake_glug_plugin::STATE_VERSION);
 }
 
 #[test]
@@ -90,8 +90,8 @@ fn migration_brings_old_states_up_to_date_and_leaves_newer_ones_alone() {
     use nice_plug::prelude::PluginState;
     let mut old: PluginState = serde_json::from_slice(&fixture("v0-session.state")[8..]).unwrap();
     let params = serde_json::to_string(&old.params).unwrap();
-    sake_glug::plugin::migrate_state(&mut old);
-    let version = sake_glug::plugin::STATE_VERSION.to_string();
+    sake_glug_plugin::migrate_state(&mut old);
+    let version = sake_glug_plugin::STATE_VERSION.to_string();
     assert_eq!(old.fields.get("state_version"), Some(&version));
     assert_eq!(
         serde_json::to_string(&old.params).unwrap(),
@@ -100,6 +100,6 @@ fn migration_brings_old_states_up_to_date_and_leaves_newer_ones_alone() {
     );
     let mut newer = old.clone();
     newer.fields.insert("state_version".into(), "200".into());
-    sake_glug::plugin::migrate_state(&mut newer);
+    sake_glug_plugin::migrate_state(&mut newer);
     assert_eq!(newer.fields["state_version"], "200");
 }

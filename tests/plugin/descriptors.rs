@@ -57,7 +57,7 @@ fn fixed_text(field: &[c_char]) -> String {
 
 /// The one plugin's CLAP descriptor, as a host reads it from the factory.
 fn clap_descriptor() -> &'static clap_plugin_descriptor {
-    let entry = &sake_glug::plugin::clap_entry;
+    let entry = &sake_glug_plugin::clap_entry;
     unsafe {
         assert!((entry.init.unwrap())(c"".as_ptr()));
         let factory = (entry.get_factory.unwrap())(CLAP_PLUGIN_FACTORY_ID.as_ptr())
@@ -111,7 +111,7 @@ fn the_clap_descriptor_shows_no_placeholder_and_leaves_out_what_the_project_lack
 
 #[test]
 fn the_vst3_factory_shows_no_placeholder_and_leaves_the_contact_blank() {
-    let raw = sake_glug::plugin::GetPluginFactory() as *mut IPluginFactory;
+    let raw = sake_glug_plugin::GetPluginFactory() as *mut IPluginFactory;
     let factory = unsafe { ComPtr::from_raw(raw) }.expect("a factory");
     let mut info: PFactoryInfo = unsafe { std::mem::zeroed() };
     assert_eq!(unsafe { factory.getFactoryInfo(&mut info) }, kResultOk);

@@ -11,8 +11,8 @@ use std::path::Path;
 
 use crate::clap_host::ClapInstance;
 use crate::support::fuzz::{self, any_number};
-use sake_glug::device::midi::{CcDecoder, MidiMap};
-use sake_glug::engine::Control;
+use sake_glug_device::midi::{CcDecoder, MidiMap};
+use sake_glug_engine::Control;
 
 /// What each target feeds and asserts, shared with the libFuzzer targets.
 #[path = "../../fuzz/src/checks.rs"]

@@ -5,7 +5,7 @@
 use std::collections::{BTreeMap, VecDeque};
 
 use nice_plug::prelude::*;
-use sake_glug::SakeGlug;
+use sake_glug_plugin::SakeGlug;
 
 pub struct MockActivate;
 

@@ -4,8 +4,8 @@
 use std::sync::atomic::Ordering::Relaxed;
 
 use crate::host::{cc, note_on, Playhead, TestHost};
-use sake_glug::device::midi::{CcDecoder, MidiMap, Overrides};
-use sake_glug::engine::{Control, ControlValues, PerControl};
+use sake_glug_device::midi::{CcDecoder, MidiMap, Overrides};
+use sake_glug_engine::{Control, ControlValues, PerControl};
 
 /// A map with these CCs for tilt (MSB, LSB), viscosity and fill.
 fn map_of(channel: Option<u8>, [tilt, tilt_lsb, viscosity, fill]: [Option<u8>; 4]) -> MidiMap {

@@ -5,9 +5,9 @@
 use std::path::Path;
 
 use nice_plug::prelude::Param;
-use sake_glug::model::Model;
-use sake_glug::offline::{render_scene_to_vec, Scene};
-use sake_glug::plugin::{model_values, GlugParams, MODEL_KEY, MODEL_NAME_KEY};
+use sake_glug_model_file::ModelFile;
+use sake_glug_plugin::{model_values, GlugParams, MODEL_KEY, MODEL_NAME_KEY};
+use sake_glug_render::{render_scene_to_vec, Scene};
 
 use crate::clap_host::{ClapInstance, ParamChange};
 use crate::fuzz::checks::{assert_saved_state_valid, bytes_of, json_of};
@@ -21,9 +21,9 @@ const TILT_AT: u64 = 24_000;
 const SCENE: &str = "seed = 7\nduration_s = 2.0\n\
                      tilt_deg = [[0.0, 90.0], [0.5, 90.0], [0.5, 135.0]]\n";
 
-fn fitted() -> Model {
+fn fitted() -> ModelFile {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/models/fitted.toml");
-    Model::load(&path).unwrap()
+    ModelFile::load(&path).unwrap()
 }
 
 /// The state bytes of `instance` with a model's fields holding `name` and `text` as they are
@@ -38,7 +38,7 @@ fn with_model_fields(instance: &ClapInstance, name: &str, text: &str) -> Vec<u8>
 
 /// A new instance with `model` loaded as the editor loads it (its parameters through the host,
 /// its text into the state), the seed and tilt of [`SCENE`] set.
-fn loaded(model: &Model) -> ClapInstance {
+fn loaded(model: &ModelFile) -> ClapInstance {
     let instance = ClapInstance::new();
     for (param, value) in model_values(model, &GlugParams::default()) {
         instance.set_text(param.name(), &value.to_string());
@@ -121,7 +121,7 @@ fn a_bad_model_in_a_state_is_refused_and_changes_nothing() {
         "sample_rate = 48000",                         // a render setting
         "[curves]\ndrain = [[0.0, 0.0], [90.0, 0.5]]", // h(135°) is not 1
     ] {
-        assert!(Model::parse("bad", bad).is_err(), "{bad}");
+        assert!(ModelFile::parse("bad", bad).is_err(), "{bad}");
         instance.load(&with_model_fields(&other, "bad", bad));
         assert_eq!(instance.save(), before, "{bad:?} changed the state");
     }

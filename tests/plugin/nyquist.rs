@@ -8,7 +8,7 @@
 use nice_plug::prelude::Plugin;
 
 use crate::host::{peak, TestHost};
-use sake_glug::plugin::{Feed, RealtimeEngine, Settings};
+use sake_glug_plugin::{Feed, RealtimeEngine, Settings};
 
 const RATES: [f32; 10] = [
     1_000.0, 8_000.0, 22_050.0, 44_100.0, 48_000.0, 88_200.0, 96_000.0, 192_000.0, 384_000.0,

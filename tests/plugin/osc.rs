@@ -11,10 +11,10 @@ use rosc::{OscMessage, OscPacket, OscType};
 
 use crate::clap_host::ClapInstance;
 use crate::host::{peak, TestHost};
-use sake_glug::device::{Axis, LiveControls, LiveReader};
-use sake_glug::engine::Control;
-use sake_glug::plugin::{OscStatus, DEFAULT_OSC_INTERFACE};
-use sake_glug::SakeGlug;
+use sake_glug_device::{Axis, LiveControls, LiveReader};
+use sake_glug_engine::Control;
+use sake_glug_plugin::SakeGlug;
+use sake_glug_plugin::{OscStatus, DEFAULT_OSC_INTERFACE};
 
 const RATE: f32 = 48_000.0;
 

@@ -4,11 +4,11 @@
 use rosc::encoder::encode;
 use rosc::{OscBundle, OscMessage, OscPacket, OscTime, OscType};
 
-use sake_glug::device::axis::Axis;
-use sake_glug::device::osc::{
+use sake_glug_device::axis::Axis;
+use sake_glug_device::osc::{
     decode_osc, OscControl, OscError, Pointing, GRAVITY_SOURCES, MAX_BUNDLE_DEPTH,
 };
-use sake_glug::engine::Control;
+use sake_glug_engine::Control;
 
 fn message(address: &str, args: Vec<OscType>) -> OscPacket {
     OscPacket::Message(OscMessage {

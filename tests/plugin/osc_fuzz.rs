@@ -10,8 +10,8 @@ use proptest::prelude::*;
 use crate::support::fuzz::{edits, mutate};
 use rosc::{OscBundle, OscMessage, OscPacket, OscTime, OscType};
 
-use sake_glug::device::axis::Axis;
-use sake_glug::device::osc::{decode_osc, OscControl, GRAVITY_SOURCES};
+use sake_glug_device::axis::Axis;
+use sake_glug_device::osc::{decode_osc, OscControl, GRAVITY_SOURCES};
 
 /// A packet with every address, nested, as a phone app might send it.
 fn valid_osc() -> Vec<u8> {

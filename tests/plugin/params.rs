@@ -5,10 +5,10 @@ use std::sync::Arc;
 
 use crate::host::TestHost;
 use nice_plug::prelude::*;
-use sake_glug::engine::config;
-use sake_glug::engine::config::CEILING_DB;
-use sake_glug::engine::{Constant, Control};
-use sake_glug::plugin::GlugParams;
+use sake_glug_engine::config;
+use sake_glug_engine::config::CEILING_DB;
+use sake_glug_engine::{Constant, Control};
+use sake_glug_plugin::GlugParams;
 
 const MAIN_IDS: [&str; 5] = ["tilt", "visc", "fill", "pour", "gain"];
 const MODEL_IDS: [&str; 12] = [
@@ -124,6 +124,6 @@ fn the_engine_gets_the_decimal_the_host_typed() {
     assert_eq!(model.frequency_hz[0], 81.7);
     assert_eq!(model.decay_per_s[1], 38.9);
     assert_eq!(model.seed, 7);
-    assert_eq!(model.drain, sake_glug::engine::DrainMode::Follow);
+    assert_eq!(model.drain, sake_glug_engine::DrainMode::Follow);
     assert_eq!(model.ceiling, 10f64.powf(-6.0 / 20.0));
 }

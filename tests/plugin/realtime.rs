@@ -89,14 +89,14 @@ fn process_does_not_allocate_under_a_busy_session() {
 /// OSC arriving from a socket thread while `process()` runs: the audio thread only reads atomics.
 #[test]
 fn process_does_not_allocate_while_osc_arrives() {
-    let plugin = sake_glug::SakeGlug::default();
+    let plugin = sake_glug_plugin::SakeGlug::default();
     let socket = std::net::UdpSocket::bind("127.0.0.1:0").expect("a free port");
     let port = socket.local_addr().expect("its address").port();
     drop(socket);
     plugin
         .glug_params()
         .osc
-        .set(port, sake_glug::device::Axis::PlusY);
+        .set(port, sake_glug_device::Axis::PlusY);
     plugin.osc().allow(port);
     let mut host = TestHost::with_plugin(plugin, 48_000.0, 2);
     host.guard = no_alloc;

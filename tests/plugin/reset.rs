@@ -6,8 +6,8 @@ use nice_plug::prelude::Plugin;
 
 use crate::host::{cc, note_on, peak, Playhead, TestHost};
 use crate::support::largest_step;
-use sake_glug::engine::{Controls, Engine};
-use sake_glug::plugin::FADE_S;
+use sake_glug_engine::{Controls, Engine};
+use sake_glug_plugin::FADE_S;
 
 const RATE: f32 = 48_000.0;
 

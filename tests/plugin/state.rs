@@ -6,7 +6,7 @@ use serde_json::json;
 
 use crate::clap_host::ClapInstance;
 use crate::fuzz::checks::{assert_saved_state_valid, bytes_of, float_quantity, json_of};
-use sake_glug::engine::config;
+use sake_glug_engine::config;
 
 /// Every parameter, by the name a host lists, with a value other than its default.
 const CHANGED: [(&str, &str); 17] = [

@@ -5,9 +5,9 @@
 use midly::num::{u15, u24, u28, u4, u7};
 use midly::{Format, Header, MetaMessage, MidiMessage, Smf, Timing, TrackEvent, TrackEventKind};
 use nice_plug::prelude::*;
-use sake_glug::device::midi::{MidiInput, MidiMap};
-use sake_glug::offline::{render_scene_to_vec, Scene};
-use sake_glug::SakeGlug;
+use sake_glug_device::midi::{MidiInput, MidiMap};
+use sake_glug_plugin::SakeGlug;
+use sake_glug_render::{render_scene_to_vec, Scene};
 
 use crate::host::{Playhead, TestHost};
 

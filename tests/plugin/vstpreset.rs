@@ -26,10 +26,10 @@
 use std::path::{Path, PathBuf};
 
 use nice_plug::prelude::Vst3Plugin;
-use sake_glug::engine::{Knob, PresetValue};
-use sake_glug::engine::{Preset, PRESETS};
-use sake_glug::plugin::exact;
-use sake_glug::SakeGlugVst3;
+use sake_glug_engine::{Knob, PresetValue};
+use sake_glug_engine::{Preset, PRESETS};
+use sake_glug_plugin::exact;
+use sake_glug_plugin::SakeGlugVst3;
 
 use crate::clap_host::ClapInstance;
 

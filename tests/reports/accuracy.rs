@@ -4,7 +4,7 @@
 
 use std::ops::Range;
 
-use sake_glug::reports::accuracy::{self, Case, SynthesisPath};
+use sake_glug_reports::accuracy::{self, Case, SynthesisPath};
 
 const FS: f64 = 48_000.0;
 

@@ -1,8 +1,8 @@
 //! The stability cases of `sake-glug stability` at test lengths (seconds; ten minutes for the
 //! long render): every case must pass every check it states. See docs/stability.md.
 
-use sake_glug::engine::{AnchoredF32, Synthesis, UnitOnset};
-use sake_glug::reports::stability::{Outcome, Property, Scale, StabilityCase};
+use sake_glug_engine::{AnchoredF32, Synthesis, UnitOnset};
+use sake_glug_reports::stability::{Outcome, Property, Scale, StabilityCase};
 
 fn assert_all_pass(outcomes: Vec<Outcome>) {
     assert!(!outcomes.is_empty());
@@ -150,8 +150,8 @@ fn a_nan_in_a_unit_fails_the_suite() {
 /// 1 kHz a 4096-sample block outlasts every unit, so a count taken at block ends reads 0.
 #[test]
 fn the_peak_voice_count_is_counted_where_it_happens() {
-    use sake_glug::engine::{ControlValues, Controls, Engine, ModelConfig};
-    use sake_glug::reports::timing::{self, RenderSpec};
+    use sake_glug_engine::{ControlValues, Controls, Engine, ModelConfig};
+    use sake_glug_reports::timing::{self, RenderSpec};
     let fs = 1_000.0;
     let controls = |sample: u64| {
         let tilt_deg = if sample < 1_000 { 135.0 } else { 0.0 };

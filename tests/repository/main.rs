@@ -1,6 +1,6 @@
 //! No pointer to nowhere: every repository path that README.md, docs/*.md and the comments of the
-//! code name exists, every `--test`, `--bench` and `--bin` names a target of Cargo.toml, and the
-//! README's map of the code ("How it is built") puts every source file of `src/` where it is.
+//! code name exists, every `--test`, `--bench` and `--bin` names a target of a manifest, and the
+//! map of the code (docs/code-map.md) puts every source file of `src/` and `crates/` where it is.
 //!
 //! It reads files only, so it needs none of the crate's features.
 
@@ -10,8 +10,9 @@ use std::path::{Path, PathBuf};
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// How a repository path starts: one of the top-level folders, or it is a top-level file.
-const FOLDERS: [&str; 10] = [
+const FOLDERS: [&str; 11] = [
     "src/",
+    "crates/",
     "fuzz/",
     "tests/",
     "docs/",
@@ -31,7 +32,7 @@ const FILES: [&str; 5] = [
 ];
 
 /// The folders whose Rust sources' comments are read.
-const CODE: [&str; 4] = ["src", "tests", "benches", "xtask"];
+const CODE: [&str; 6] = ["src", "crates", "tests", "benches", "xtask", "python/src"];
 
 /// A line of prose: the file it is in (relative to the root), its number, its text.
 struct Line {
@@ -73,18 +74,31 @@ fn every_repository_path_named_exists() {
 
 #[test]
 fn every_cargo_target_named_exists() {
-    let manifest: toml::Table = std::fs::read_to_string(Path::new(ROOT).join("Cargo.toml"))
-        .expect("Cargo.toml")
-        .parse()
-        .expect("Cargo.toml is TOML");
+    // The root manifest and every crate's: a `--bin` may be the plugin crate's app.
+    let manifests: Vec<toml::Table> = std::iter::once(PathBuf::from("Cargo.toml"))
+        .chain(
+            std::fs::read_dir(Path::new(ROOT).join("crates"))
+                .expect("crates/")
+                .map(|entry| entry.expect("a crate").path().join("Cargo.toml")),
+        )
+        .map(|path| {
+            std::fs::read_to_string(Path::new(ROOT).join(&path))
+                .unwrap_or_else(|error| panic!("{}: {error}", path.display()))
+                .parse()
+                .unwrap_or_else(|error| panic!("{}: {error}", path.display()))
+        })
+        .collect();
     let (mut stale, mut checked) = (Vec::new(), 0);
     for line in prose() {
         for (kind, name) in targets_in(&line.text) {
             checked += 1;
-            let known = target_names(&manifest, kind);
+            let known: Vec<String> = manifests
+                .iter()
+                .flat_map(|manifest| target_names(manifest, kind))
+                .collect();
             if !known.contains(&name.to_owned()) {
                 stale.push(format!(
-                    "{}:{}: `--{kind} {name}` names no [[{kind}]] of Cargo.toml ({})",
+                    "{}:{}: `--{kind} {name}` names no [[{kind}]] of a manifest ({})",
                     line.file,
                     line.number,
                     known.join(", ")
@@ -102,14 +116,17 @@ fn every_cargo_target_named_exists() {
 }
 
 #[test]
-fn the_readme_map_puts_every_source_file_where_it_is() {
-    let map = readme_map();
+fn the_code_map_puts_every_source_file_where_it_is() {
+    let map = code_map();
     assert!(map.len() > 10, "the map was not found: the scan is broken");
     let mut wrong = Vec::new();
-    // Each file of src/ is named by the deepest entry that holds it: its own line, or its
-    // folder's, whose text lists it. A folder's `mod.rs` is its front door, which the map's
-    // preamble names once for all.
-    for file in files_under("src", "rs") {
+    // Each file of src/ and crates/ is named by the deepest entry that holds it: its own line,
+    // or its folder's, whose text lists it. A folder's `mod.rs` is its front door, which the
+    // map's preamble names once for all.
+    let sources = files_under("src", "rs")
+        .into_iter()
+        .chain(files_under("crates", "rs"));
+    for file in sources {
         let file = file.display().to_string();
         let Some(entry) = map
             .iter()
@@ -124,7 +141,7 @@ fn the_readme_map_puts_every_source_file_where_it_is() {
         let name = file.rsplit('/').next().unwrap_or(&file);
         if entry.path != file && name != "mod.rs" && !entry.names().any(|named| named == name) {
             wrong.push(format!(
-                "{file}: README.md:{} ({}) does not name {name}",
+                "{file}: {MAP}:{} ({}) does not name {name}",
                 entry.line, entry.path
             ));
         }
@@ -138,7 +155,7 @@ fn the_readme_map_puts_every_source_file_where_it_is() {
                 .any(|file| file.file_name().is_some_and(|file| file == named));
             if !here {
                 wrong.push(format!(
-                    "README.md:{}: {named} is not in {}",
+                    "{MAP}:{}: {named} is not in {}",
                     entry.line, entry.path
                 ));
             }
@@ -146,13 +163,16 @@ fn the_readme_map_puts_every_source_file_where_it_is() {
     }
     assert!(
         wrong.is_empty(),
-        "the README's map of the code is wrong in {} places:\n{}",
+        "the map of the code ({MAP}) is wrong in {} places:\n{}",
         wrong.len(),
         wrong.join("\n")
     );
 }
 
-/// One entry of the README's map of `src/`: a folder (ending in `/`) or a file, the line it
+/// The map of the code.
+const MAP: &str = "docs/code-map.md";
+
+/// One entry of the map of `src/` and `crates/`: a folder (ending in `/`) or a file, the line it
 /// starts on, and its text with the lines that continue it.
 struct MapEntry {
     path: String,
@@ -173,16 +193,16 @@ impl MapEntry {
     }
 }
 
-/// The entries of the README's map under `src/`: the fenced block after "## How it is built",
+/// The entries of the map under `src/` and `crates/`: the fenced block after "## The map",
 /// where a top-level entry starts in the first column, an entry inside a folder's two spaces in,
 /// and a line further in continues the entry above.
-fn readme_map() -> Vec<MapEntry> {
-    let readme = read(Path::new("README.md"));
-    let lines: Vec<&str> = readme.lines().collect();
+fn code_map() -> Vec<MapEntry> {
+    let map = read(Path::new(MAP));
+    let lines: Vec<&str> = map.lines().collect();
     let heading = lines
         .iter()
-        .position(|line| *line == "## How it is built")
-        .expect("README.md has a \"## How it is built\" section");
+        .position(|line| *line == "## The map")
+        .expect("the code map has a \"## The map\" section");
     let fence = heading
         + lines[heading..]
             .iter()
@@ -222,7 +242,7 @@ fn readme_map() -> Vec<MapEntry> {
             text: rest.trim().to_owned(),
         });
     }
-    entries.retain(|entry| entry.path.starts_with("src/"));
+    entries.retain(|entry| entry.path.starts_with("src/") || entry.path.starts_with("crates/"));
     entries
 }
 
@@ -329,7 +349,7 @@ fn targets_in(text: &str) -> Vec<(&'static str, &str)> {
     named
 }
 
-/// The names of Cargo.toml's `[[kind]]` targets.
+/// The names of a manifest's `[[kind]]` targets.
 fn target_names(manifest: &toml::Table, kind: &str) -> Vec<String> {
     manifest
         .get(kind)

@@ -3,13 +3,13 @@
 
 pub mod fuzz;
 
-use sake_glug::engine::synthesis::reference;
-use sake_glug::engine::{
+use sake_glug_engine::synthesis::reference;
+use sake_glug_engine::{
     AnchoredF32, ControlSource, ControlValues, Engine, ModelConfig, Pour, UnitOnset,
 };
-use sake_glug::offline::{LaneBuffers, Scene};
-use sake_glug::reports::accuracy;
-use sake_glug::reports::timing::{self, RenderSpec};
+use sake_glug_render::{LaneBuffers, Scene};
+use sake_glug_reports::accuracy;
+use sake_glug_reports::timing::{self, RenderSpec};
 
 /// Renders `len` samples of `scene` on the default path, cutting time into blocks of the sizes
 /// `block_sizes` yields (cycled).

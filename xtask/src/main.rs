@@ -82,7 +82,7 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             cargo(&["test", "--workspace", "--no-fail-fast", "--all-features"])?;
             build_bundles()?;
             // Built once, with what the host tests need of it: a study played on JACK and ALSA.
-            build_cli_with("cli,audio")?;
+            build_cli_with("ogg,audio")?;
             build_standalone()?;
             host_tests()?;
             python_tests()
@@ -131,15 +131,7 @@ fn build_bundles_and_cli() -> nice_plug_xtask::Result<()> {
 fn build_bundles() -> nice_plug_xtask::Result<()> {
     nice_plug_xtask::main_with_args(
         "cargo xtask",
-        [
-            "bundle",
-            "sake_glug",
-            "--release",
-            "--no-default-features",
-            "--features",
-            "editor",
-        ]
-        .map(String::from),
+        ["bundle", "sake-glug-plugin", "--release"].map(String::from),
     )
 }
 
@@ -196,17 +188,18 @@ fn build_standalone() -> nice_plug_xtask::Result<()> {
     cargo(&[
         "build",
         "--release",
+        "--package",
+        "sake-glug-plugin",
         "--bin",
         "sake-glug-standalone",
-        "--no-default-features",
         "--features",
         "standalone",
     ])
 }
 
-/// The release command line alone, with only its features.
+/// The release command line alone, with its default features.
 fn build_cli() -> nice_plug_xtask::Result<()> {
-    build_cli_with("cli")
+    build_cli_with("ogg")
 }
 
 /// The release command line with `features`.
@@ -214,9 +207,10 @@ fn build_cli_with(features: &str) -> nice_plug_xtask::Result<()> {
     cargo(&[
         "build",
         "--release",
+        "--package",
+        "sake-glug",
         "--bin",
         "sake-glug",
-        "--no-default-features",
         "--features",
         features,
     ])

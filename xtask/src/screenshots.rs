@@ -27,7 +27,7 @@ const TOOLS: [(&str, &str); 3] = [
     ("import", "imagemagick"),
 ];
 
-/// The editor window's title (`EguiNiceSettings::with_tile` in src/plugin/editor/mod.rs).
+/// The editor window's title (`EguiNiceSettings::with_tile` in crates/plugin/src/editor/mod.rs).
 const WINDOW_TITLE: &str = "^Sake Glug$";
 
 /// The tilt of the pouring shot, in degrees: where MODEL.md's pour time is defined.
@@ -37,7 +37,7 @@ const POUR_TILT_DEG: f32 = 135.0;
 /// about 90 ms after it, so by then the scope's 0.6 s shows several.
 const POUR_SHOT_AFTER: Duration = Duration::from_millis(800);
 
-/// The scope's trace colour (src/plugin/editor/scope.rs) and how far a pixel may be from it
+/// The scope's trace colour (crates/plugin/src/editor/scope.rs) and how far a pixel may be from it
 /// (anti-aliasing) to count as trace.
 const TRACE_RGB: [u8; 3] = [120, 200, 255];
 const TRACE_TOLERANCE: u8 = 40;
@@ -250,7 +250,7 @@ fn osc_port() -> anyhow::Result<u16> {
 
 /// GyrOSC's `/gyrosc/grav x y z` for a phone whose +y axis points from the bottle's base to its
 /// mouth, the bottle tilted `tilt_deg` from upright in the phone's y–z plane. GyrOSC reports
-/// gravity pointing to the earth (src/device/osc.rs), so upright reads (0, −1, 0).
+/// gravity pointing to the earth (crates/device/src/osc.rs), so upright reads (0, −1, 0).
 fn gravity_message(tilt_deg: f32) -> rosc::OscMessage {
     let (sin, cos) = tilt_deg.to_radians().sin_cos();
     rosc::OscMessage {

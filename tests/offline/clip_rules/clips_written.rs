@@ -6,10 +6,10 @@ use std::f64::consts::TAU;
 use std::io::Write;
 
 use super::{ahap, haptic};
-use sake_glug::offline::clips::{
+use sake_glug_render::clips::{
     envelope_at, envelope_breakpoints, is_audible, BandParseError, ClipSource, Glug, HapticBand,
 };
-use sake_glug::offline::sinks::{
+use sake_glug_render::sinks::{
     ahap_json, draw_pour_plot, haptic_json, write_csv_samples, PlotData, PlotError, Waveform,
 };
 

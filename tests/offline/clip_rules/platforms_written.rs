@@ -4,9 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use sake_glug::offline::sinks::DUALSENSE_RATE_HZ;
-use sake_glug::offline::steps::ANDROID_STEP_MS;
-use sake_glug::offline::{render_to_files, Output, OutputFormat, OutputOptions, Scene};
+use sake_glug_render::sinks::DUALSENSE_RATE_HZ;
+use sake_glug_render::steps::ANDROID_STEP_MS;
+use sake_glug_render::{render_to_files, Output, OutputFormat, OutputOptions, Scene};
 
 use super::{android_ogg, android_waveform, android_xml, dualsense, haps, rumble};
 use crate::clips_rendered::{engine_units, onset_s, SCENE};
@@ -245,7 +245,7 @@ fn one_command_writes_every_platform_file() {
 /// the envelope of each clip format within a few dB.
 #[test]
 fn the_fidelity_report_measures_every_format_within_its_step() {
-    use sake_glug::offline::fidelity::measure;
+    use sake_glug_render::fidelity::measure;
     let scene = Scene::parse(SCENE).unwrap();
     let rows = measure(&scene, "pour", &OutputOptions::default()).unwrap();
     let step_ms = |format: OutputFormat| match format.name() {

@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use sake_glug::device::axis::Axis;
-use sake_glug::device::csv_lane::{read_csv_lane, CsvFault, CsvLaneError, CsvLaneSpec};
+use sake_glug_device::axis::Axis;
+use sake_glug_device::csv_lane::{read_csv_lane, CsvFault, CsvLaneError, CsvLaneSpec};
 
 fn fixtures(kind: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

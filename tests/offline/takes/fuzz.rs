@@ -12,9 +12,9 @@ use proptest::prelude::*;
 
 use crate::support::fuzz::{edits, mutate};
 
-use sake_glug::device::axis::Axis;
-use sake_glug::device::csv_lane::{read_csv_lane, CsvLaneSpec};
-use sake_glug::device::midi_take::read_midi_take;
+use sake_glug_device::axis::Axis;
+use sake_glug_device::csv_lane::{read_csv_lane, CsvLaneSpec};
+use sake_glug_device::midi_take::read_midi_take;
 
 /// A format 1 take with a tempo map, CCs, note-ons and a note-off.
 fn valid_midi() -> Vec<u8> {

@@ -6,8 +6,8 @@ use midly::{
 };
 use proptest::prelude::*;
 
-use sake_glug::device::midi::MidiInput;
-use sake_glug::device::midi_take::{read_midi_take, TakeError, TimedInput, MAX_TAKE_SECONDS};
+use sake_glug_device::midi::MidiInput;
+use sake_glug_device::midi_take::{read_midi_take, TakeError, TimedInput, MAX_TAKE_SECONDS};
 
 /// A file of `tracks`, each a list of (delta ticks, event), End of Track added.
 fn smf(format: Format, timing: Timing, tracks: &[Vec<(u32, TrackEventKind<'static>)>]) -> Vec<u8> {

@@ -3,7 +3,7 @@
 //! for; a malformed take is refused with its file, line and column, and nothing is written.
 
 use crate::command::sake_glug;
-use sake_glug::offline::{render_scene_to_vec, Scene, SceneError};
+use sake_glug_render::{render_scene_to_vec, Scene, SceneError};
 
 fn render(scene: &Scene) -> Vec<f32> {
     render_scene_to_vec(scene).unwrap().0

@@ -1,0 +1,184 @@
+//! The analyses' figures: the Thurstone scale on a line (the paper's fig. 2) and the fitted
+//! psychometric function over the proportions (fig. 5). Drawn into a temporary file beside the
+//! target and renamed over it once complete, so a failed plot leaves nothing.
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use super::constant::{ConstantAnalysis, POINT_PERCENTS};
+use super::error::AnalysisError;
+use super::paired::PairedAnalysis;
+use sake_glug_io::temp::temp_file_builder;
+
+const SIZE_PX: (u32, u32) = (1000, 620);
+const FONT: &str = "sans-serif";
+
+/// Draws `draw` into a PNG at `path`, all or nothing.
+fn write_png(
+    path: &Path,
+    draw: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), AnalysisError> {
+    plotters::style::register_font(FONT, FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT)
+        .map_err(|_| AnalysisError::plot(path, "the embedded font did not load"))?;
+    if path.is_dir() {
+        return Err(AnalysisError::plot(path, "it is a folder"));
+    }
+    let folder = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    let temp = temp_file_builder()
+        .prefix(".sake-glug-analysis-")
+        .suffix(".tmp.png")
+        .tempfile_in(folder)
+        .map_err(|error| AnalysisError::plot(path, error))?;
+    draw(temp.path()).map_err(|message| AnalysisError::plot(path, message))?;
+    temp.as_file()
+        .sync_all()
+        .map_err(|error| AnalysisError::plot(path, error))?;
+    temp.persist(path)
+        .map_err(|error| AnalysisError::plot(path, error.error))?;
+    Ok(())
+}
+
+/// The scale values on one line, each stimulus marked and named (fig. 2).
+pub fn draw_paired_plot(analysis: &PairedAnalysis, path: &Path) -> Result<(), AnalysisError> {
+    write_png(path, |file| {
+        let fail = |error: &dyn std::fmt::Display| error.to_string();
+        let root = BitMapBackend::new(file, (SIZE_PX.0, 300)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| fail(&e))?;
+        let top = analysis.scale.iter().copied().fold(0.0, f64::max).max(0.1);
+        let margin = 0.08 * top;
+        let mut chart = ChartBuilder::on(&root)
+            .margin(30)
+            .caption("Thurstone Case V scale", (FONT, 26))
+            .x_label_area_size(45)
+            .build_cartesian_2d(-margin..top + margin, -1.0..1.0)
+            .map_err(|e| fail(&e))?;
+        chart
+            .configure_mesh()
+            .disable_y_axis()
+            .disable_mesh()
+            .x_desc("scale value (standard deviations of the discriminal dispersion)")
+            .label_style((FONT, 16))
+            .axis_desc_style((FONT, 18))
+            .draw()
+            .map_err(|e| fail(&e))?;
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(0.0, 0.0), (top, 0.0)],
+                BLACK.stroke_width(2),
+            )))
+            .map_err(|e| fail(&e))?;
+        // Names alternate above and below the line, so close values stay legible.
+        for (index, (name, &value)) in analysis.stimuli.iter().zip(&analysis.scale).enumerate() {
+            let above = index % 2 == 0;
+            chart
+                .draw_series([PathElement::new(
+                    vec![(value, -0.15), (value, 0.15)],
+                    RED.stroke_width(3),
+                )])
+                .map_err(|e| fail(&e))?;
+            let label = format!("{name} ({value:.2})");
+            let y = if above { 0.45 } else { -0.45 };
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    label,
+                    (value, y),
+                    (FONT, 18).into_font().color(&BLACK),
+                )))
+                .map_err(|e| fail(&e))?;
+        }
+        root.present().map_err(|e| fail(&e))
+    })
+}
+
+/// The proportion "comparison chosen" per level, the pooled fitted curve, its 25/50/75 %
+/// points with their 95 % intervals, and each participant's curve in grey (fig. 5).
+pub fn draw_constant_plot(analysis: &ConstantAnalysis, path: &Path) -> Result<(), AnalysisError> {
+    write_png(path, |file| {
+        let fail = |error: &dyn std::fmt::Display| error.to_string();
+        let pooled = &analysis.pooled;
+        let (first, last) = (
+            pooled.levels.first().map_or(0.0, |l| l.level),
+            pooled.levels.last().map_or(1.0, |l| l.level),
+        );
+        let pad = 0.05 * (last - first);
+        let (low, high) = (first - pad, last + pad);
+        let root = BitMapBackend::new(file, SIZE_PX).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| fail(&e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .margin(25)
+            .caption(
+                "Psychometric function (logistic, maximum likelihood)",
+                (FONT, 26),
+            )
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(low..high, 0.0..1.0)
+            .map_err(|e| fail(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("comparison level")
+            .y_desc("proportion comparison chosen")
+            .label_style((FONT, 16))
+            .axis_desc_style((FONT, 18))
+            .draw()
+            .map_err(|e| fail(&e))?;
+        let curve_points = |curve: &super::Logistic| {
+            (0..=200)
+                .map(|step| low + (high - low) * f64::from(step) / 200.0)
+                .map(|x| (x, curve.probability(x)))
+                .collect::<Vec<_>>()
+        };
+        for (_, fit) in &analysis.participants {
+            if let Ok(fit) = fit {
+                chart
+                    .draw_series(LineSeries::new(
+                        curve_points(&fit.curve),
+                        RGBColor(200, 200, 200),
+                    ))
+                    .map_err(|e| fail(&e))?;
+            }
+        }
+        chart
+            .draw_series(LineSeries::new(
+                curve_points(&pooled.curve),
+                BLUE.stroke_width(3),
+            ))
+            .map_err(|e| fail(&e))?;
+        chart
+            .draw_series(
+                pooled
+                    .levels
+                    .iter()
+                    .map(|level| Circle::new((level.level, level.proportion()), 6, BLACK.filled())),
+            )
+            .map_err(|e| fail(&e))?;
+        for (percent, point) in POINT_PERCENTS.iter().zip(&pooled.points) {
+            let y = f64::from(*percent) / 100.0;
+            chart
+                .draw_series([
+                    PathElement::new(vec![(low, y), (high, y)], RED.mix(0.3)),
+                    PathElement::new(vec![(point.low, y), (point.high, y)], RED.stroke_width(3)),
+                    PathElement::new(
+                        vec![(point.value, y - 0.03), (point.value, y + 0.03)],
+                        RED.stroke_width(3),
+                    ),
+                ])
+                .map_err(|e| fail(&e))?;
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    format!(
+                        "{percent} %: {:.3} [{:.3}, {:.3}]",
+                        point.value, point.low, point.high
+                    ),
+                    (low + 0.02 * (high - low), y + 0.045),
+                    (FONT, 16).into_font().color(&RED),
+                )))
+                .map_err(|e| fail(&e))?;
+        }
+        root.present().map_err(|e| fail(&e))
+    })
+}

@@ -1,0 +1,182 @@
+//! The sounding components of a synthesis path, in a bank of fixed capacity allocated once, and
+//! the rules for letting new ones in (the caps of MODEL.md §11). Every path is a [`Bank`]
+//! and admits components the same way, so paths differ only in their [`BankComponent`]: how one
+//! component is rendered.
+
+use super::component::Component;
+use super::Synthesis;
+use crate::pour::UnitOnset;
+
+/// More components than this never sound at once. Past it, a new component replaces the weakest
+/// sounding one if it is louder, and is given up otherwise: a bottle pours a handful of units at
+/// a time, so this only bites in stress cases (B near 0, pocket volumes near zero).
+pub const MAX_COMPONENTS: usize = 256;
+/// The start budget holds at most this many units: a burst of this many may start at once.
+pub const START_BURST_UNITS: f64 = 8.0;
+/// The start budget refills by this many units per second of (onset) time: 500 times a real
+/// bottle's glug rate. Units beyond the budget are given up whole, before anything is computed:
+/// without it a flood of onsets (pour time and pocket volume at their minimums) costs a component
+/// start and a scan of the full bank per onset, and rendering falls far behind real time. Counted
+/// in time, not in samples, so the voicing does not depend on the sample rate.
+pub const STARTS_PER_SECOND: f64 = 6000.0;
+
+/// A component as one synthesis path renders it: what its [`Bank`] holds.
+pub trait BankComponent: Sized {
+    /// The component from its first sample on.
+    fn start(component: Component) -> Self;
+    /// Any measure that orders components by loudness.
+    fn level(&self) -> f64;
+    /// Moves to the grid period starting at `period_start`; false once the component is silent.
+    fn advance(&mut self, period_start: u64) -> bool;
+    /// Adds every component of a bank into `out`, which starts at absolute sample `span_start`
+    /// and lies within one grid period.
+    fn add_all(components: &mut [Self], span_start: u64, out: &mut [f32]);
+}
+
+/// The start budget of MODEL.md §11: a bucket of at most [`START_BURST_UNITS`] units that refills
+/// at [`STARTS_PER_SECOND`], judged at each unit's exact onset time.
+#[derive(Debug, Clone, Copy)]
+struct StartBudget {
+    units: f64,
+    /// Onset time (s since the reset) at which `units` was last brought up to date.
+    as_of_s: f64,
+}
+
+impl StartBudget {
+    const FULL: Self = Self {
+        units: START_BURST_UNITS,
+        as_of_s: 0.0,
+    };
+
+    /// Whether a unit with its onset at `time_s` may start; spends one unit of budget if so.
+    fn admit(&mut self, time_s: f64) -> bool {
+        let elapsed_s = (time_s - self.as_of_s).max(0.0);
+        self.units = (self.units + STARTS_PER_SECOND * elapsed_s).min(START_BURST_UNITS);
+        self.as_of_s = self.as_of_s.max(time_s);
+        if self.units >= 1.0 {
+            self.units -= 1.0;
+            true
+        } else {
+            false
+        }
+    }
+}
+
+/// A synthesis path: the sounding components of kind `C`, allocation-free after `new()`.
+pub struct Bank<C> {
+    sounding: Vec<C>,
+    sample_rate: f64,
+    /// Components given up because the bank was full or the start budget was spent (both
+    /// components of a unit refused by the budget count).
+    given_up: u64,
+    budget: StartBudget,
+    /// The most components that sounded at once since [`Synthesis::take_peak_len`] last read it.
+    peak_len: usize,
+}
+
+impl<C: BankComponent> Synthesis for Bank<C> {
+    fn new(sample_rate: f64) -> Self {
+        Self {
+            sounding: Vec::with_capacity(MAX_COMPONENTS),
+            sample_rate,
+            given_up: 0,
+            budget: StartBudget::FULL,
+            peak_len: 0,
+        }
+    }
+
+    fn clear(&mut self) {
+        self.sounding.clear();
+        self.given_up = 0;
+        self.budget = StartBudget::FULL;
+    }
+
+    fn is_empty(&self) -> bool {
+        self.sounding.is_empty()
+    }
+
+    fn len(&self) -> usize {
+        self.sounding.len()
+    }
+
+    fn given_up(&self) -> u64 {
+        self.given_up
+    }
+
+    fn take_peak_len(&mut self) -> usize {
+        let peak = self.peak_len.max(self.sounding.len());
+        self.peak_len = self.sounding.len();
+        peak
+    }
+
+    /// Starts the audible components of `onset` if the start budget admits the unit; a refused
+    /// unit is given up whole.
+    fn start_unit(&mut self, onset: &UnitOnset) -> bool {
+        let time_s = (onset.sample as f64 + onset.fraction) / self.sample_rate;
+        if !self.budget.admit(time_s) {
+            self.given_up += 2;
+            return false;
+        }
+        let mut sounds = false;
+        for index in 0..2 {
+            if let Some(component) = Component::of(onset, index, self.sample_rate) {
+                sounds |= self.insert(C::start(component));
+            }
+        }
+        sounds
+    }
+
+    #[inline]
+    fn synthesize(&mut self, span_start: u64, out: &mut [f32]) {
+        C::add_all(&mut self.sounding, span_start, out);
+    }
+
+    fn advance(&mut self, period_start: u64) {
+        self.sounding
+            .retain_mut(|component| component.advance(period_start));
+    }
+}
+
+impl<C: BankComponent> Bank<C> {
+    /// Lets `new` in; returns whether it sounds (it is given up if the bank is full of louder
+    /// components).
+    fn insert(&mut self, new: C) -> bool {
+        if self.sounding.len() < MAX_COMPONENTS {
+            self.sounding.push(new);
+            self.peak_len = self.peak_len.max(self.sounding.len());
+            return true;
+        }
+        self.given_up += 1;
+        let weakest = self
+            .sounding
+            .iter_mut()
+            .min_by(|a, b| a.level().total_cmp(&b.level()))
+            .expect("a full bank is not empty");
+        let louder = weakest.level() < new.level();
+        if louder {
+            *weakest = new;
+        }
+        louder
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_budget_admits_a_burst_then_the_rate() {
+        let mut budget = StartBudget::FULL;
+        let burst = (0..20).filter(|_| budget.admit(0.0)).count();
+        assert_eq!(burst, 8);
+        // A second later the bucket is full again, no fuller.
+        let next = (0..20).filter(|_| budget.admit(1.0)).count();
+        assert_eq!(next, 8);
+        // One unit's worth of time admits one unit (a binary fraction of a second, so the sum
+        // is exact), and not two.
+        let later = 1.0 + 1.0 / 4096.0;
+        const { assert!(STARTS_PER_SECOND / 4096.0 >= 1.0 && STARTS_PER_SECOND / 4096.0 < 2.0) };
+        assert!(budget.admit(later));
+        assert!(!budget.admit(later));
+    }
+}

@@ -1,0 +1,127 @@
+//! Why a fit was refused: every error names the file and, where it has one, the key, line or
+//! column at fault. A fit that cannot be made is an error, never a made-up model.
+
+use std::path::{Path, PathBuf};
+
+use sake_glug_io::text::printable;
+
+/// Why `sake-glug fit` could not fit a model.
+#[derive(Debug, thiserror::Error)]
+pub enum FitError {
+    /// The session file could not be read.
+    #[error("cannot read session file {}: {source}", shown(path))]
+    SessionRead {
+        /// The session file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// Not valid TOML, an unknown key or a value of the wrong type.
+    #[error("invalid session {}: {}", shown(path), printable(message))]
+    SessionSyntax {
+        /// The session file.
+        path: PathBuf,
+        /// The parser's message, with the key.
+        message: String,
+    },
+    /// A value of the session outside what the fit can use.
+    #[error("session {}: `{key}` = {value}: {why}", shown(path))]
+    SessionValue {
+        /// The session file.
+        path: PathBuf,
+        /// The key, with the recording's index (`recording[2].tilt_deg`).
+        key: String,
+        /// The value given.
+        value: f64,
+        /// What was expected.
+        why: &'static str,
+    },
+    /// The session names no recording.
+    #[error("session {} has no [[recording]]: nothing to fit", shown(path))]
+    NoRecording {
+        /// The session file.
+        path: PathBuf,
+    },
+    /// A recording's WAV file could not be opened or read.
+    #[error("`{key}`: cannot read WAV file {}: {source}", shown(path))]
+    Wav {
+        /// The key naming it (`recording[0].audio`).
+        key: String,
+        /// The file.
+        path: PathBuf,
+        /// hound's error (a missing file included).
+        source: hound::Error,
+    },
+    /// A recording sampled too slowly to show the glug's components.
+    #[error(
+        "`{key}`: {} is sampled at {rate} Hz, below the {min} Hz the fit needs",
+        shown(path)
+    )]
+    RateTooLow {
+        /// The key naming it.
+        key: String,
+        /// The file.
+        path: PathBuf,
+        /// Its rate (Hz).
+        rate: u32,
+        /// The lowest rate accepted (Hz).
+        min: u32,
+    },
+    /// A recording with nothing in it.
+    #[error(
+        "`{key}`: {} is silent (peak {peak:e} after its offset is removed)",
+        shown(path)
+    )]
+    Silent {
+        /// The key naming it.
+        key: String,
+        /// The file.
+        path: PathBuf,
+        /// Its peak after the DC offset is removed.
+        peak: f64,
+    },
+    /// A weight log that cannot be read: the file, line and column.
+    #[error("`{key}`: {}, line {line}{}: {what}", shown(path), column.as_ref().map(|c| format!(", column {:?}", printable(c))).unwrap_or_default())]
+    WeightLog {
+        /// The key naming it (`recording[0].weight.csv`).
+        key: String,
+        /// The CSV file.
+        path: PathBuf,
+        /// The line, from 1 (0: the file as a whole).
+        line: u64,
+        /// The column at fault, if one is.
+        column: Option<String>,
+        /// What is wrong there.
+        what: String,
+    },
+    /// A recording with neither a start volume nor a weight log: its volumes are unknown.
+    #[error(
+        "`{key}`: give `start_ml` or a `weight` log, so that the volume at each glug is known"
+    )]
+    NoVolume {
+        /// The recording (`recording[1]`).
+        key: String,
+    },
+    /// No glug unit was found in any recording of a liquid: there is nothing to fit.
+    #[error("no glugs found in {what}: no unit rose above the noise (is it a pour?)")]
+    NoGlugs {
+        /// The recording or liquid.
+        what: String,
+    },
+    /// An output file could not be written (nothing was: every file is written all or none).
+    #[error("cannot write {}: {message}", shown(path))]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
+    /// The outputs asked for do not fit the session (one model for several liquids).
+    #[error("{0}")]
+    Outputs(String),
+}
+
+/// A path for a message.
+pub(crate) fn shown(path: &Path) -> String {
+    printable(&path.to_string_lossy()).into_owned()
+}

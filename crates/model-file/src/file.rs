@@ -1,0 +1,264 @@
+//! Reading and validating a model file: the keys of a scene that describe the bottle and the
+//! liquid, nothing else (MODEL.md §12.1).
+
+use std::io::Read;
+use std::path::Path;
+
+use sake_glug_engine::{Constant, Control, Curve, ModelConfig, PerControl, Quantity, ValueError};
+use sake_glug_io::text::printable;
+
+/// The largest model file read (bytes): a model is a few dozen lines; a larger file is no model.
+pub const MAX_MODEL_BYTES: u64 = 1 << 20;
+
+/// The regular file at `path`, opened without waiting (a FIFO opened for reading waits for a
+/// writer) and checked as opened, so a path replaced after a check cannot slip through.
+fn open_regular_file(path: &Path) -> std::io::Result<std::fs::File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    if file.metadata()?.is_file() {
+        Ok(file)
+    } else {
+        Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file",
+        ))
+    }
+}
+
+/// Why a model was refused. Text from the file is shown with its control characters escaped.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelFileError {
+    /// The file could not be read.
+    #[error("cannot read model file {}: {source}", printable(path))]
+    Read {
+        /// The file's path, as given.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// Larger than [`MAX_MODEL_BYTES`].
+    #[error(
+        "model file {} is over the limit of {MAX_MODEL_BYTES} bytes",
+        printable(path)
+    )]
+    TooLarge {
+        /// The file's path, as given.
+        path: String,
+    },
+    /// Not valid TOML, or a value of the wrong type: the parser's message, escaped.
+    #[error("invalid model: {0}")]
+    Syntax(String),
+    /// A key a scene may have but a model may not: automation, a take, render settings.
+    #[error(
+        "`{key}` does not belong in a model: a model gives the bottle and the liquid (the \
+         constants, the [curves] and each control as one number); {what} belong in the scene"
+    )]
+    NotAModelKey {
+        /// The key, as written.
+        key: String,
+        /// What such keys are.
+        what: &'static str,
+    },
+    /// A value the model cannot take: out of range, V0 not below the capacity, or no curve.
+    #[error(transparent)]
+    Value(#[from] ValueError),
+}
+
+/// A validated model file: its name and text (what the plugin saves), its keys as written (what
+/// a scene is layered over), and what they set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelFile {
+    name: String,
+    text: String,
+    keys: Vec<(String, toml::Value)>,
+    config: ModelConfig,
+    controls: PerControl<Option<f64>>,
+}
+
+impl ModelFile {
+    /// Reads the model file at `path`, named after the file (its stem).
+    pub fn load(path: &Path) -> Result<Self, ModelFileError> {
+        let shown = path.to_string_lossy().into_owned();
+        let read = |source| ModelFileError::Read {
+            path: shown.clone(),
+            source,
+        };
+        let mut text = String::new();
+        open_regular_file(path)
+            .map_err(read)?
+            .take(MAX_MODEL_BYTES + 1)
+            .read_to_string(&mut text)
+            .map_err(read)?;
+        if text.len() as u64 > MAX_MODEL_BYTES {
+            return Err(ModelFileError::TooLarge { path: shown });
+        }
+        let name = path
+            .file_stem()
+            .map_or("model".into(), |stem| stem.to_string_lossy().into_owned());
+        Self::parse(&name, &text)
+    }
+
+    /// Parses and validates the model `text`, called `name`.
+    pub fn parse(name: &str, text: &str) -> Result<Self, ModelFileError> {
+        let table: toml::Table = toml::from_str(text).map_err(|error| {
+            let lines: Vec<_> = error
+                .to_string()
+                .split('\n')
+                .map(|line| printable(line).into_owned())
+                .collect();
+            ModelFileError::Syntax(lines.join("\n"))
+        })?;
+        let keys = flatten(&table);
+        let mut config = ModelConfig::default();
+        let mut controls = PerControl::from_fn(|_| None);
+        for (key, value) in &keys {
+            match model_key(key) {
+                Some(ModelKey::Control(control)) => {
+                    let quantity = control.quantity();
+                    let value = as_number(value).ok_or_else(|| ModelFileError::NotAModelKey {
+                        key: printable(key).into_owned(),
+                        what: "automation lanes and recorded takes",
+                    })?;
+                    controls[control] = Some(check(quantity, value)?);
+                }
+                Some(ModelKey::Constant(constant)) => {
+                    let quantity = constant.quantity();
+                    let value = as_number(value).ok_or_else(|| {
+                        syntax(&format!("`{key}`: invalid type: expected a number"))
+                    })?;
+                    constant.set(&mut config, check(quantity, value)?);
+                }
+                Some(ModelKey::Curve(curve)) => {
+                    let key = curve.scene_key();
+                    let points = value
+                        .as_array()
+                        .ok_or_else(|| syntax(&format!("`{key}`: expected a list of points")))?;
+                    let points = curve_points(points).ok_or_else(|| {
+                        syntax(&format!(
+                            "`{key}`: each point must be a [tilt_deg, value] pair of numbers"
+                        ))
+                    })?;
+                    *curve.of_mut(&mut config.curves) = curve
+                        .from_points(&points)
+                        .map_err(|source| ValueError::Curve { key, source })?;
+                }
+                None => {
+                    return Err(ModelFileError::NotAModelKey {
+                        key: printable(key).into_owned(),
+                        what: "automation, takes, [midi] and the render's settings",
+                    })
+                }
+            }
+        }
+        config.check_silent_below()?;
+        Ok(Self {
+            name: name.to_owned(),
+            text: text.to_owned(),
+            keys,
+            config,
+            controls,
+        })
+    }
+
+    /// Its name: the file's stem, or the name it was saved with.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The file's text, as read.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// Every key it gives (`section.name` inside a table), with its value as written.
+    pub fn keys(&self) -> &[(String, toml::Value)] {
+        &self.keys
+    }
+
+    /// The default constants with the model's (its constants, V0, spread and curves).
+    pub fn config(&self) -> &ModelConfig {
+        &self.config
+    }
+
+    /// The value it gives each control, if it gives one.
+    pub fn controls(&self) -> &PerControl<Option<f64>> {
+        &self.controls
+    }
+}
+
+/// What a model key sets.
+enum ModelKey {
+    Control(Control),
+    Constant(Constant),
+    Curve(Curve),
+}
+
+/// The model key `key` (`section.name` inside a table), if it is one.
+fn model_key(key: &str) -> Option<ModelKey> {
+    let controls = Control::ALL
+        .iter()
+        .find(|control| control.quantity().scene_key == key)
+        .map(|&control| ModelKey::Control(control));
+    let constants = || {
+        Constant::ALL
+            .iter()
+            .find(|constant| constant.quantity().scene_key == key)
+            .map(|&constant| ModelKey::Constant(constant))
+    };
+    let curves = || {
+        Curve::ALL
+            .iter()
+            .find(|curve| curve.scene_key() == key)
+            .map(|&curve| ModelKey::Curve(curve))
+    };
+    controls.or_else(constants).or_else(curves)
+}
+
+/// Every key of `table`, a section's keys as `section.name` (scene files nest no deeper), in the
+/// file's order. A control's table (a CSV lane) is one key, the control's.
+fn flatten(table: &toml::Table) -> Vec<(String, toml::Value)> {
+    let mut keys = Vec::new();
+    for (name, value) in table {
+        let lane = matches!(model_key(name), Some(ModelKey::Control(_)));
+        match value {
+            toml::Value::Table(section) if !lane => {
+                for (inner, value) in section {
+                    keys.push((format!("{name}.{inner}"), value.clone()));
+                }
+            }
+            value => keys.push((name.clone(), value.clone())),
+        }
+    }
+    keys
+}
+
+/// A number as a scene writes it: a float or an integer.
+fn as_number(value: &toml::Value) -> Option<f64> {
+    value
+        .as_float()
+        .or_else(|| value.as_integer().map(|integer| integer as f64))
+}
+
+/// A curve's points as a scene writes them: `[tilt_deg, value]` pairs of numbers, integer or
+/// float; `None` if any point is not.
+pub fn curve_points(points: &[toml::Value]) -> Option<Vec<(f64, f64)>> {
+    let pair = |point: &toml::Value| match point.as_array()?.as_slice() {
+        [tilt_deg, value] => Some((as_number(tilt_deg)?, as_number(value)?)),
+        _ => None,
+    };
+    points.iter().map(pair).collect()
+}
+
+fn check(quantity: &Quantity, value: f64) -> Result<f64, ModelFileError> {
+    Ok(quantity.range.check(quantity.scene_key, value)?)
+}
+
+fn syntax(message: &str) -> ModelFileError {
+    ModelFileError::Syntax(printable(message).into_owned())
+}

@@ -1,0 +1,110 @@
+//! Listening studies (feature `study`): the paper's two designs run on any actuator.
+//!
+//! A [`Spec`] file names the stimuli (scenes, presets or model files with scene keys over them)
+//! and the design; [`plan_trials`] orders a participant's trials from a seed; [`render_stimuli`]
+//! renders each stimulus once with the offline renderer and matches their levels; a [`StudySession`]
+//! presents the trials through a [`Presenter`] (with feature `audio` a JACK server or an ALSA
+//! device, whose samples come from one mix; or [`Silent`] for a dry run, whose files
+//! [`write_dry_run`] writes), reads each answer and appends it to the [`TrialLog`] at once.
+//! `sake-glug analyze` reads that log.
+
+#[cfg(feature = "audio")]
+mod alsa_out;
+mod dry_run;
+#[cfg(feature = "audio")]
+mod jack_out;
+mod log;
+#[cfg(feature = "audio")]
+mod mix;
+mod session;
+mod spec;
+mod stimuli;
+mod trials;
+
+use std::path::PathBuf;
+
+#[cfg(feature = "audio")]
+pub use alsa_out::{AlsaOutput, AlsaPlayer};
+pub use dry_run::{write_dry_run, TRIAL_LIST};
+#[cfg(feature = "audio")]
+pub use jack_out::{JackOutput, JackPlayer};
+pub use log::{header as log_header, Expected, LogRow, TrialLog};
+pub use session::{Presented, Presenter, Silent, StudySession};
+pub use spec::{
+    level_keys, Channels, Design, Equalize, Spec, Stimulus, MAX_NOISE_DBFS, MIN_NOISE_DBFS,
+    STANDARD,
+};
+pub use stimuli::{level_of, render_stimuli, Rendered};
+pub use trials::{order_seed, plan_trials, Trial};
+
+/// Why a study could not run, or stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// A file could not be read or written.
+    #[error("{}: {source}", .path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The spec is not valid: the message names the key.
+    #[error("{}: {message}", .path.display())]
+    Spec {
+        /// The spec file.
+        path: PathBuf,
+        /// What was wrong, and where.
+        message: String,
+    },
+    /// A stimulus could not be made into a scene or rendered.
+    #[error("{}: stimulus `{name}`: {message}", .path.display())]
+    Stimulus {
+        /// The spec file.
+        path: PathBuf,
+        /// The stimulus's name.
+        name: String,
+        /// What was wrong (the scene's message names the key).
+        message: String,
+    },
+    /// A new session's log already exists.
+    #[error(
+        "{} already exists: pass --resume to continue its session, or name a new log",
+        .0.display()
+    )]
+    LogExists(PathBuf),
+    /// `--resume` with no log.
+    #[error("{}: no such log, so nothing to resume; leave out --resume to start", .0.display())]
+    NothingToResume(PathBuf),
+    /// A log that cannot be resumed.
+    #[error("{}, line {line}: {message}", .path.display())]
+    Log {
+        /// The log.
+        path: PathBuf,
+        /// The line, from 1.
+        line: u64,
+        /// What was wrong.
+        message: String,
+    },
+    /// The answers ended before the trials.
+    #[error(
+        "the answers ended (stdin closed) after {answered} of {total} trials; the log keeps \
+         them, and --resume continues"
+    )]
+    InputClosed {
+        /// Trials answered, in this run and before.
+        answered: usize,
+        /// Trials in the session.
+        total: usize,
+    },
+    /// The dry run's folder.
+    #[error("--dry-run {}: {message}", .path.display())]
+    DryRunFolder {
+        /// The folder.
+        path: PathBuf,
+        /// What was wrong.
+        message: String,
+    },
+    /// The audio interface.
+    #[error("{0}")]
+    Audio(String),
+}

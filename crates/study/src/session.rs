@@ -1,0 +1,173 @@
+//! A session: each trial presented, its answer read and logged, from where the log left off.
+
+use std::io::{BufRead, Write};
+use std::time::Instant;
+
+use super::log::{Expected, LogRow, TrialLog};
+use super::spec::{Design, Spec};
+use super::stimuli::Rendered;
+use super::trials::Trial;
+use super::StudyError;
+
+/// When a trial's stimuli played.
+#[derive(Debug, Clone, Copy)]
+pub struct Presented {
+    /// The audio interface's frames at which the first and the second stimulus started (JACK's
+    /// frame time, or frames written to an ALSA device since the session started); `None` when
+    /// nothing was played (a dry run).
+    pub onset_frames: Option<(u64, u64)>,
+    /// The moment the last sample of the second stimulus was played, from which the response
+    /// time counts.
+    pub ended: Instant,
+}
+
+/// What plays a trial: the first stimulus, the gap, the second; returns once it has ended.
+pub trait Presenter {
+    /// Plays stimuli `trial.first` and `trial.second` (indices into the rendered stimuli).
+    fn present(&mut self, trial: Trial) -> Result<Presented, StudyError>;
+}
+
+/// Plays nothing: the dry run's answers count from the prompt.
+#[derive(Debug, Default)]
+pub struct Silent;
+
+impl Presenter for Silent {
+    fn present(&mut self, _trial: Trial) -> Result<Presented, StudyError> {
+        Ok(Presented {
+            onset_frames: None,
+            ended: Instant::now(),
+        })
+    }
+}
+
+/// Everything a session needs, prepared before the first trial.
+#[derive(Debug)]
+pub struct StudySession<'a> {
+    /// The spec.
+    pub spec: &'a Spec,
+    /// The participant's ID.
+    pub participant: &'a str,
+    /// The seed of the order.
+    pub seed: u64,
+    /// The order.
+    pub trials: &'a [Trial],
+    /// The stimuli, level-matched.
+    pub rendered: &'a [Rendered],
+}
+
+impl StudySession<'_> {
+    /// What a resumed log must agree with.
+    pub fn expected(&self) -> Expected {
+        Expected {
+            participant: self.participant.to_owned(),
+            design: self.spec.design.name(),
+            seed: self.seed,
+            trials: self
+                .trials
+                .iter()
+                .map(|trial| {
+                    let (first, second) = (
+                        &self.spec.stimuli[trial.first],
+                        &self.spec.stimuli[trial.second],
+                    );
+                    [
+                        first.name.clone(),
+                        second.name.clone(),
+                        first.params.clone(),
+                        second.params.clone(),
+                    ]
+                })
+                .collect(),
+        }
+    }
+
+    /// Presents the trials from number `from` (0-based) on, once a first line (Enter) comes from
+    /// `input`, reading each answer from it (a line `1` or `2`; anything else asks again) and appending it to `log` before the next
+    /// trial. Prompts go to `prompt`. Ends with [`StudyError::InputClosed`] if `input` ends first.
+    pub fn run(
+        &self,
+        from: usize,
+        presenter: &mut dyn Presenter,
+        log: &mut TrialLog,
+        input: &mut impl BufRead,
+        prompt: &mut impl Write,
+    ) -> Result<(), StudyError> {
+        let total = self.trials.len();
+        let say = |prompt: &mut dyn Write, text: std::fmt::Arguments| {
+            // A prompt that cannot be shown is no reason to lose the session.
+            let _ = prompt.write_fmt(text).and_then(|()| prompt.flush());
+        };
+        let read_line = |input: &mut dyn BufRead, line: &mut String, answered: usize| {
+            line.clear();
+            match input.read_line(line) {
+                Ok(0) => Err(StudyError::InputClosed { answered, total }),
+                Ok(_) => Ok(()),
+                Err(source) => Err(StudyError::Io {
+                    path: "stdin".into(),
+                    source,
+                }),
+            }
+        };
+        let mut line = String::new();
+        if from < total {
+            // The participant (and whoever connects the audio) starts the session.
+            say(prompt, format_args!("Press Enter to begin.\n"));
+            read_line(input, &mut line, from)?;
+        }
+        for (index, &trial) in self.trials.iter().enumerate().skip(from) {
+            say(
+                prompt,
+                format_args!("Trial {}/{total}: listen…\n", index + 1),
+            );
+            let presented = presenter.present(trial)?;
+            say(
+                prompt,
+                format_args!("{} 1 (the first) or 2 (the second): ", self.spec.question),
+            );
+            let pressed = loop {
+                read_line(input, &mut line, index)?;
+                match line.trim() {
+                    "1" => break 1u8,
+                    "2" => break 2u8,
+                    _ => say(prompt, format_args!("Please answer 1 or 2: ")),
+                }
+            };
+            let rt_s = presented.ended.elapsed().as_secs_f64();
+            let (first, second) = (
+                &self.spec.stimuli[trial.first],
+                &self.spec.stimuli[trial.second],
+            );
+            let chosen = if pressed == 1 {
+                trial.first
+            } else {
+                trial.second
+            };
+            let (level, chose_comparison) = match self.spec.design {
+                Design::Paired => (None, None),
+                // The standard is stimulus 0; the comparison is the other one.
+                Design::Constant => (first.level.or(second.level), Some(u8::from(chosen != 0))),
+            };
+            log.append(&LogRow {
+                participant: self.participant.to_owned(),
+                trial: index + 1,
+                design: self.spec.design.name().to_owned(),
+                first: first.name.clone(),
+                second: second.name.clone(),
+                answer: self.spec.stimuli[chosen].name.clone(),
+                pressed,
+                rt_s,
+                seed: self.seed,
+                level,
+                chose_comparison,
+                first_gain_db: self.rendered[trial.first].gain_db,
+                second_gain_db: self.rendered[trial.second].gain_db,
+                first_onset_frame: presented.onset_frames.map(|(first, _)| first),
+                second_onset_frame: presented.onset_frames.map(|(_, second)| second),
+                first_params: first.params.clone(),
+                second_params: second.params.clone(),
+            })?;
+        }
+        say(prompt, format_args!("Done: {total} trials. Thank you.\n"));
+        Ok(())
+    }
+}

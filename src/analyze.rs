@@ -1,0 +1,238 @@
+//! `sake-glug analyze paired|constant LOG.csv…`: the paper's two studies from their trial logs,
+//! as tables on stdout or one JSON object (`--json`), and their figure (`--plot FILE.png`).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Subcommand};
+use sake_glug_io::text::printable;
+
+use sake_glug_analysis::{
+    analyze_constant_logs, analyze_paired_logs, constant_json, draw_constant_plot,
+    draw_paired_plot, paired_json, AnalysisError, ChiSquareTest, ConstantAnalysis, PairedAnalysis,
+    PsychometricFit, PsychometricOptions, POINT_PERCENTS,
+};
+
+#[derive(Args, Debug)]
+pub struct AnalyzeArgs {
+    #[command(subcommand)]
+    design: Design,
+}
+
+#[derive(Subcommand, Debug)]
+enum Design {
+    /// Paired comparison: count matrix, Thurstone Case V scale, Mosteller's fit, agreement.
+    Paired {
+        #[command(flatten)]
+        common: Common,
+    },
+    /// Constant stimuli: logistic psychometric function, 25/50/75 % points with 95 % intervals.
+    Constant {
+        #[command(flatten)]
+        common: Common,
+        /// Bootstrap resamples for the intervals.
+        #[arg(long, default_value_t = PsychometricOptions::default().resamples)]
+        resamples: usize,
+        /// Seed of the resamples (the same seed gives the same intervals).
+        #[arg(long, default_value_t = PsychometricOptions::default().seed)]
+        seed: u64,
+        /// Fits a lapse rate λ within 0..=MAX (the curve runs from λ to 1 − λ); 0 for none.
+        #[arg(long, default_value_t = PsychometricOptions::default().max_lapse, value_name = "MAX")]
+        lapse: f64,
+    },
+}
+
+#[derive(Args, Debug)]
+struct Common {
+    /// The trial logs (CSV with a header), read together.
+    #[arg(required = true, value_name = "LOG.csv")]
+    logs: Vec<PathBuf>,
+    /// Draws the figure into this PNG file.
+    #[arg(long, value_name = "FILE.png")]
+    plot: Option<PathBuf>,
+    /// Prints one JSON object instead of tables.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Exit status 0 when analysed (and plotted), 1 for a bad log or an unwritable plot, 2 for a
+/// bad option.
+pub fn run(args: AnalyzeArgs) -> ExitCode {
+    let outcome = match args.design {
+        Design::Paired { common } => analyze_paired_logs(&common.logs).and_then(|analysis| {
+            if let Some(path) = &common.plot {
+                draw_paired_plot(&analysis, path)?;
+            }
+            Ok(match common.json {
+                true => paired_json(&analysis).to_string(),
+                false => paired_text(&analysis),
+            })
+        }),
+        Design::Constant {
+            common,
+            resamples,
+            seed,
+            lapse,
+        } => {
+            let options = PsychometricOptions {
+                resamples,
+                seed,
+                max_lapse: lapse,
+            };
+            analyze_constant_logs(&common.logs, &options).and_then(|analysis| {
+                if let Some(path) = &common.plot {
+                    draw_constant_plot(&analysis, path)?;
+                }
+                Ok(match common.json {
+                    true => constant_json(&analysis).to_string(),
+                    false => constant_text(&analysis),
+                })
+            })
+        }
+    };
+    match outcome {
+        Ok(report) => {
+            println!("{report}");
+            ExitCode::SUCCESS
+        }
+        Err(error) => {
+            eprintln!("error: {error}");
+            match error {
+                AnalysisError::Option(_) => ExitCode::from(2),
+                _ => ExitCode::FAILURE,
+            }
+        }
+    }
+}
+
+fn test_text(name: &str, test: Option<ChiSquareTest>, absent: &str) -> String {
+    match test {
+        Some(test) => format!(
+            "{name}: χ²({}) = {:.2}, p = {:.4}\n",
+            test.df, test.chi2, test.p
+        ),
+        None => format!("{name}: {absent}\n"),
+    }
+}
+
+fn matrix_text(title: &str, names: &[String], cell: impl Fn(usize, usize) -> String) -> String {
+    let width = names
+        .iter()
+        .map(|name| name.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(8);
+    let mut text = format!("{title}\n{:width$}", "");
+    for name in names {
+        text += &format!(" {name:>width$}");
+    }
+    text.push('\n');
+    for (i, name) in names.iter().enumerate() {
+        text += &format!("{name:width$}");
+        for j in 0..names.len() {
+            text += &format!(" {:>width$}", cell(i, j));
+        }
+        text.push('\n');
+    }
+    text
+}
+
+fn paired_text(analysis: &PairedAnalysis) -> String {
+    // The names come from the logs: shown with their control characters escaped.
+    let names: Vec<String> = analysis
+        .stimuli
+        .iter()
+        .map(|name| printable(name).into_owned())
+        .collect();
+    let mut text = format!(
+        "{} trials, {} participant(s), {} stimuli\n\n",
+        analysis.trials,
+        analysis.participants.len(),
+        names.len()
+    );
+    let diagonal = |i: usize, j: usize, value: String| if i == j { "-".into() } else { value };
+    text += &matrix_text(
+        "times the row was chosen over the column",
+        &names,
+        |i, j| diagonal(i, j, analysis.counts[i][j].to_string()),
+    );
+    text += &matrix_text("\nproportions", &names, |i, j| {
+        diagonal(i, j, format!("{:.3}", analysis.proportions[i][j]))
+    });
+    text += &matrix_text(
+        "\nz (proportions clipped to [1/2n, 1 − 1/2n])",
+        &names,
+        |i, j| format!("{:.3}", analysis.z[i][j]),
+    );
+    text += &matrix_text(
+        "\npredicted proportions Φ(Sᵢ − Sⱼ)",
+        &names,
+        |i, j| diagonal(i, j, format!("{:.3}", analysis.predicted[i][j])),
+    );
+    text += "\nscale (Case V, lowest 0)\n";
+    let mut order: Vec<usize> = (0..names.len()).collect();
+    order.sort_by(|&a, &b| analysis.scale[b].total_cmp(&analysis.scale[a]));
+    for index in order {
+        text += &format!("  {:>8.3}  {}\n", analysis.scale[index], names[index]);
+    }
+    text.push('\n');
+    text += &test_text(
+        "fit (Mosteller)",
+        analysis.fit,
+        "none with two stimuli (no degree of freedom)",
+    );
+    text += &test_text(
+        "agreement of participants (homogeneity of choices)",
+        analysis.agreement,
+        "needs two or more participants",
+    );
+    text.trim_end().to_owned()
+}
+
+fn fit_text(fit: &PsychometricFit) -> String {
+    let curve = fit.curve;
+    let mut text = format!(
+        "  ψ(x) = {:.3} + {:.3}·σ({:.3} + {:.3}·x)\n",
+        curve.lapse,
+        1.0 - 2.0 * curve.lapse,
+        curve.intercept,
+        curve.slope
+    );
+    for (percent, point) in POINT_PERCENTS.iter().zip(&fit.points) {
+        text += &format!(
+            "  {percent:>2} %: {:.4}  95 % [{:.4}, {:.4}]\n",
+            point.value, point.low, point.high
+        );
+    }
+    if fit.failed_resamples > 0 {
+        text += &format!(
+            "  ({} of {} resamples had no finite fit and are left out)\n",
+            fit.failed_resamples, fit.resamples
+        );
+    }
+    text
+}
+
+fn constant_text(analysis: &ConstantAnalysis) -> String {
+    let pooled = &analysis.pooled;
+    let mut text = String::from("level     trials  chosen  proportion\n");
+    for level in &pooled.levels {
+        text += &format!(
+            "{:<9} {:>6}  {:>6}  {:>10.3}\n",
+            level.level,
+            level.trials,
+            level.chosen,
+            level.proportion()
+        );
+    }
+    text += &format!("\nall participants ({} resamples)\n", pooled.resamples);
+    text += &fit_text(pooled);
+    for (name, fit) in &analysis.participants {
+        text += &format!("\n{}\n", printable(name));
+        text += &match fit {
+            Ok(fit) => fit_text(fit),
+            Err(error) => format!("  {error}\n"),
+        };
+    }
+    text.trim_end().to_owned()
+}

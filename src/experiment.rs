@@ -1,0 +1,295 @@
+//! `sake-glug experiment`: runs a listening study's session for one participant.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, ValueEnum};
+
+use sake_glug_study::{
+    order_seed, plan_trials, render_stimuli, write_dry_run, Equalize, Silent, Spec, StudyError,
+    StudySession, TrialLog,
+};
+#[cfg(feature = "audio")]
+use sake_glug_study::{AlsaOutput, Channels, JackOutput, Presenter};
+
+/// The JACK client's name unless `--client-name` gives one.
+const CLIENT_NAME: &str = "sake-glug-experiment";
+/// The ALSA device unless `--alsa-device` names one.
+const ALSA_DEVICE: &str = "default";
+
+#[derive(Args, Debug)]
+pub struct ExperimentArgs {
+    /// The study's spec file (see experiments/README.md).
+    spec: PathBuf,
+    /// The participant's ID: with the spec's seed it fixes the trial order.
+    #[arg(long)]
+    participant: String,
+    /// The trial log (CSV), one row appended per answer.
+    #[arg(long)]
+    log: PathBuf,
+    /// Writes every trial's two stimuli as WAV files and the trial list into this new (or
+    /// empty) folder, and runs the session without playing anything.
+    #[arg(long, value_name = "DIR")]
+    dry_run: Option<PathBuf>,
+    /// Continues the session of an existing log after its last trial (same order).
+    #[arg(long)]
+    resume: bool,
+    /// The actuator's output channels, from 1 (e.g. `1` or `1,2`): overrides the spec's.
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    actuator: Option<Vec<u16>>,
+    /// The headphones' output channels, which carry the masking noise: overrides the spec's.
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    headphones: Option<Vec<u16>>,
+    /// Where the trials play: a running JACK server, or an ALSA device (`--alsa-device`).
+    #[arg(long, value_enum, default_value_t = Audio::Jack)]
+    audio: Audio,
+    /// With `--audio jack`: the JACK client's name [default: sake-glug-experiment].
+    #[arg(long, value_name = "NAME")]
+    client_name: Option<String>,
+    /// With `--audio alsa`: the ALSA device (a PCM name: `default`, `hw:1`, `plughw:CARD=USB`,
+    /// …) [default: default].
+    #[arg(long, value_name = "NAME")]
+    alsa_device: Option<String>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Audio {
+    /// A running JACK server.
+    Jack,
+    /// An ALSA device.
+    Alsa,
+}
+
+/// The audio interface the options name.
+#[derive(Debug)]
+#[cfg_attr(
+    not(feature = "audio"),
+    expect(
+        dead_code,
+        reason = "checked, so that a build without audio refuses the same options"
+    )
+)]
+enum Interface {
+    Jack { client_name: String },
+    Alsa { device: String },
+}
+
+impl ExperimentArgs {
+    /// Refuses an option of the other interface's (`--client-name` is JACK's, `--alsa-device`
+    /// ALSA's), so that neither is silently ignored.
+    fn interface(&self) -> Result<Interface, StudyError> {
+        match (self.audio, &self.client_name, &self.alsa_device) {
+            (Audio::Jack, _, Some(_)) => Err(StudyError::Audio(
+                "--alsa-device names an ALSA device: add `--audio alsa` (without it the session \
+                 plays on JACK)"
+                    .into(),
+            )),
+            (Audio::Alsa, Some(_), _) => Err(StudyError::Audio(
+                "--client-name names a JACK client, and `--audio alsa` plays on an ALSA device: \
+                 name it with --alsa-device"
+                    .into(),
+            )),
+            (Audio::Jack, client_name, None) => Ok(Interface::Jack {
+                client_name: client_name.as_deref().unwrap_or(CLIENT_NAME).to_owned(),
+            }),
+            (Audio::Alsa, None, device) => Ok(Interface::Alsa {
+                device: device.as_deref().unwrap_or(ALSA_DEVICE).to_owned(),
+            }),
+        }
+    }
+}
+
+/// The audio interface opened, not yet playing: its sample rate is the stimuli's.
+#[cfg(feature = "audio")]
+enum Output {
+    Jack(JackOutput),
+    Alsa(AlsaOutput),
+}
+
+#[cfg(feature = "audio")]
+impl Output {
+    /// Reaches the interface; an ALSA device is asked for the scenes' sample rate and the
+    /// spec's channel count.
+    fn open(interface: &Interface, spec: &Spec) -> Result<Self, StudyError> {
+        match interface {
+            Interface::Jack { client_name } => JackOutput::open(client_name).map(Self::Jack),
+            Interface::Alsa { device } => AlsaOutput::open(
+                device,
+                spec.channels.count(),
+                spec.stimuli[0].scene.sample_rate,
+            )
+            .map(Self::Alsa),
+        }
+    }
+
+    fn sample_rate(&self) -> u32 {
+        match self {
+            Self::Jack(output) => output.sample_rate(),
+            Self::Alsa(output) => output.sample_rate(),
+        }
+    }
+
+    fn start(
+        self,
+        stimuli: Vec<Vec<f32>>,
+        gap_samples: u64,
+        channels: &Channels,
+        noise_dbfs: Option<f64>,
+    ) -> Result<Box<dyn Presenter>, StudyError> {
+        Ok(match self {
+            Self::Jack(output) => {
+                Box::new(output.start(stimuli, gap_samples, channels, noise_dbfs)?)
+            }
+            Self::Alsa(output) => {
+                Box::new(output.start(stimuli, gap_samples, channels, noise_dbfs)?)
+            }
+        })
+    }
+}
+
+pub fn run(args: ExperimentArgs) -> ExitCode {
+    match session(args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err((status, error)) => {
+            eprintln!("error: {error}");
+            ExitCode::from(status)
+        }
+    }
+}
+
+/// A usage error (exit status 2): nothing was presented.
+fn usage(error: StudyError) -> (u8, StudyError) {
+    (2, error)
+}
+
+fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
+    let mut spec = Spec::load(&args.spec).map_err(usage)?;
+    if args.participant.trim().is_empty() || args.participant.chars().any(char::is_control) {
+        return Err(usage(StudyError::Spec {
+            path: args.spec.clone(),
+            message: "--participant: give a non-empty ID without control characters".into(),
+        }));
+    }
+    let interface = args.interface().map_err(usage)?;
+    if let Some(actuator) = args.actuator {
+        spec.channels.actuator = actuator;
+    }
+    if let Some(headphones) = args.headphones {
+        spec.channels.headphones = headphones;
+    }
+    spec.channels.check(spec.noise_dbfs).map_err(|message| {
+        usage(StudyError::Spec {
+            path: args.spec.clone(),
+            message,
+        })
+    })?;
+    // Refused before the audio and the renders: the log is created or reopened after them.
+    if args.resume && !args.log.exists() {
+        return Err(usage(StudyError::NothingToResume(args.log)));
+    }
+    if !args.resume && args.log.exists() {
+        return Err(usage(StudyError::LogExists(args.log)));
+    }
+    let seed = order_seed(spec.seed, &args.participant);
+    let trials = plan_trials(&spec, seed);
+
+    // The audio interface first: its sample rate is the stimuli's.
+    #[cfg(feature = "audio")]
+    let output = match args.dry_run {
+        Some(_) => None,
+        None => Some(Output::open(&interface, &spec).map_err(|e| (1, e))?),
+    };
+    #[cfg(feature = "audio")]
+    let sample_rate = output
+        .as_ref()
+        .map_or(spec.stimuli[0].scene.sample_rate, |output| {
+            output.sample_rate()
+        });
+    #[cfg(not(feature = "audio"))]
+    let sample_rate = {
+        if args.dry_run.is_none() {
+            return Err((
+                2,
+                StudyError::Audio(
+                    "this build plays no audio: build it with `--features audio` (JACK and \
+                     ALSA), or run the session without it with `--dry-run DIR`"
+                        .into(),
+                ),
+            ));
+        }
+        // The interface means nothing without audio.
+        let _ = interface;
+        spec.stimuli[0].scene.sample_rate
+    };
+
+    let rendered = render_stimuli(&spec, sample_rate).map_err(usage)?;
+    println!(
+        "{} design, {} trials, order seed {seed}, equalize {} ({} Hz):",
+        spec.design.name(),
+        trials.len(),
+        spec.equalize.name(),
+        sample_rate
+    );
+    // What was matched: `none` shows the peaks.
+    let kind = match spec.equalize {
+        Equalize::Rms => "rms ",
+        Equalize::Peak | Equalize::None => "peak",
+    };
+    for (stimulus, rendered) in spec.stimuli.iter().zip(&rendered) {
+        println!(
+            "  {:<24} {} {:>8.2} dBFS  gain {:>+7.3} dB",
+            stimulus.name,
+            kind,
+            20.0 * rendered.level.log10(),
+            rendered.gain_db
+        );
+    }
+    let session = StudySession {
+        spec: &spec,
+        participant: &args.participant,
+        seed,
+        trials: &trials,
+        rendered: &rendered,
+    };
+    let resumed = if args.resume {
+        let (log, done) = TrialLog::resume(&args.log, &session.expected()).map_err(usage)?;
+        println!("Resuming after trial {done} of {}.", trials.len());
+        Some((log, done))
+    } else {
+        None
+    };
+    if let Some(dir) = &args.dry_run {
+        // A resumed dry run keeps the folder its first run wrote.
+        let already = args.resume && dir.join(sake_glug_study::TRIAL_LIST).exists();
+        if !already {
+            let written = write_dry_run(dir, &session, sample_rate).map_err(usage)?;
+            println!("Wrote {} files into {}.", written.len(), dir.display());
+        }
+    }
+    // Created last, so that a refused folder or spec leaves no log behind.
+    let (mut log, done) = match resumed {
+        Some(resumed) => resumed,
+        None => (TrialLog::create(&args.log).map_err(usage)?, 0),
+    };
+    let _ = std::io::stdout().flush();
+
+    let mut input = std::io::stdin().lock();
+    let mut prompt = std::io::stdout();
+    let result = match &args.dry_run {
+        Some(_) => session.run(done, &mut Silent, &mut log, &mut input, &mut prompt),
+        #[cfg(feature = "audio")]
+        None => {
+            let stimuli = rendered.iter().map(|r| r.samples.clone()).collect();
+            let gap = (spec.gap_s * sample_rate as f64).round() as u64;
+            let output = output.expect("opened above without --dry-run");
+            let mut player = output
+                .start(stimuli, gap, &spec.channels, spec.noise_dbfs)
+                .map_err(|e| (1, e))?;
+            session.run(done, player.as_mut(), &mut log, &mut input, &mut prompt)
+        }
+        #[cfg(not(feature = "audio"))]
+        None => unreachable!("refused above without --dry-run"),
+    };
+    result.map_err(|error| (1, error))
+}

@@ -1,0 +1,74 @@
+//! `sake-glug`: the offline renderer and the reports on the command line. One file per
+//! subcommand; the work is in the library, which knows nothing of `clap`.
+
+mod accuracy;
+mod analyze;
+mod experiment;
+mod fit;
+mod parameters;
+mod presets;
+mod render;
+mod stability;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use sake_glug_render::Scene;
+
+#[derive(Parser)]
+#[command(
+    name = "sake-glug",
+    version,
+    about = "The glug of a poured sake bottle, rendered offline"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Renders a scene file (or the built-in pour) to a mono WAV file.
+    Render(Box<render::RenderArgs>),
+    /// Error against run time of every synthesis path (MODEL.md §9); see docs/accuracy.md.
+    Accuracy(accuracy::AccuracyArgs),
+    /// Stiff and extreme cases: finite, bounded, no slow-down; see docs/stability.md.
+    Stability(stability::StabilityArgs),
+    /// Lists the presets, or prints one as a scene file.
+    Presets(presets::PresetsArgs),
+    /// Every control and model constant: parameter id, scene key, range, step and default.
+    Parameters(parameters::ParametersArgs),
+    /// Fits a model (a scene file) to recordings of a bottle: see MODEL.md §13.
+    Fit(fit::FitArgs),
+    /// Analyses study logs: Thurstone scaling (paired) or a psychometric fit (constant).
+    Analyze(analyze::AnalyzeArgs),
+    /// Runs a listening study's session (paired or constant stimuli) for one participant.
+    Experiment(experiment::ExperimentArgs),
+}
+
+/// A `--sample-rate` as a scene's `sample_rate` is checked (in range, whole), refused by the
+/// command line (exit status 2) before anything is rendered.
+fn sample_rate_hz(text: &str) -> Result<f64, String> {
+    let sample_rate: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number of Hz"))?;
+    Scene::default()
+        .with_sample_rate(sample_rate)
+        .map(|_| sample_rate)
+        .map_err(|error| error.to_string())
+}
+
+fn main() -> ExitCode {
+    match Cli::parse().command {
+        Command::Render(args) => render::run(*args),
+        Command::Accuracy(args) => accuracy::run(args),
+        Command::Stability(args) => stability::run(args),
+        Command::Presets(args) => presets::run(args),
+        Command::Parameters(args) => parameters::run(args),
+        Command::Fit(args) => fit::run(args),
+        Command::Analyze(args) => analyze::run(args),
+        Command::Experiment(args) => experiment::run(args),
+    }
+}

@@ -1,9 +1,0 @@
-//! Model files (MODEL.md §12.1): a scene file that describes one bottle and one liquid, as
-//! `sake-glug fit` writes it, read into a validated [`Model`] that the offline renderer layers
-//! under a scene ([`crate::offline::Scene::load_with_model`]) and the plugin loads into its
-//! parameters and saved state. Compiled by both (feature `model`), so a model means the same
-//! everywhere.
-
-mod file;
-
-pub use file::{curve_points, Model, ModelError, MAX_MODEL_BYTES};

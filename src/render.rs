@@ -1,0 +1,650 @@
+//! `sake-glug render`: scenes (or the built-in pour) to WAV, `.haptic`, `.ahap`, CSV and a plot,
+//! every file of a scene from one render pass, all or nothing.
+
+use std::io::{self, IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use sake_glug_engine::Preset;
+use sake_glug_io::text::printable;
+use sake_glug_model_file::ModelFile;
+use sake_glug_render::clips::HapticBand;
+use sake_glug_render::fidelity::{self, fidelity_table, Fidelity};
+use sake_glug_render::sinks::AudioChannels;
+use sake_glug_render::steps::{DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
+use sake_glug_render::{
+    human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions,
+    PlatformOptions, RenderError, RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
+    StateRate, DEFAULT_SCENE,
+};
+
+#[derive(Args)]
+pub struct RenderArgs {
+    /// Scene files (TOML, see MODEL.md §10); without any, the built-in default pour.
+    scenes: Vec<PathBuf>,
+    #[arg(short, long = "output", value_name = "FILE", value_parser = output, help = format!(
+        "A file to write; its extension picks the format ({}), or NAME:FILE names it ({}). \
+         Repeat for several files from the same render. Default: pour.wav",
+        OutputFormat::extensions(),
+        OutputFormat::names()
+    ))]
+    outputs: Vec<Output>,
+    /// Writes DIR/<scene name>.<extension> for every scene and every one of --formats.
+    #[arg(long, value_name = "DIR", conflicts_with = "outputs")]
+    out_dir: Option<PathBuf>,
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "wav",
+        requires = "out_dir",
+        help = format!("With --out-dir: the formats to write ({})", OutputFormat::names())
+    )]
+    formats: Vec<String>,
+    /// Also draws the pour plot (waveform, clip envelope and onsets, V(t), tilt(t)) to this PNG.
+    #[arg(long, value_name = "FILE.png")]
+    plot: Option<PathBuf>,
+    /// Also writes one row per glug unit to this CSV (the same as -o units:FILE.csv).
+    #[arg(long, value_name = "FILE.csv", conflicts_with = "out_dir")]
+    units: Option<PathBuf>,
+    /// Also writes the bottle's state at --state-rate to this CSV (the same as -o
+    /// state:FILE.csv).
+    #[arg(long, value_name = "FILE.csv", conflicts_with = "out_dir")]
+    state: Option<PathBuf>,
+    #[arg(long, value_name = "HZ", value_parser = state_rate, allow_negative_numbers = true, help = format!(
+        "Rows per second of the state table: above 0, at most the sample rate. Default: {}",
+        StateRate::DEFAULT_HZ
+    ))]
+    state_rate: Option<StateRate>,
+    /// A .csv of samples gets a header line and a time_s column (default: Syntacts' form, one
+    /// sample per line).
+    #[arg(long)]
+    csv_time: bool,
+    /// The actuator band (Hz) that .haptic frequencies 0..1 map to, as LOW..HIGH.
+    #[arg(long, value_name = "LOW..HIGH", default_value_t = HapticBand::default())]
+    haptic_band: HapticBand,
+    // The help names the presets from their table.
+    #[arg(
+        long,
+        value_name = "NAME",
+        conflicts_with = "scenes",
+        help = format!(
+            "Renders a preset ({}) instead of a scene file: the default pour with that liquid and bottle",
+            Preset::ids()
+        )
+    )]
+    preset: Option<String>,
+    /// A recorded take (Standard MIDI File) that drives the scene, read with the plugin's
+    /// mapping (or the scene's [midi] table); replaces a take the scene names.
+    #[arg(long, value_name = "TAKE.mid")]
+    midi: Option<PathBuf>,
+    /// A model file (as `sake-glug fit` writes): each scene plays on its bottle and liquid, the
+    /// keys a scene sets its own (MODEL.md §12.1).
+    #[arg(long, value_name = "MODEL.toml")]
+    model: Option<PathBuf>,
+    /// Overrides the scenes' sample rate (Hz).
+    #[arg(long, value_parser = crate::sample_rate_hz)]
+    sample_rate: Option<f64>,
+    /// Sample format of WAV files: f32, s24 or s16.
+    #[arg(long, default_value = "f32")]
+    sample_format: SampleFormat,
+    /// Frames a second of a rumble file (1 to 1000).
+    #[arg(long, value_name = "HZ", default_value_t = DEFAULT_RUMBLE_RATE_HZ, value_parser = rumble_rate)]
+    rumble_rate: f64,
+    /// What the audio channels of a dualsense or android-ogg file hold: silent or glug (the
+    /// actuators and the haptic channel always hold the glug).
+    #[arg(long, value_name = "silent|glug", default_value = "silent")]
+    audio_channels: AudioChannels,
+    /// Measures what every format keeps of the render (onsets, envelope, what carries c, size,
+    /// platform limits) and prints it as a Markdown table on stdout; the summary line then goes
+    /// to stderr.
+    #[arg(long)]
+    fidelity: bool,
+    /// The old name of --sample-format, which sat beside --formats: refused, naming the new one.
+    #[arg(long = "format", hide = true, num_args = 0..=1, default_missing_value = "")]
+    renamed_format: Option<String>,
+}
+
+/// One scene to render and the files it becomes.
+struct Job {
+    /// The scene file, or `None` for the built-in pour.
+    scene: Option<PathBuf>,
+    name: String,
+    outputs: Vec<Output>,
+}
+
+#[derive(Debug, thiserror::Error)]
+enum JobError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+/// Runs the command: every scene is rendered, a bad one is reported and skipped; the exit
+/// status is 1 if any failed, 2 if the command line itself is wrong (nothing is rendered then),
+/// 128 + the signal's number if a signal stopped it.
+pub fn run(args: RenderArgs) -> ExitCode {
+    let jobs = match plan(&args) {
+        Ok(jobs) => jobs,
+        Err(message) => {
+            eprintln!("error: {message}");
+            return ExitCode::from(2);
+        }
+    };
+    let model = match args.model.as_deref().map(ModelFile::load).transpose() {
+        Ok(model) => model,
+        Err(error) => {
+            eprintln!("error: --model: {error}");
+            return ExitCode::from(2);
+        }
+    };
+    if let Some(directory) = &args.out_dir {
+        if let Err(error) = std::fs::create_dir_all(directory) {
+            eprintln!("error: cannot create {}: {error}", directory.display());
+            return ExitCode::FAILURE;
+        }
+    }
+    let options = OutputOptions {
+        sample_format: args.sample_format,
+        haptic_band: args.haptic_band,
+        csv_time: args.csv_time,
+        state_rate: args.state_rate.unwrap_or_default(),
+        platforms: PlatformOptions {
+            rumble_rate_hz: args.rumble_rate,
+            audio_channels: args.audio_channels,
+        },
+    };
+    let stop = Stop::on_signals(jobs.iter().flat_map(|job| job.outputs.clone()).collect());
+    let mut out = Console::new(jobs.len());
+    let mut failed = 0;
+    for (index, job) in jobs.iter().enumerate() {
+        let progress = |fraction| out.progress.set(index, fraction);
+        let signal_name =
+            |signal| signal_hook::low_level::signal_name(signal).unwrap_or("a signal");
+        match render_job(job, &args, model.as_ref(), &options, &stop, progress) {
+            Ok(Rendered {
+                report,
+                outside,
+                fidelity,
+            }) => {
+                for leftover in &report.leftovers {
+                    out.error(&format!(
+                        "warning: {} looks left by an interrupted render; remove it unless a \
+                         render is writing it",
+                        leftover.display()
+                    ));
+                }
+                match fidelity {
+                    Some(rows) => {
+                        out.error(&summary(job, &report, &outside));
+                        let heading = if jobs.len() > 1 {
+                            format!("{}:\n\n", job.name)
+                        } else {
+                            String::new()
+                        };
+                        out.summary(&(heading + fidelity_table(&rows).trim_end()));
+                    }
+                    None => out.summary(&summary(job, &report, &outside)),
+                }
+            }
+            Err(JobError::Output(OutputError::Render(RenderError::Interrupted))) => {
+                let signal = stop.signal().map_or("a signal", signal_name);
+                out.error(&format!(
+                    "{}: stopped by {signal}; its files were not written",
+                    job.name
+                ));
+            }
+            Err(error) => {
+                failed += 1;
+                out.error(&format!("error: {}: {error}", job.name));
+            }
+        }
+        if let Some(signal) = stop.signal() {
+            let left = jobs.len() - index - 1;
+            if left > 0 {
+                out.error(&format!(
+                    "stopped by {}: {left} more scene(s) not rendered",
+                    signal_name(signal)
+                ));
+            }
+            out.progress.finish();
+            return ExitCode::from((128 + signal).clamp(0, 255) as u8);
+        }
+    }
+    out.progress.finish();
+    if failed > 0 && jobs.len() > 1 {
+        out.error(&format!("{failed} of {} scenes failed", jobs.len()));
+    }
+    if let Some(error) = &out.stdout_error {
+        out.error(&format!("error: cannot print the summary: {error}"));
+    }
+    if failed > 0 || out.stdout_error.is_some() {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// The signals that stop a render: Ctrl-C, `kill`'s default, a closed terminal. The render stops
+/// at its next block and removes its temporary files, and the command ends with 128 + the
+/// signal's number; a second signal ends it at once, whatever the render is doing (finishing a
+/// clip, syncing), its temporary files removed, with 128 + the second signal's number.
+#[cfg(unix)]
+const STOP_SIGNALS: [i32; 3] = [
+    signal_hook::consts::SIGINT,
+    signal_hook::consts::SIGTERM,
+    signal_hook::consts::SIGHUP,
+];
+#[cfg(not(unix))]
+const STOP_SIGNALS: [i32; 2] = [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM];
+
+/// The last of [`STOP_SIGNALS`] that came, if any.
+struct Stop {
+    signal: Arc<AtomicUsize>,
+}
+
+impl Stop {
+    /// Catches [`STOP_SIGNALS`] for a batch that writes `outputs`.
+    fn on_signals(outputs: Vec<Output>) -> Self {
+        let signal = Arc::new(AtomicUsize::new(0));
+        for number in STOP_SIGNALS {
+            // Not being able to catch a signal leaves it as it was: it ends the process.
+            let _ = signal_hook::flag::register_usize(number, Arc::clone(&signal), number as usize);
+        }
+        end_at_a_second_signal(outputs);
+        Self { signal }
+    }
+
+    fn signal(&self) -> Option<i32> {
+        match self.signal.load(Ordering::Relaxed) {
+            0 => None,
+            number => Some(number as i32),
+        }
+    }
+}
+
+/// Ends the process at a second of [`STOP_SIGNALS`], with the temporary files of `outputs`
+/// removed. A thread of its own sees it: it can remove files (a signal handler cannot), wherever
+/// the render is.
+#[cfg(unix)]
+fn end_at_a_second_signal(outputs: Vec<Output>) {
+    let Ok(mut signals) = signal_hook::iterator::Signals::new(STOP_SIGNALS) else {
+        return;
+    };
+    std::thread::spawn(move || {
+        if let Some(number) = signals.forever().nth(1) {
+            sake_glug_render::remove_temporary_files(&outputs);
+            let name = signal_hook::low_level::signal_name(number).unwrap_or("a signal");
+            eprintln!(
+                "stopped by {name}, a second stop signal: ended at once, its temporary files removed"
+            );
+            std::process::exit(128 + number);
+        }
+    });
+}
+
+/// Without signal_hook's iterator, a second signal stops the render as the first does.
+#[cfg(not(unix))]
+fn end_at_a_second_signal(_outputs: Vec<Output>) {}
+
+/// The jobs the arguments ask for; every output's format is checked here, before anything is
+/// rendered.
+fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
+    if args.renamed_format.is_some() {
+        return Err(
+            "--format is now --sample-format (the sample format of WAV files); \
+                    --formats chooses the kinds of file"
+                .into(),
+        );
+    }
+    if let (Some(rate), Some(sample_rate)) = (args.state_rate, args.sample_rate) {
+        if rate.hz() > sample_rate {
+            return Err(format!(
+                "--state-rate {}: above --sample-rate {sample_rate}; a state row is one sample",
+                rate.hz()
+            ));
+        }
+    }
+    if let Some(name) = &args.preset {
+        if Preset::find(name).is_none() {
+            return Err(format!(
+                "no preset `{name}`: choose one of {}",
+                Preset::ids()
+            ));
+        }
+    }
+    let scenes: Vec<Option<PathBuf>> = if args.scenes.is_empty() {
+        vec![None]
+    } else {
+        args.scenes.iter().cloned().map(Some).collect()
+    };
+    let name_of = |scene: &Option<PathBuf>| {
+        let built_in = args.preset.as_deref().unwrap_or("default");
+        scene
+            .as_deref()
+            .and_then(Path::file_stem)
+            .map_or(built_in.to_string(), |stem| {
+                stem.to_string_lossy().into_owned()
+            })
+    };
+    let mut jobs = Vec::new();
+    if let Some(directory) = &args.out_dir {
+        if directory.exists() && !directory.is_dir() {
+            return Err(format!(
+                "--out-dir {}: it is a file, not a folder",
+                directory.display()
+            ));
+        }
+        let formats = args
+            .formats
+            .iter()
+            .map(|name| {
+                OutputFormat::of_name(name.trim_start_matches('.')).ok_or_else(|| {
+                    format!(
+                        "unknown format `{name}` in --formats: use {}",
+                        OutputFormat::names()
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        if args.plot.is_some() {
+            return Err("with --out-dir, ask for the plot with --formats …,png".into());
+        }
+        for scene in scenes {
+            let name = name_of(&scene);
+            let outputs = formats
+                .iter()
+                .map(|&format| Output {
+                    format,
+                    path: directory.join(format.file_name(&name)),
+                })
+                .collect();
+            jobs.push(Job {
+                scene,
+                name,
+                outputs,
+            });
+        }
+        let mut names: Vec<&str> = jobs.iter().map(|job| job.name.as_str()).collect();
+        names.sort_unstable();
+        if let Some(pair) = names.windows(2).find(|pair| pair[0] == pair[1]) {
+            return Err(format!(
+                "two scenes are named `{}`: their files would overwrite each other in {}",
+                pair[0],
+                directory.display()
+            ));
+        }
+    } else {
+        if scenes.len() > 1 {
+            return Err("several scenes need --out-dir DIR (each writes DIR/<name>.<ext>)".into());
+        }
+        let mut outputs = args.outputs.clone();
+        if outputs.is_empty() {
+            outputs.push(Output {
+                format: OutputFormat::WAV,
+                path: PathBuf::from("pour.wav"),
+            });
+        }
+        let tables = [
+            (OutputFormat::UNITS, &args.units),
+            (OutputFormat::STATE, &args.state),
+        ];
+        for (format, path) in tables {
+            if let Some(path) = path {
+                outputs.push(Output {
+                    format,
+                    path: path.clone(),
+                });
+            }
+        }
+        if let Some(plot) = &args.plot {
+            match Output::of_path(plot) {
+                Ok(output) if output.format == OutputFormat::PLOT => outputs.push(output),
+                _ => {
+                    return Err(format!(
+                        "--plot {}: the plot is a .png file",
+                        plot.display()
+                    ))
+                }
+            }
+        }
+        let scene = scenes.into_iter().next().flatten();
+        jobs.push(Job {
+            name: name_of(&scene),
+            scene,
+            outputs,
+        });
+    }
+    Ok(jobs)
+}
+
+/// `--state-rate`'s value parser: a finite number of Hz above 0.
+fn state_rate(text: &str) -> Result<StateRate, String> {
+    let hz: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number of Hz"))?;
+    StateRate::new(hz).map_err(|error| error.to_string())
+}
+
+/// `--rumble-rate`'s value parser: a rate in [`RUMBLE_RATE_RANGE_HZ`].
+fn rumble_rate(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(hz) if RUMBLE_RATE_RANGE_HZ.contains(&hz) => Ok(hz),
+        _ => Err(format!(
+            "`{text}` is not a rate from {} to {} Hz",
+            RUMBLE_RATE_RANGE_HZ.start(),
+            RUMBLE_RATE_RANGE_HZ.end()
+        )),
+    }
+}
+
+/// `-o`'s value parser: `NAME:FILE` or a file its extension names.
+fn output(argument: &str) -> Result<Output, String> {
+    Output::parse(argument).map_err(|error| error.to_string())
+}
+
+/// What a job did: its report, the files it read from outside its scene's folder, and, with
+/// --fidelity, what every format keeps.
+struct Rendered {
+    report: RenderReport,
+    outside: Vec<PathBuf>,
+    fidelity: Option<Vec<Fidelity>>,
+}
+
+/// A built-in scene (the default pour or a preset's), on `model`'s bottle if one is given.
+fn built_in(text: &str, model: Option<&ModelFile>) -> Result<Scene, SceneError> {
+    match model {
+        None => Scene::parse(text),
+        Some(model) => Scene::parse_with_model(text, Path::new(""), model),
+    }
+}
+
+fn render_job(
+    job: &Job,
+    args: &RenderArgs,
+    model: Option<&ModelFile>,
+    options: &OutputOptions,
+    stop: &Stop,
+    progress: impl FnMut(f64),
+) -> Result<Rendered, JobError> {
+    let preset = args.preset.as_deref().and_then(Preset::find);
+    let mut scene = match (&job.scene, preset, model) {
+        (Some(path), _, None) => Scene::load(path)?,
+        (Some(path), _, Some(model)) => Scene::load_with_model(path, model)?,
+        (None, Some(preset), model) => built_in(&Scene::preset_toml(preset), model)?,
+        (None, None, model) => built_in(DEFAULT_SCENE, model)?,
+    };
+    if let Some(take) = &args.midi {
+        scene = scene.with_midi_take(take)?;
+    }
+    if let Some(sample_rate) = args.sample_rate {
+        scene = scene.with_sample_rate(sample_rate)?;
+    }
+    let observer = JobObserver {
+        total: scene.duration_samples(),
+        progress,
+        stop,
+    };
+    let report = render_to_files(&scene, &job.name, &job.outputs, options, observer)?;
+    let outside = scene
+        .inputs
+        .iter()
+        .filter(|input| input.outside_folder)
+        .map(|input| input.path.clone())
+        .collect();
+    let fidelity = if args.fidelity {
+        Some(fidelity::measure(&scene, &job.name, options)?)
+    } else {
+        None
+    };
+    Ok(Rendered {
+        report,
+        outside,
+        fidelity,
+    })
+}
+
+/// What a job's render reports to: the progress bar, and whether a signal came.
+struct JobObserver<'a, P> {
+    /// Samples of the scene, if it has a duration.
+    total: Option<u64>,
+    progress: P,
+    stop: &'a Stop,
+}
+
+impl<P: FnMut(f64)> RenderObserver for JobObserver<'_, P> {
+    fn progress(&mut self, done: u64) {
+        // A scene without a duration ends where it falls silent: its share is unknown.
+        if let Some(total) = self.total {
+            (self.progress)(done as f64 / total.max(1) as f64);
+        }
+    }
+
+    fn interrupted(&self) -> bool {
+        self.stop.signal().is_some()
+    }
+}
+
+/// The line printed for a finished scene.
+/// The line a finished scene prints; files the scene read from outside its own folder are named
+/// at its end, so a scene from elsewhere cannot read one unseen.
+fn summary(job: &Job, report: &RenderReport, outside: &[PathBuf]) -> String {
+    let summary = &report.summary;
+    let files: Vec<String> = report
+        .files
+        .iter()
+        .map(|(path, bytes)| format!("{} ({})", path.display(), human_bytes(*bytes)))
+        .collect();
+    format!(
+        "{}: {:.2} s at {} Hz, {} glug units, peak {:.1} dBFS, {:.0}× faster than real time → {}",
+        job.name,
+        summary.duration_s(),
+        summary.sample_rate,
+        summary.units,
+        20.0 * (summary.peak.max(1e-12) as f64).log10(),
+        summary.realtime_factor(),
+        files.join(", ")
+    ) + &outside_note(outside)
+}
+
+fn outside_note(outside: &[PathBuf]) -> String {
+    if outside.is_empty() {
+        return String::new();
+    }
+    let paths: Vec<String> = outside
+        .iter()
+        .map(|path| printable(&path.display().to_string()).into_owned())
+        .collect();
+    format!(
+        "; read from outside the scene's folder: {}",
+        paths.join(", ")
+    )
+}
+
+/// Where a batch reports: the summary lines on stdout, whatever stderr is; errors and the
+/// progress bar (on a terminal only) on stderr. Output that cannot be written ends the printing,
+/// never the batch: a reader that has gone (`| head -1`) is no error, any other (a full disk)
+/// fails the command once every scene is written.
+struct Console {
+    progress: BatchProgress,
+    /// Stdout can no longer be written.
+    stdout_closed: bool,
+    /// Why, unless its reader had gone.
+    stdout_error: Option<io::Error>,
+}
+
+impl Console {
+    fn new(scenes: usize) -> Self {
+        Self {
+            progress: BatchProgress::new(scenes),
+            stdout_closed: false,
+            stdout_error: None,
+        }
+    }
+
+    /// Prints a scene's summary line on stdout (above the bar, if there is one).
+    fn summary(&mut self, line: &str) {
+        if self.stdout_closed {
+            return;
+        }
+        let written = self
+            .progress
+            .bar
+            .suspend(|| writeln!(io::stdout().lock(), "{line}"));
+        if let Err(error) = written {
+            self.stdout_closed = true;
+            if error.kind() != io::ErrorKind::BrokenPipe {
+                self.stdout_error = Some(error);
+            }
+        }
+    }
+
+    /// Prints a line on stderr (above the bar, if there is one); one that cannot be written is
+    /// lost, as there is nowhere else to say so.
+    fn error(&self, line: &str) {
+        self.progress.bar.suspend(|| {
+            let _ = writeln!(io::stderr().lock(), "{line}");
+        });
+    }
+}
+
+/// One progress bar over the whole batch on stderr when it is a terminal; nothing otherwise.
+struct BatchProgress {
+    bar: ProgressBar,
+}
+
+/// Steps of the bar per scene.
+const STEPS_PER_SCENE: u64 = 1000;
+
+impl BatchProgress {
+    fn new(scenes: usize) -> Self {
+        if !io::stderr().is_terminal() {
+            return Self {
+                bar: ProgressBar::hidden(),
+            };
+        }
+        let bar = ProgressBar::new(scenes as u64 * STEPS_PER_SCENE);
+        bar.set_draw_target(ProgressDrawTarget::stderr());
+        if let Ok(style) = ProgressStyle::with_template("{bar:40} {percent:>3}% {msg}") {
+            bar.set_style(style);
+        }
+        Self { bar }
+    }
+
+    /// Scene `index` is `fraction` done.
+    fn set(&self, index: usize, fraction: f64) {
+        let within = (fraction.clamp(0.0, 1.0) * STEPS_PER_SCENE as f64) as u64;
+        self.bar
+            .set_position(index as u64 * STEPS_PER_SCENE + within);
+    }
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
