@@ -9,7 +9,8 @@ use std::time::Duration;
 
 use sake_glug_device::csv_lane::MAX_CSV_LANE_BYTES;
 use sake_glug_device::midi_take::MAX_TAKE_BYTES;
-use sake_glug_render::{InputFile, InputFileError, Scene, SceneError, MAX_SCENE_BYTES};
+use sake_glug_io::ReadFailure;
+use sake_glug_render::{InputFile, Scene, SceneError, MAX_SCENE_BYTES};
 
 use crate::command::sake_glug_within;
 
@@ -123,7 +124,7 @@ fn a_fifo_is_refused_without_waiting_for_a_writer() {
             error,
             SceneError::CsvFile {
                 key: "tilt_deg",
-                source: InputFileError::NotAFile(_),
+                source: ReadFailure::NotAFile(_),
                 ..
             }
         ),
@@ -178,7 +179,7 @@ fn a_fifo_swapped_in_after_the_check_does_not_hang_the_read() {
             match Scene::default().with_midi_take(&link) {
                 Ok(_) => takes += 1,
                 Err(SceneError::TakeFile {
-                    source: InputFileError::NotAFile(_),
+                    source: ReadFailure::NotAFile(_),
                     ..
                 }) => fifos += 1,
                 Err(error) => panic!("{error}"),
@@ -234,7 +235,7 @@ fn a_file_over_the_limit_is_refused_from_its_size() {
         matches!(
             error,
             SceneError::CsvFile {
-                source: InputFileError::TooLarge { .. },
+                source: ReadFailure::TooLarge { .. },
                 ..
             }
         ),
@@ -274,7 +275,7 @@ fn a_missing_csv_lane_or_take_is_named_as_such() {
         matches!(
             error,
             SceneError::CsvFile {
-                source: InputFileError::Io(_),
+                source: ReadFailure::Io(_),
                 ..
             }
         ),
@@ -434,7 +435,7 @@ fn a_scene_that_is_a_fifo_or_a_device_is_refused_not_waited_for() {
         matches!(
             error,
             SceneError::Read {
-                source: InputFileError::NotAFile(_),
+                source: ReadFailure::NotAFile(_),
                 ..
             }
         ),
@@ -487,7 +488,7 @@ fn a_scene_over_the_limit_is_refused_from_its_size() {
         matches!(
             error,
             SceneError::Read {
-                source: InputFileError::TooLarge { .. },
+                source: ReadFailure::TooLarge { .. },
                 ..
             }
         ),

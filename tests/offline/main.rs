@@ -9,6 +9,7 @@ mod clip_rules;
 mod clips_rendered;
 mod command;
 mod determinism;
+mod every_input;
 mod files;
 mod fuzz;
 // FIFOs, devices and links as Unix makes them.

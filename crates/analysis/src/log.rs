@@ -1,6 +1,7 @@
 //! Study logs as the analyses read them: CSV with a header, of which only the columns an
 //! analysis names are read (a log holds many more: the runner logs every stimulus parameter).
 
+use sake_glug_io::read::{self, InputKind};
 use std::path::Path;
 
 use super::error::{shown, AnalysisError};
@@ -52,10 +53,11 @@ fn read_file<const N: usize>(
     rows: &mut Vec<LogRow<N>>,
 ) -> Result<(), AnalysisError> {
     let name = shown(file);
+    let input = read::open(file, InputKind::STUDY_LOG)
+        .map_err(|error| AnalysisError::read(file, error.failure))?;
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
-        .from_path(file)
-        .map_err(|error| AnalysisError::read(file, csv_message(&error)))?;
+        .from_reader(std::io::BufReader::new(input));
     let headers = reader
         .headers()
         .map_err(|error| row_error(&name, &error, 1))?

@@ -12,10 +12,8 @@ use sake_glug_io::text::printable;
 /// The column of times, in seconds from the start of the take.
 pub const TIME_COLUMN: &str = "time_s";
 
-/// The largest CSV take read (256 MiB): an hour of readings at 1 kHz with a time and three
-/// gravity columns (about 70 bytes a row) fits, and the text, held whole while it is read, stays
-/// a small part of a computer's memory.
-pub const MAX_CSV_LANE_BYTES: u64 = 256 << 20;
+/// The largest take file read ([`sake_glug_io::InputKind::CSV_LANE`]).
+pub const MAX_CSV_LANE_BYTES: u64 = sake_glug_io::InputKind::CSV_LANE.max_bytes;
 
 /// The most of a field an error quotes: enough to see what it is, never a whole line.
 const QUOTED_FIELD_CHARS: usize = 32;

@@ -14,9 +14,8 @@ use sake_glug_io::text::printable;
 /// The longest take read, in seconds: anything later is a corrupt delta time, not a pour.
 pub const MAX_TAKE_SECONDS: u64 = 24 * 60 * 60;
 
-/// The largest take file read (16 MiB): four million messages of about four bytes, over an
-/// hour of a control change every millisecond, far more than a tilt device sends.
-pub const MAX_TAKE_BYTES: u64 = 16 << 20;
+/// The largest take file read ([`sake_glug_io::InputKind::MIDI_TAKE`]).
+pub const MAX_TAKE_BYTES: u64 = sake_glug_io::InputKind::MIDI_TAKE.max_bytes;
 
 /// The tempo of a file that sets none: 120 quarter notes per minute.
 const DEFAULT_TEMPO_US: u32 = 500_000;

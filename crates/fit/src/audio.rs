@@ -1,6 +1,7 @@
 //! A recording's samples: any WAV hound reads, at 8 kHz or more, its first channel, with its DC
 //! offset removed; silence refused, clipping counted.
 
+use sake_glug_io::read::{self, InputKind};
 use std::path::Path;
 
 use super::error::FitError;
@@ -38,7 +39,13 @@ impl Audio {
             path: path.to_owned(),
             source,
         };
-        let mut reader = hound::WavReader::open(path).map_err(wav_error)?;
+        let input =
+            read::open(path, InputKind::RECORDING).map_err(|source| FitError::RecordingRead {
+                key: key.to_owned(),
+                source,
+            })?;
+        let mut reader =
+            hound::WavReader::new(std::io::BufReader::new(input)).map_err(wav_error)?;
         let spec = reader.spec();
         if spec.sample_rate < MIN_SAMPLE_RATE_HZ {
             return Err(FitError::RateTooLow {

@@ -4,18 +4,14 @@
 use std::path::{Path, PathBuf};
 
 use sake_glug_io::text::printable;
+use sake_glug_io::ReadError;
 
 /// Why `sake-glug fit` could not fit a model.
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
-    /// The session file could not be read.
-    #[error("cannot read session file {}: {source}", shown(path))]
-    SessionRead {
-        /// The session file.
-        path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
-    },
+    /// The session file could not be read: missing, not a regular file, too large, not UTF-8.
+    #[error(transparent)]
+    SessionRead(ReadError),
     /// Not valid TOML, an unknown key or a value of the wrong type.
     #[error("invalid session {}: {}", shown(path), printable(message))]
     SessionSyntax {
@@ -42,7 +38,15 @@ pub enum FitError {
         /// The session file.
         path: PathBuf,
     },
-    /// A recording's WAV file could not be opened or read.
+    /// A recording could not be opened: missing, not a regular file, too large.
+    #[error("`{key}`: {source}")]
+    RecordingRead {
+        /// The key naming it (`recording[0].audio`).
+        key: String,
+        /// Why not, with the file.
+        source: ReadError,
+    },
+    /// A recording's WAV file could not be read.
     #[error("`{key}`: cannot read WAV file {}: {source}", shown(path))]
     Wav {
         /// The key naming it (`recording[0].audio`).

@@ -1,6 +1,7 @@
 //! A fit session (MODEL.md §13): the bottle's capacity and its recordings, each a WAV file at one
 //! tilt, with its start volume or a weight log, and the liquid it holds.
 
+use sake_glug_io::read::{self, InputKind};
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
@@ -92,10 +93,7 @@ fn water_density() -> f64 {
 impl FitSession {
     /// Reads and validates the session at `path`.
     pub fn load(path: &Path) -> Result<Self, FitError> {
-        let text = std::fs::read_to_string(path).map_err(|source| FitError::SessionRead {
-            path: path.to_owned(),
-            source,
-        })?;
+        let text = read::read_text(path, InputKind::FIT_SESSION).map_err(FitError::SessionRead)?;
         Self::parse(&text, path)
     }
 

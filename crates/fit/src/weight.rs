@@ -4,6 +4,7 @@
 
 use super::error::FitError;
 use super::session::WeightSpec;
+use sake_glug_io::read::{self, InputKind};
 
 /// The residual volume over time read from a weight log.
 #[derive(Debug, Clone, PartialEq)]
@@ -25,8 +26,8 @@ impl WeightLog {
             column: column.map(str::to_owned),
             what,
         };
-        let text =
-            std::fs::read_to_string(&spec.csv).map_err(|error| fail(0, None, error.to_string()))?;
+        let text = read::text_within(&spec.csv, InputKind::WEIGHT_LOG.max_bytes)
+            .map_err(|failure| fail(0, None, failure.to_string()))?;
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(true)
             .trim(csv::Trim::All)

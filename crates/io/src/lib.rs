@@ -1,11 +1,18 @@
-//! How Sake Glug reads and writes files.
+//! How Sake Glug reads and writes files: one way each.
 //!
-//! - [`text`]: outside text (a scene's field, a file name) made safe to echo in a message;
-//! - [`pending`]: every file written all or nothing, in a temporary file beside its target
-//!   ([`temp`]) renamed over it once complete.
+//! - [`read`]: every input file, read through one bounded reader (a regular file only, within
+//!   the limit of its kind, which [`read::InputKind`] declares);
+//! - [`pending`]: every output file, written all or nothing: in a temporary file beside its
+//!   target ([`temp`]), renamed over it once complete;
+//! - [`keys`]: the dotted keys of the product's TOML files (feature `toml`);
+//! - [`text`]: outside text (a file's field, a file name) made safe to echo in a message.
 
+#[cfg(feature = "toml")]
+pub mod keys;
 pub mod pending;
+pub mod read;
 pub mod temp;
 pub mod text;
 
 pub use pending::{remove_own_temps, remove_stale_temps, PendingFile, WriteError};
+pub use read::{InputKind, ReadError, ReadFailure};

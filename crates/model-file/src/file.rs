@@ -1,56 +1,23 @@
 //! Reading and validating a model file: the keys of a scene that describe the bottle and the
 //! liquid, nothing else (MODEL.md §12.1).
 
-use std::io::Read;
 use std::path::Path;
 
 use sake_glug_engine::{Constant, Control, Curve, ModelConfig, PerControl, Quantity, ValueError};
+use sake_glug_io::keys;
+use sake_glug_io::read::{self, InputKind, ReadError};
 use sake_glug_io::text::printable;
 
-/// The largest model file read (bytes): a model is a few dozen lines; a larger file is no model.
-pub const MAX_MODEL_BYTES: u64 = 1 << 20;
-
-/// The regular file at `path`, opened without waiting (a FIFO opened for reading waits for a
-/// writer) and checked as opened, so a path replaced after a check cannot slip through.
-fn open_regular_file(path: &Path) -> std::io::Result<std::fs::File> {
-    let mut options = std::fs::OpenOptions::new();
-    options.read(true);
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::OpenOptionsExt;
-        options.custom_flags(libc::O_NONBLOCK);
-    }
-    let file = options.open(path)?;
-    if file.metadata()?.is_file() {
-        Ok(file)
-    } else {
-        Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            "not a regular file",
-        ))
-    }
-}
+/// The largest model file read ([`InputKind::MODEL`]): a model is a few dozen lines.
+pub const MAX_MODEL_BYTES: u64 = InputKind::MODEL.max_bytes;
 
 /// Why a model was refused. Text from the file is shown with its control characters escaped.
 #[derive(Debug, thiserror::Error)]
 pub enum ModelFileError {
-    /// The file could not be read.
-    #[error("cannot read model file {}: {source}", printable(path))]
-    Read {
-        /// The file's path, as given.
-        path: String,
-        /// The I/O error.
-        source: std::io::Error,
-    },
-    /// Larger than [`MAX_MODEL_BYTES`].
-    #[error(
-        "model file {} is over the limit of {MAX_MODEL_BYTES} bytes",
-        printable(path)
-    )]
-    TooLarge {
-        /// The file's path, as given.
-        path: String,
-    },
+    /// The file could not be read: missing, not a regular file, over [`MAX_MODEL_BYTES`], not
+    /// UTF-8.
+    #[error(transparent)]
+    Read(#[from] ReadError),
     /// Not valid TOML, or a value of the wrong type: the parser's message, escaped.
     #[error("invalid model: {0}")]
     Syntax(String),
@@ -84,20 +51,7 @@ pub struct ModelFile {
 impl ModelFile {
     /// Reads the model file at `path`, named after the file (its stem).
     pub fn load(path: &Path) -> Result<Self, ModelFileError> {
-        let shown = path.to_string_lossy().into_owned();
-        let read = |source| ModelFileError::Read {
-            path: shown.clone(),
-            source,
-        };
-        let mut text = String::new();
-        open_regular_file(path)
-            .map_err(read)?
-            .take(MAX_MODEL_BYTES + 1)
-            .read_to_string(&mut text)
-            .map_err(read)?;
-        if text.len() as u64 > MAX_MODEL_BYTES {
-            return Err(ModelFileError::TooLarge { path: shown });
-        }
+        let text = read::read_text(path, InputKind::MODEL)?;
         let name = path
             .file_stem()
             .map_or("model".into(), |stem| stem.to_string_lossy().into_owned());
@@ -106,14 +60,8 @@ impl ModelFile {
 
     /// Parses and validates the model `text`, called `name`.
     pub fn parse(name: &str, text: &str) -> Result<Self, ModelFileError> {
-        let table: toml::Table = toml::from_str(text).map_err(|error| {
-            let lines: Vec<_> = error
-                .to_string()
-                .split('\n')
-                .map(|line| printable(line).into_owned())
-                .collect();
-            ModelFileError::Syntax(lines.join("\n"))
-        })?;
+        let table: toml::Table = toml::from_str(text)
+            .map_err(|error| ModelFileError::Syntax(keys::syntax_message(&error)))?;
         let keys = flatten(&table);
         let mut config = ModelConfig::default();
         let mut controls = PerControl::from_fn(|_| None);
@@ -229,7 +177,7 @@ fn flatten(table: &toml::Table) -> Vec<(String, toml::Value)> {
         match value {
             toml::Value::Table(section) if !lane => {
                 for (inner, value) in section {
-                    keys.push((format!("{name}.{inner}"), value.clone()));
+                    keys.push((keys::join(name, inner), value.clone()));
                 }
             }
             value => keys.push((name.clone(), value.clone())),

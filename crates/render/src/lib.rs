@@ -22,8 +22,7 @@ pub use render::{
     render_scene, render_scene_to_vec, BottleReport, RenderError, RenderObserver, RenderSummary,
 };
 pub use scene::{
-    InputFile, InputFileError, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S,
-    MAX_SCENE_BYTES,
+    InputFile, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S, MAX_SCENE_BYTES,
 };
 pub use sinks::{
     Output, OutputError, OutputFormat, OutputOptions, PlatformOptions, SampleFormat, WavError,

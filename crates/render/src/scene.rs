@@ -1,8 +1,6 @@
 //! Scene files (MODEL.md §10): TOML in, a validated [`Scene`] out. Every key is optional; an
 //! unknown key, a wrong type or an out-of-range value is refused with an error naming it.
 
-use std::fs::{File, FileType};
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use super::automation::{Automation, CsvLaneRef, LaneSpec};
@@ -15,6 +13,8 @@ use sake_glug_engine::{
     Constant, Control, ControlSource, ControlValues, Controls, Curve, DrainMode, ModelConfig,
     PerControl, Preset, PresetValue, Quantity, Range, ValueError,
 };
+use sake_glug_io::keys::{self, KeyedTable};
+use sake_glug_io::read::{self, InputKind, ReadFailure};
 use sake_glug_io::text::printable;
 use sake_glug_model_file::{curve_points, ModelFile};
 
@@ -24,10 +24,8 @@ pub const DEFAULT_SCENE: &str = r#"
 tilt_deg = [[0.0, 90.0], [0.5, 135.0]]
 "#;
 
-/// The largest scene file read (16 MiB): its automation points are written out in TOML, which
-/// the parser holds several times over while it reads them; a longer recording belongs in a
-/// CSV lane, which may be larger.
-pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+/// The largest scene file read ([`InputKind::SCENE`]).
+pub const MAX_SCENE_BYTES: u64 = InputKind::SCENE.max_bytes;
 
 /// Longest render a scene may ask for (and the limit on one that never falls silent).
 pub const MAX_DURATION_S: f64 = 86_400.0;
@@ -42,7 +40,7 @@ pub enum SceneError {
         /// The file's path.
         path: PathBuf,
         /// Why not.
-        source: InputFileError,
+        source: ReadFailure,
     },
     /// The file of a CSV lane could not be read.
     #[error("cannot read CSV lane `{key}` file {}: {source}", shown(path))]
@@ -52,7 +50,7 @@ pub enum SceneError {
         /// The file's path.
         path: PathBuf,
         /// Why not.
-        source: InputFileError,
+        source: ReadFailure,
     },
     /// The file of a MIDI take could not be read.
     #[error("cannot read MIDI take {}: {source}", shown(path))]
@@ -60,7 +58,7 @@ pub enum SceneError {
         /// The file's path.
         path: PathBuf,
         /// Why not.
-        source: InputFileError,
+        source: ReadFailure,
     },
     /// Not valid TOML, an unknown key or a value of the wrong type: the parser's message, its
     /// control characters escaped.
@@ -113,37 +111,6 @@ pub enum SceneError {
         index: usize,
         /// The point's time (s).
         time_s: f64,
-    },
-}
-
-/// Why a CSV lane's or a MIDI take's file was not read.
-#[derive(Debug, thiserror::Error)]
-pub enum InputFileError {
-    /// Opening or reading it failed.
-    #[error("{0}")]
-    Io(#[from] std::io::Error),
-    /// A FIFO, a device, a folder: reading it could block, never end or mean nothing.
-    #[error("it is {0}, not a regular file")]
-    NotAFile(&'static str),
-    /// Larger than the limit, by its size on disk.
-    #[error("it is {size} bytes, over the limit of {limit} bytes ({} MiB)", limit >> 20)]
-    TooLarge {
-        /// Its size (bytes).
-        size: u64,
-        /// The limit (bytes).
-        limit: u64,
-    },
-    /// More bytes than the limit came out of it, whatever its size said.
-    #[error("it holds more than the limit of {limit} bytes ({} MiB)", limit >> 20)]
-    OverLimit {
-        /// The limit (bytes).
-        limit: u64,
-    },
-    /// A scene or a CSV lane that is not UTF-8 text.
-    #[error("line {line} is not UTF-8 text")]
-    NotText {
-        /// The line, from 1.
-        line: u64,
     },
 }
 
@@ -214,7 +181,7 @@ impl MidiTake {
     /// Reads the take at `path` for a render at `sample_rate` (Hz).
     pub fn load(path: &Path, sample_rate: u32) -> Result<Self, SceneError> {
         let bytes =
-            read_input_file(path, MAX_TAKE_BYTES).map_err(|source| SceneError::TakeFile {
+            read::bytes_within(path, MAX_TAKE_BYTES).map_err(|source| SceneError::TakeFile {
                 path: path.to_owned(),
                 source,
             })?;
@@ -236,12 +203,10 @@ impl MidiTake {
 
 /// A scene file's text, read as a regular file within [`MAX_SCENE_BYTES`], in UTF-8.
 fn read_scene_text(path: &Path) -> Result<String, SceneError> {
-    read_input_file(path, MAX_SCENE_BYTES)
-        .and_then(utf8_text)
-        .map_err(|source| SceneError::Read {
-            path: path.to_owned(),
-            source,
-        })
+    read::text_within(path, MAX_SCENE_BYTES).map_err(|source| SceneError::Read {
+        path: path.to_owned(),
+        source,
+    })
 }
 
 impl Default for Scene {
@@ -315,17 +280,7 @@ impl Scene {
                 PresetValue::Control(control, value) => (control.quantity(), value),
                 PresetValue::Constant(constant, value) => (constant.quantity(), value),
             };
-            let (section, name) = match quantity.scene_key.split_once('.') {
-                Some((section, name)) => {
-                    let section = table
-                        .entry(section)
-                        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-                    let section = section.as_table_mut().expect("a section is a table");
-                    (section, name)
-                }
-                None => (&mut table, quantity.scene_key),
-            };
-            section.insert(name.to_owned(), toml::Value::Float(value));
+            keys::insert(&mut table, quantity.scene_key, toml::Value::Float(value));
         }
         format!(
             "# {}: {}.\n# Written by `cargo xtask docs` from crates/engine/src/presets.rs: edit the preset \
@@ -419,25 +374,13 @@ const MIDI_SECTION: &str = "midi";
 /// A scene file's TOML, from which each key is taken as it is read: what is left at the end is
 /// unknown, and refused.
 struct SceneFile {
-    table: toml::Table,
-    /// Every key read or asked for, for the message that refuses an unknown one.
-    known: Vec<String>,
+    keys: KeyedTable,
 }
 
 impl SceneFile {
     fn parse(text: &str) -> Result<Self, SceneError> {
-        let table = toml::from_str(text).map_err(|error| {
-            // toml's message shows the line at fault over several lines: their layout is kept.
-            let lines: Vec<_> = error
-                .to_string()
-                .split('\n')
-                .map(|line| printable(line).into_owned())
-                .collect();
-            SceneError::Syntax(lines.join("\n"))
-        })?;
         Ok(Self {
-            table,
-            known: Vec::new(),
+            keys: KeyedTable::parse(text).map_err(SceneError::Syntax)?,
         })
     }
 
@@ -446,89 +389,18 @@ impl SceneFile {
     /// something other than a table is left for validation to refuse.
     fn layer_over(&mut self, model: &ModelFile) {
         for (key, value) in model.keys() {
-            let (table, name) = match key.split_once('.') {
-                None => (&mut self.table, key.as_str()),
-                Some((section, name)) => {
-                    let section = self
-                        .table
-                        .entry(section)
-                        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-                    match section.as_table_mut() {
-                        Some(table) => (table, name),
-                        None => continue,
-                    }
-                }
-            };
-            table.entry(name).or_insert_with(|| value.clone());
+            keys::insert_if_absent(self.keys.table_mut(), key, value);
         }
     }
 
     /// The value at `key` (`section.name` inside a table), taken out of the file.
     fn take<T: serde::de::DeserializeOwned>(&mut self, key: &str) -> Result<Option<T>, SceneError> {
-        self.known.push(key.to_owned());
-        let (section, name) = match key.split_once('.') {
-            Some((section, name)) => (Some(section), name),
-            None => (None, key),
-        };
-        let table = match section {
-            None => &mut self.table,
-            Some(section) => match self.table.get_mut(section) {
-                None => return Ok(None),
-                Some(toml::Value::Table(table)) => table,
-                Some(other) => {
-                    return Err(syntax(&format!(
-                        "`{section}`: invalid type: {}, expected a table",
-                        other.type_str()
-                    )))
-                }
-            },
-        };
-        match table.remove(name) {
-            None => Ok(None),
-            Some(value) => value
-                .try_into()
-                .map(Some)
-                // toml ends a message without a place in the file with a line break.
-                .map_err(|error| syntax(&format!("`{key}`: {}", error.to_string().trim_end()))),
-        }
+        self.keys.take(key).map_err(SceneError::Syntax)
     }
 
     /// Refuses whatever key is left: none of the scene's.
     fn refuse_unknown(self) -> Result<(), SceneError> {
-        // The names known inside `section` (`None`: at the top, sections included).
-        let names_in = |section: Option<&str>| {
-            let mut names: Vec<&str> = Vec::new();
-            for key in &self.known {
-                let name = match (key.split_once('.'), section) {
-                    (Some((outer, name)), Some(wanted)) if outer == wanted => name,
-                    (Some((outer, _)), None) => outer,
-                    (None, None) => key.as_str(),
-                    _ => continue,
-                };
-                if !names.contains(&name) {
-                    names.push(name);
-                }
-            }
-            names
-        };
-        let unknown = |name: &str, place: String, known: Vec<&str>| {
-            let known: Vec<String> = known.iter().map(|name| format!("`{name}`")).collect();
-            syntax(&format!(
-                "unknown field `{name}`{place}, expected one of {}",
-                known.join(", ")
-            ))
-        };
-        for (name, value) in &self.table {
-            let inside = names_in(Some(name));
-            if inside.is_empty() {
-                if !self.known.contains(name) {
-                    return Err(unknown(name, String::new(), names_in(None)));
-                }
-            } else if let Some(key) = value.as_table().and_then(|table| table.keys().next()) {
-                return Err(unknown(key, format!(" in [{name}]"), inside));
-            }
-        }
-        Ok(())
+        self.keys.refuse_unknown().map_err(SceneError::Syntax)
     }
 
     /// The `[midi]` table, each setting checked: a CC above 127 or a channel above 15 that is
@@ -676,89 +548,11 @@ fn resolve(
         path: path.clone(),
         source,
     };
-    let text = read_input_file(&path, MAX_CSV_LANE_BYTES)
-        .and_then(utf8_text)
-        .map_err(file_error)?;
+    let text = read::text_within(&path, MAX_CSV_LANE_BYTES).map_err(file_error)?;
     let points =
         read_csv_lane(&text, &path, &spec).map_err(|source| SceneError::Csv { key, source })?;
     inputs.push(InputFile::new(key, path, folder));
     Ok(Some(Automation::Points(points)))
-}
-
-/// The bytes of the regular file at `path`, refused if larger than `limit` bytes.
-fn read_input_file(path: &Path, limit: u64) -> Result<Vec<u8>, InputFileError> {
-    let (file, size) = open_regular_file(path, limit)?;
-    // A file may hold more than its size says (/proc) or grow while read.
-    read_at_most(file, size, limit)
-}
-
-/// The regular file at `path`, opened, and its size, refused if over `limit` bytes. What is
-/// checked is the opened file, not the path: a path checked and then opened can be replaced in
-/// between. Opening never waits: a FIFO opened for reading without O_NONBLOCK waits for a
-/// writer, and is refused as soon as it is open.
-fn open_regular_file(path: &Path, limit: u64) -> Result<(File, u64), InputFileError> {
-    let mut options = std::fs::OpenOptions::new();
-    options.read(true);
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::OpenOptionsExt;
-        options.custom_flags(libc::O_NONBLOCK);
-    }
-    let file = options.open(path)?;
-    let metadata = file.metadata()?;
-    if !metadata.is_file() {
-        return Err(InputFileError::NotAFile(kind(metadata.file_type())));
-    }
-    match metadata.len() {
-        size if size > limit => Err(InputFileError::TooLarge { size, limit }),
-        // O_NONBLOCK changes nothing for a regular file.
-        size => Ok((file, size)),
-    }
-}
-
-/// `bytes` as text, or the line (from 1) where they stop being UTF-8.
-fn utf8_text(bytes: Vec<u8>) -> Result<String, InputFileError> {
-    String::from_utf8(bytes).map_err(|error| {
-        let bytes = &error.as_bytes()[..error.utf8_error().valid_up_to()];
-        let line = 1 + bytes.iter().filter(|&&byte| byte == b'\n').count() as u64;
-        InputFileError::NotText { line }
-    })
-}
-
-/// Everything `reader` holds (`expected_size` bytes, it says), or an error once more than
-/// `limit` bytes came out of it.
-fn read_at_most(
-    reader: impl Read,
-    expected_size: u64,
-    limit: u64,
-) -> Result<Vec<u8>, InputFileError> {
-    let mut bytes = Vec::with_capacity(expected_size.min(limit) as usize);
-    reader.take(limit + 1).read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > limit {
-        return Err(InputFileError::OverLimit { limit });
-    }
-    Ok(bytes)
-}
-
-/// What a file that is not a regular file is, for a message.
-fn kind(file_type: FileType) -> &'static str {
-    if file_type.is_dir() {
-        return "a folder";
-    }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if file_type.is_fifo() {
-            return "a FIFO (named pipe)";
-        }
-        if file_type.is_char_device() || file_type.is_block_device() {
-            return "a device";
-        }
-        if file_type.is_socket() {
-            return "a socket";
-        }
-    }
-    "a special file"
 }
 
 /// A path for a message.
@@ -816,43 +610,4 @@ fn automation(
         }
     }
     Ok(automation)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn an_input_file_is_read_up_to_its_limit() {
-        let folder = tempfile::tempdir().unwrap();
-        let path = folder.path().join("take.csv");
-        std::fs::write(&path, "0123456789").unwrap();
-        assert_eq!(read_input_file(&path, 10).unwrap(), b"0123456789");
-        assert!(matches!(
-            read_input_file(&path, 9),
-            Err(InputFileError::TooLarge { size: 10, limit: 9 })
-        ));
-    }
-
-    #[test]
-    fn reading_stops_past_the_limit() {
-        let endless = std::io::repeat(b'x');
-        assert!(matches!(
-            read_at_most(endless, 0, 1000),
-            Err(InputFileError::OverLimit { limit: 1000 })
-        ));
-        assert_eq!(read_at_most(&b"12345"[..], 5, 5).unwrap(), b"12345");
-    }
-
-    #[cfg(target_os = "linux")]
-    #[test]
-    fn the_limit_holds_while_reading_a_file_larger_than_its_size_says() {
-        // Files of /proc say they hold 0 bytes.
-        let status = Path::new("/proc/self/status");
-        assert_eq!(std::fs::metadata(status).unwrap().len(), 0);
-        assert!(matches!(
-            read_input_file(status, 16),
-            Err(InputFileError::OverLimit { limit: 16 })
-        ));
-    }
 }

@@ -40,6 +40,9 @@ pub use trials::{order_seed, plan_trials, Trial};
 /// Why a study could not run, or stopped.
 #[derive(Debug, thiserror::Error)]
 pub enum StudyError {
+    /// An input file (the spec) could not be read: missing, not a regular file, too large.
+    #[error(transparent)]
+    Read(#[from] sake_glug_io::ReadError),
     /// A file could not be read or written.
     #[error("{}: {source}", .path.display())]
     Io {

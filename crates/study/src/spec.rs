@@ -8,6 +8,7 @@ use serde::Deserialize;
 
 use super::StudyError;
 use sake_glug_engine::{Constant, Control, Preset};
+use sake_glug_io::read::{self, InputKind};
 use sake_glug_io::text::printable;
 use sake_glug_render::{Scene, DEFAULT_SCENE, MAX_DURATION_S};
 
@@ -205,10 +206,7 @@ impl Spec {
     /// Reads and validates the spec at `path`; the scene and model files it names are found
     /// relative to its folder.
     pub fn load(path: &Path) -> Result<Self, StudyError> {
-        let text = std::fs::read_to_string(path).map_err(|source| StudyError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
+        let text = read::read_text(path, InputKind::STUDY_SPEC)?;
         Self::parse(&text, path)
     }
 
@@ -477,9 +475,14 @@ fn build_stimulus(
         }
         Some((key, toml::Value::String(file))) => {
             let path = folder.join(&file);
-            let text = std::fs::read_to_string(&path).map_err(|error| {
+            let kind = if key == MODEL {
+                InputKind::MODEL
+            } else {
+                InputKind::SCENE
+            };
+            let text = read::text_within(&path, kind.max_bytes).map_err(|failure| {
                 bad(format!(
-                    "`{key}` = \"{}\": cannot read it: {error}",
+                    "`{key}` = \"{}\": cannot read it: {failure}",
                     printable(&file)
                 ))
             })?;
