@@ -466,6 +466,10 @@ fn presets() -> Vec<(&'static str, &'static str, &'static str, String)> {
 
 #[pymodule]
 fn _sake_glug(module: &Bound<'_, PyModule>) -> PyResult<()> {
+    // rust-numpy fetches NumPy's API on first use, running Python (an import): done here, so that
+    // a Ctrl-C pending as a render returns is raised as KeyboardInterrupt, not met by that
+    // import and turned into a panic.
+    PyArray1::<f32>::zeros(module.py(), 0, false);
     module.add_function(wrap_pyfunction!(render, module)?)?;
     module.add_function(wrap_pyfunction!(render_tables, module)?)?;
     module.add_function(wrap_pyfunction!(fit, module)?)?;

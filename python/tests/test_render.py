@@ -1,8 +1,8 @@
 """sake_glug.render gives the samples of `sake-glug render` of the same scene, bit for bit, and
 refuses what the command line refuses with the same message."""
 
-import functools
-import io
+import collections
+import itertools
 import threading
 import time
 import _thread
@@ -125,71 +125,80 @@ def test_a_scene_of_another_type_is_a_type_error():
 ENDLESS_POUR = {"tilt_deg": [[0.0, 90.0], [86400.0, 135.0]], "sample_rate": 1000}
 
 
-def c_progress(stream: io.StringIO):
-    """A progress callback made of C alone (print into a StringIO): calling it runs no Python
-    code, so it never offers the GIL nor raises a pending KeyboardInterrupt, as a callback in
-    Python would; its stream's position tells how often it was called, and once the stream is
-    closed the next call raises (ValueError: I/O operation on closed file)."""
-    return functools.partial(print, file=stream)
+class CallCount:
+    """A progress callback made of C alone: `deque.insert`, which runs no Python code, so calling
+    it never offers the GIL nor runs a pending signal's handler (as Python code would, and
+    as C that prints does). Each call adds an entry; `stop()` fills the deque, and the next call
+    raises IndexError (deque already at its maximum size)."""
+
+    def __init__(self):
+        self.calls = collections.deque(maxlen=1_000_000)
+        self.callback = self.calls.insert
+
+    def __len__(self):
+        return len(self.calls)
+
+    def stop(self):
+        self.calls.extend(itertools.repeat(None, self.calls.maxlen - len(self.calls)))
 
 
 def test_the_gil_is_released_while_rendering():
     # The render runs in a thread whose only Python is the C callback: this thread can run
     # while it renders only if the render released the GIL. Held, this loop would first run
-    # once the render had ended (a day of pouring), and see the callback's count stand still.
-    calls = io.StringIO()
+    # once the render had ended (a day of pouring), and see the count stand still.
+    calls = CallCount()
     outcome = []
 
     def render():
         try:
-            sake_glug.render(ENDLESS_POUR, progress=c_progress(calls))
-        except ValueError as error:
+            sake_glug.render(ENDLESS_POUR, progress=calls.callback)
+        except IndexError as error:
             outcome.append(str(error))
 
     worker = threading.Thread(target=render)
     worker.start()
-    while calls.tell() == 0 and worker.is_alive():
+    while len(calls) == 0 and worker.is_alive():
         time.sleep(0.001)
-    seen = calls.tell()
-    while calls.tell() == seen and worker.is_alive():
+    seen = len(calls)
+    while len(calls) == seen and worker.is_alive():
         time.sleep(0.001)
     # Seen rendering on while this thread ran: now stop it.
-    calls.close()
+    calls.stop()
     worker.join()
-    assert len(outcome) == 1 and "closed file" in outcome[0], outcome
+    assert outcome == ["deque already at its maximum size"]
 
 
-def test_ctrl_c_stops_a_render():
+def test_ctrl_c_stops_a_render(ctrl_c):
     # Ctrl-C comes once the render has begun (its callback was called), from another thread.
-    # The callback is C, so only the render's own look for signals can raise it, and it must
-    # raise it before calling the callback again. A render that went on instead is stopped by
-    # closing the callback's stream (a ValueError, not KeyboardInterrupt): a failure, not a hang.
-    calls = io.StringIO()
+    # The callback is C that looks for no signal, so only the render's own look can raise it,
+    # and it must raise it before calling the callback again. A render that went on instead is
+    # stopped through its callback (IndexError, not CtrlC): a failure, not a hang.
+    calls = CallCount()
     rendering = threading.Event()
     interrupted_at = []
 
     def interrupt_once_rendering():
-        while rendering.is_set() and calls.tell() == 0:
+        while rendering.is_set() and len(calls) == 0:
             time.sleep(0.001)
         if not rendering.is_set():
             return
         _thread.interrupt_main()
-        interrupted_at.append(calls.tell())
-        while rendering.is_set() and calls.tell() == interrupted_at[0]:
+        interrupted_at.append(len(calls))
+        while rendering.is_set() and len(calls) == interrupted_at[0]:
             time.sleep(0.001)
         if rendering.is_set():
-            calls.close()
+            calls.stop()
 
     rendering.set()
     interrupter = threading.Thread(target=interrupt_once_rendering)
     interrupter.start()
     try:
-        with pytest.raises(KeyboardInterrupt):
-            sake_glug.render(ENDLESS_POUR, progress=c_progress(calls))
+        with pytest.raises(ctrl_c):
+            sake_glug.render(ENDLESS_POUR, progress=calls.callback)
     finally:
         rendering.clear()
         interrupter.join()
-    assert calls.tell() == interrupted_at[0], "the render called back after Ctrl-C"
+    assert len(calls) == interrupted_at[0], "the render called back after Ctrl-C"
 
 
 class Stop(Exception):
