@@ -360,6 +360,8 @@ fn columns<'py, R>(
 /// what the fit found: {"liquids": {name: {"estimates": {key: {"value", "low", "high",
 /// "in_model"}}, "units", "kept_default": {key: why}, "model": the model file's TOML}},
 /// "warnings": [...]}. Nothing is written. Raises SakeGlugError with the command line's message.
+/// Ctrl-C returns at once; the fit, which cannot be stopped, runs on in the background and its
+/// result is dropped.
 #[pyfunction]
 fn fit(py: Python<'_>, session: PathBuf) -> PyResult<Bound<'_, PyAny>> {
     let fitted = interruptible(py, move || {
@@ -404,7 +406,8 @@ fn fit(py: Python<'_>, session: PathBuf) -> PyResult<Bound<'_, PyAny>> {
 
 /// The paired-comparison analysis of trial logs (`sake-glug analyze paired --json`): the
 /// count matrix, proportions, Thurstone Case V "scale" by stimulus, predicted proportions,
-/// Mosteller's "fit" test and the participants' "agreement" test, as a dict.
+/// Mosteller's "fit" test and the participants' "agreement" test, as a dict. Ctrl-C returns at
+/// once (the analysis runs on in the background, its result dropped).
 #[pyfunction]
 fn analyze_paired(py: Python<'_>, logs: Vec<PathBuf>) -> PyResult<Bound<'_, PyAny>> {
     let analysis = interruptible(py, move || analyze_paired_logs(&logs))?
@@ -415,7 +418,8 @@ fn analyze_paired(py: Python<'_>, logs: Vec<PathBuf>) -> PyResult<Bound<'_, PyAn
 /// The constant-stimuli analysis of trial logs (`sake-glug analyze constant --json`): the
 /// logistic fit pooled and per participant, its 25/50/75 % "points" with 95 % intervals
 /// ("value", "low", "high"), as a dict. resamples (1 to 100,000), seed and lapse as the command
-/// line's options.
+/// line's options. Ctrl-C returns at once (the analysis runs on in the background, its result
+/// dropped).
 #[pyfunction]
 #[pyo3(signature = (logs, *, resamples=None, seed=None, lapse=None))]
 fn analyze_constant<'py>(

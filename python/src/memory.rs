@@ -25,22 +25,33 @@ fn available_bytes() -> Option<u64> {
     Some(kilobytes.saturating_mul(1024))
 }
 
-/// Why `bytes` more cannot be held ("more than the 3.1 GB available"), or `None` if they can.
+/// Why `bytes` more cannot be held: more than the system has available ("more than the 3.1 GB
+/// available"), or `None`.
+fn beyond_available(bytes: u64) -> Option<String> {
+    let available = available_bytes().filter(|&available| bytes > available)?;
+    Some(format!(
+        "more than the {} available",
+        human_bytes(available)
+    ))
+}
+
+/// Why an allocation failed: the address-space limit (`ulimit -v`), or past what the system
+/// could ever give.
+const BEYOND_LIMIT: &str = "more than this process may allocate (its memory limit)";
+
+/// Why `bytes` more cannot be held, checked against the memory available and against what this
+/// process may allocate, or `None` if they can: for allocations out of this crate's reach (the
+/// render crate's tables), whose failure would abort.
 fn refusal(bytes: u64) -> Option<String> {
-    if let Some(available) = available_bytes().filter(|&available| bytes > available) {
-        return Some(format!(
-            "more than the {} available",
-            human_bytes(available)
-        ));
-    }
-    // Taken and given back untouched: it costs address space, not memory, and fails as the real
-    // allocations would under an address-space limit (`ulimit -v`) or past what the system
-    // could ever give.
-    let mut probe = Vec::<u8>::new();
-    let fits = usize::try_from(bytes)
-        .ok()
-        .is_some_and(|bytes| probe.try_reserve_exact(bytes).is_ok());
-    (!fits).then(|| "more than this process may allocate (its memory limit)".to_owned())
+    beyond_available(bytes).or_else(|| {
+        // Taken and given back untouched: it costs address space, not memory, and fails as the
+        // real allocations would.
+        let mut probe = Vec::<u8>::new();
+        let fits = usize::try_from(bytes)
+            .ok()
+            .is_some_and(|bytes| probe.try_reserve_exact(bytes).is_ok());
+        (!fits).then(|| BEYOND_LIMIT.to_owned())
+    })
 }
 
 /// Where a render gets to in seconds, for a message.
@@ -69,14 +80,14 @@ impl Samples {
                 human_bytes(bytes)
             )
         };
-        if let Some(why) = refusal(bytes) {
+        if let Some(why) = beyond_available(bytes) {
             return Err(refused(why));
         }
         let mut samples = Vec::new();
-        let count = usize::try_from(count).map_err(|_| refused("more than an address".into()))?;
-        samples.try_reserve_exact(count).map_err(|_| {
-            refused("more than this process may allocate (its memory limit)".into())
-        })?;
+        usize::try_from(count)
+            .ok()
+            .and_then(|count| samples.try_reserve_exact(count).ok())
+            .ok_or_else(|| refused(BEYOND_LIMIT.into()))?;
         Ok(Self {
             samples,
             sample_rate,
@@ -111,12 +122,12 @@ impl Samples {
                     human_bytes(more)
                 )
             };
-            if let Some(why) = refusal(more) {
+            if let Some(why) = beyond_available(more) {
                 return Err(refused(why));
             }
-            self.samples.try_reserve_exact(wanted - len).map_err(|_| {
-                refused("more than this process may allocate (its memory limit)".into())
-            })?;
+            self.samples
+                .try_reserve_exact(wanted - len)
+                .map_err(|_| refused(BEYOND_LIMIT.into()))?;
         }
         self.samples.extend_from_slice(block);
         Ok(())
