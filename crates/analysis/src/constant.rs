@@ -24,6 +24,10 @@ pub const POINT_PERCENTS: [u8; 3] = [25, 50, 75];
 /// the curve's range.
 pub const MAX_LAPSE: f64 = 0.2;
 
+/// The most bootstrap resamples an analysis draws: fifty times the default, far more than a 95 %
+/// interval needs, and a bound on how long one runs (and on what a typo like 10**7 asks for).
+pub const MAX_RESAMPLES: usize = 100_000;
+
 /// How a psychometric function is fitted and its intervals drawn.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PsychometricOptions {
@@ -155,10 +159,11 @@ pub fn analyze_constant_logs(
             options.max_lapse
         )));
     }
-    if options.resamples == 0 {
-        return Err(AnalysisError::Option(
-            "at least one resample is needed".into(),
-        ));
+    if !(1..=MAX_RESAMPLES).contains(&options.resamples) {
+        return Err(AnalysisError::Option(format!(
+            "{} resamples: from 1 to {MAX_RESAMPLES} are drawn",
+            options.resamples
+        )));
     }
     let rows = read_rows(files, CONSTANT_COLUMNS)?;
     let mut participants: Vec<(String, Vec<(f64, bool)>)> = Vec::new();

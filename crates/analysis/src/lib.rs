@@ -20,7 +20,7 @@ mod plot;
 pub use constant::{
     analyze_constant_logs, count_levels, fit_psychometric, ConstantAnalysis, LevelCount, Logistic,
     PointEstimate, PsychometricFit, PsychometricFitError, PsychometricOptions, CONSTANT_COLUMNS,
-    MAX_LAPSE, POINT_PERCENTS,
+    MAX_LAPSE, MAX_RESAMPLES, POINT_PERCENTS,
 };
 pub use error::AnalysisError;
 pub use json::{constant_json, paired_json};
