@@ -5,6 +5,7 @@ use std::process::ExitCode;
 use clap::Args;
 
 use sake_glug_engine::{Preset, PRESETS};
+use sake_glug_io::text::quoted;
 use sake_glug_render::Scene;
 
 #[derive(Args, Debug)]
@@ -28,7 +29,10 @@ pub fn run(args: PresetsArgs) -> ExitCode {
                 ExitCode::SUCCESS
             }
             None => {
-                eprintln!("error: no preset `{name}`; `sake-glug presets` lists them");
+                eprintln!(
+                    "error: no preset `{}`; `sake-glug presets` lists them",
+                    quoted(&name)
+                );
                 ExitCode::from(2)
             }
         },

@@ -11,7 +11,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use sake_glug_engine::Preset;
-use sake_glug_io::text::printable;
+use sake_glug_io::text::{printable, quoted};
 use sake_glug_model_file::ModelFile;
 use sake_glug_render::clips::HapticBand;
 use sake_glug_render::fidelity::{self, fidelity_table, Fidelity};
@@ -313,7 +313,8 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
     if let Some(name) = &args.preset {
         if Preset::find(name).is_none() {
             return Err(format!(
-                "no preset `{name}`: choose one of {}",
+                "no preset `{}`: choose one of {}",
+                quoted(name),
                 Preset::ids()
             ));
         }

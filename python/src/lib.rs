@@ -25,8 +25,8 @@ use sake_glug_analysis::{
 use sake_glug_engine::{Preset, UnitOnset, Voicing, PRESETS};
 use sake_glug_fit::{fit_session, FitSession};
 use sake_glug_render::{
-    render_scene, render_tables_until, Column, InputFileError, RenderError, RenderObserver, Scene,
-    SceneError, StateRate, StateRow, TablesError, UnitRow, MAX_SCENE_BYTES,
+    render_scene, render_tables_until, Column, RenderError, RenderObserver, Scene, SceneError,
+    StateRate, StateRow, TablesError, UnitRow, MAX_SCENE_BYTES,
 };
 
 use interrupt::{interruptible, Ticks};
@@ -83,7 +83,7 @@ impl SceneSource {
     fn text(text: String) -> PyResult<Self> {
         let size = text.len() as u64;
         if size > MAX_SCENE_BYTES {
-            let too_large = InputFileError::TooLarge {
+            let too_large = sake_glug_io::ReadFailure::TooLarge {
                 size,
                 limit: MAX_SCENE_BYTES,
             };

@@ -5,25 +5,13 @@
 //! and against what this process may allocate (its address-space limit), and refused with the
 //! figure.
 
-use sake_glug_render::human_bytes;
+use sake_glug_render::{available_bytes, human_bytes};
 
 /// Bytes of one sample as a render returns it (f32).
 const SAMPLE_BYTES: u64 = std::mem::size_of::<f32>() as u64;
 
 /// The fewest samples a buffer grows by: a few blocks, so that short renders do not regrow often.
 const MIN_GROWTH_SAMPLES: usize = 1 << 16;
-
-/// Memory the system can give without swapping (Linux: `MemAvailable` of `/proc/meminfo`, as the
-/// command line reads it in crates/render/src/memory.rs, where that reader is private to the
-/// crate); `None` where it cannot be told, and only the allocation itself is checked then.
-fn available_bytes() -> Option<u64> {
-    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = meminfo
-        .lines()
-        .find_map(|line| line.strip_prefix("MemAvailable:"))?;
-    let kilobytes: u64 = line.trim().trim_end_matches("kB").trim().parse().ok()?;
-    Some(kilobytes.saturating_mul(1024))
-}
 
 /// Why `bytes` more cannot be held: more than the system has available ("more than the 3.1 GB
 /// available"), or `None`.

@@ -288,3 +288,19 @@ fn an_output_can_name_its_format_before_its_file() {
         "{stderr}"
     );
 }
+
+/// A preset name is outside text: echoed in an error, its control characters are escaped and
+/// a long one is cut (a terminal obeys a raw ESC).
+#[test]
+fn an_unknown_preset_is_quoted_escaped_and_cut() {
+    let directory = tempfile::tempdir().unwrap();
+    let name = format!("x\u{1b}[31m{}", "y".repeat(200));
+    for args in [vec!["render", "--preset", &name], vec!["presets", &name]] {
+        let output = sake_glug(directory.path(), &args);
+        assert!(!output.status.success(), "{args:?}");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!stderr.contains('\u{1b}'), "{args:?}: {stderr:?}");
+        assert!(stderr.contains("x\\u{1b}[31m"), "{args:?}: {stderr:?}");
+        assert!(!stderr.contains(&"y".repeat(40)), "{args:?}: {stderr:?}");
+    }
+}

@@ -20,3 +20,30 @@ pub fn printable(text: &str) -> Cow<'_, str> {
     }
     Cow::Owned(escaped)
 }
+
+/// The most characters of an outside field a message quotes: enough to see what it is, never a
+/// whole line of some other file.
+pub const QUOTED_CHARS: usize = 32;
+
+/// `field` as a message quotes it: its first [`QUOTED_CHARS`] characters (an ellipsis marks a
+/// cut), control characters escaped.
+pub fn quoted(field: &str) -> String {
+    let cut = match field.char_indices().nth(QUOTED_CHARS) {
+        Some((end, _)) => format!("{}…", &field[..end]),
+        None => field.to_owned(),
+    };
+    printable(&cut).into_owned()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_quoted_field_is_cut_and_escaped() {
+        assert_eq!(quoted("short"), "short");
+        let long = "x".repeat(100);
+        assert_eq!(quoted(&long), format!("{}…", "x".repeat(QUOTED_CHARS)));
+        assert_eq!(quoted("a\u{1b}[31m"), "a\\u{1b}[31m");
+    }
+}
