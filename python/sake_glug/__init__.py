@@ -15,6 +15,10 @@ The offline renderer of the ``sake-glug`` command line, for Python::
 - :func:`presets` lists the presets of the plugin's menu;
 - :class:`SakeGlugError` (a ``ValueError``) carries the command line's message for whatever it
   refuses.
+
+No argument crashes the interpreter: a dict scene that contains itself or nests deeper than 32
+levels is refused, a render that cannot fit in memory is refused with the figure, and Ctrl-C
+stops every long call.
 """
 
 from typing import Any, Dict, List, NamedTuple
@@ -50,9 +54,11 @@ class Tables(NamedTuple):
 
 
 def render_tables(scene: Any = None, **options: Any) -> Tables:
-    """Renders a scene as :func:`render` does (same arguments, plus ``state_rate`` in Hz, 1000
-    by default) and returns its samples with its units and state tables, the rows
-    ``sake-glug render --units/--state`` writes."""
+    """Renders a scene as :func:`render` does (same arguments but ``progress``, plus
+    ``state_rate`` in Hz, 1000 by default) and returns its samples with its units and state
+    tables, the rows ``sake-glug render --units/--state`` writes. The scene renders twice: once
+    keeping nothing, to refuse tables that cannot fit in memory with the figure, then into
+    them."""
     return Tables(*_render_tables(scene, **options))
 
 

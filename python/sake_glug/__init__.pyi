@@ -1,5 +1,5 @@
 import os
-from typing import Any, Dict, List, Mapping, NamedTuple, Optional, Union
+from typing import Any, Callable, Dict, List, Mapping, NamedTuple, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -34,13 +34,23 @@ def render(
     *,
     sample_rate: Optional[float] = None,
     preset: Optional[str] = None,
+    progress: Optional[Callable[[int, Optional[int]], object]] = None,
 ) -> npt.NDArray[np.float32]:
     """Renders a scene and returns its samples (mono, float32), bit for bit those of
     `sake-glug render` of the same scene.
 
     scene: a scene file's path, scene TOML text (a str with a newline or `=`), a dict of the
-    same keys, or None for the built-in pour. sample_rate overrides the scene's (Hz); preset
-    renders a preset instead of a scene. Raises SakeGlugError for what it refuses."""
+    same keys (nested at most 32 deep; values bool, int, float, str, list, tuple or dict; one
+    that contains itself is refused), or None for the built-in pour (90° to 135° in 0.5 s).
+    An empty scene ({}) is every key's default, an upright bottle that never pours: 0 samples,
+    as `sake-glug render` renders an empty scene file, with a UserWarning. sample_rate
+    overrides the scene's (Hz); preset renders a preset instead of a scene. progress is called
+    as progress(done, total) about every 20 ms with the samples rendered and the render's
+    length (None without duration_s); what it raises stops the render and is raised.
+
+    The samples are held in memory: a render that cannot fit (a day at 48 kHz is 16.6 GB) is
+    refused before it starts, or, without duration_s, as soon as it outgrows the memory
+    available, with the figure. Ctrl-C stops it. Raises SakeGlugError for what it refuses."""
 
 def presets() -> List[Preset]:
     """Every preset, in the order of the plugin's menu."""
@@ -61,15 +71,19 @@ def render_tables(
 ) -> Tables:
     """Renders a scene as render() does and returns its samples with its units and state
     tables (a float64 array per column, named as the columns of `sake-glug render --units` and
-    `--state`). Raises SakeGlugError for what it refuses."""
+    `--state`). The scene renders twice: once keeping nothing, to count the tables' rows and
+    refuse them with the figure if they cannot fit in memory, then into the tables. Ctrl-C
+    stops it. Raises SakeGlugError for what it refuses."""
 
 def fit(session: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
     """Fits a model to the recordings of a session file (`sake-glug fit`, MODEL.md §13):
     {"liquids": {name: {"estimates": {key: {"value", "low", "high", "in_model"}}, "units",
-    "kept_default", "model"}}, "warnings": [...]}. Writes nothing."""
+    "kept_default", "model"}}, "warnings": [...]}. Writes nothing. Ctrl-C returns at once
+    (the fit, which cannot be stopped, runs on in the background and its result is dropped)."""
 
 def analyze_paired(logs: List[Union[str, "os.PathLike[str]"]]) -> Dict[str, Any]:
-    """The paired-comparison analysis of trial logs, as `sake-glug analyze paired --json`."""
+    """The paired-comparison analysis of trial logs, as `sake-glug analyze paired --json`.
+    Ctrl-C returns at once (the analysis runs on in the background, its result dropped)."""
 
 def analyze_constant(
     logs: List[Union[str, "os.PathLike[str]"]],
@@ -78,4 +92,6 @@ def analyze_constant(
     seed: Optional[int] = None,
     lapse: Optional[float] = None,
 ) -> Dict[str, Any]:
-    """The constant-stimuli analysis of trial logs, as `sake-glug analyze constant --json`."""
+    """The constant-stimuli analysis of trial logs, as `sake-glug analyze constant --json`:
+    resamples from 1 to 100,000 (default 2000), seed and lapse as its options. Ctrl-C returns
+    at once (the analysis runs on in the background, its result dropped)."""

@@ -1,26 +1,37 @@
 //! The native half of the Python package `sake_glug` (`sake_glug._sake_glug`): the offline
-//! renderer of the main crate, scene in, samples out, as `sake-glug render` renders them. The
-//! package's `__init__.py` re-exports it; `__init__.pyi` types it.
+//! renderer of the main crate, scene in, samples out, as `sake-glug render` renders them, and the
+//! fit and the analyses. The package's `__init__.py` re-exports it; `__init__.pyi` types it.
+//!
+//! No argument may crash the interpreter: a dict scene is read with its depth and cycles checked
+//! (scene_dict.rs), what a render holds in memory is checked before it is taken (memory.rs), and
+//! every long call can be stopped with Ctrl-C (interrupt.rs).
 
-use std::cell::{Cell, RefCell};
+mod interrupt;
+mod memory;
+mod scene_dict;
+
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
 
 use numpy::PyArray1;
 use pyo3::create_exception;
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyTypeError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::{PyDict, PyInt, PyString};
 
 use sake_glug_analysis::{
     analyze_constant_logs, analyze_paired_logs, constant_json, paired_json, PsychometricOptions,
+    MAX_RESAMPLES,
 };
-use sake_glug_engine::{Preset, PRESETS};
+use sake_glug_engine::{Preset, UnitOnset, Voicing, PRESETS};
 use sake_glug_fit::{fit_session, FitSession};
 use sake_glug_render::{
-    render_scene, render_tables_until, Column, RenderError, RenderObserver, Scene, SceneError,
-    StateRate, StateRow, TablesError, UnitRow,
+    render_scene, render_tables_until, Column, InputFileError, RenderError, RenderObserver, Scene,
+    SceneError, StateRate, StateRow, TablesError, UnitRow, MAX_SCENE_BYTES,
 };
+
+use interrupt::{interruptible, Ticks};
+use memory::{Samples, TableSizes};
+use scene_dict::shown;
 
 create_exception!(
     _sake_glug,
@@ -46,18 +57,16 @@ impl SceneSource {
             return Ok(Self::BuiltIn);
         };
         if let Ok(dict) = scene.cast::<PyDict>() {
-            let table: toml::Table = pythonize::depythonize(dict.as_any()).map_err(|error| {
-                SakeGlugError::new_err(format!("invalid scene: the dict is no TOML table: {error}"))
-            })?;
+            let table = scene_dict::toml_table(dict).map_err(SakeGlugError::new_err)?;
             let text = toml::to_string(&table).map_err(|error| {
                 SakeGlugError::new_err(format!("invalid scene: the dict is no TOML table: {error}"))
             })?;
-            return Ok(Self::Toml(text));
+            return Self::text(text);
         }
         if let Ok(text) = scene.cast::<PyString>() {
             let text = text.to_cow()?;
             if text.contains(['\n', '=']) {
-                return Ok(Self::Toml(text.into_owned()));
+                return Self::text(text.into_owned());
             }
         }
         match scene.extract::<PathBuf>() {
@@ -69,6 +78,22 @@ impl SceneSource {
         }
     }
 
+    /// Scene text, held to the size of the largest scene file read (the parser holds it several
+    /// times over).
+    fn text(text: String) -> PyResult<Self> {
+        let size = text.len() as u64;
+        if size > MAX_SCENE_BYTES {
+            let too_large = InputFileError::TooLarge {
+                size,
+                limit: MAX_SCENE_BYTES,
+            };
+            return Err(SakeGlugError::new_err(format!(
+                "invalid scene: the scene text is too long: {too_large}"
+            )));
+        }
+        Ok(Self::Toml(text))
+    }
+
     /// The scene, read and validated as the command line reads it (`render_job` of
     /// `sake-glug render`): the preset only without a scene, then the sample rate's override.
     fn load(self, preset: Option<&str>, sample_rate: Option<f64>) -> Result<Scene, Refused> {
@@ -76,7 +101,8 @@ impl SceneSource {
             None => None,
             Some(name) => Some(Preset::find(name).ok_or_else(|| {
                 Refused::Message(format!(
-                    "no preset `{name}`: choose one of {}",
+                    "no preset `{}`: choose one of {}",
+                    shown(name),
                     Preset::ids()
                 ))
             })?),
@@ -110,31 +136,29 @@ enum Refused {
     Tables(#[from] TablesError),
     #[error("{0}")]
     Message(String),
-    /// Python raised an exception (KeyboardInterrupt) while the render ran: it stopped there.
+    /// Python raised an exception while the render ran (KeyboardInterrupt, or the progress
+    /// callback's own): it stopped there.
     #[error(transparent)]
-    Signal(PyErr),
+    Raised(PyErr),
 }
 
-/// How often a render looks for Ctrl-C (it runs without the GIL, so Python cannot see it).
-const SIGNAL_CHECK_EVERY: Duration = Duration::from_millis(20);
-
-/// Stops a render when Python has a signal to raise (KeyboardInterrupt), keeping the exception.
-struct PythonSignals {
-    last_check: Cell<Instant>,
-    raised: RefCell<Option<PyErr>>,
-}
-
-impl RenderObserver for PythonSignals {
-    fn interrupted(&self) -> bool {
-        if self.last_check.get().elapsed() < SIGNAL_CHECK_EVERY {
-            return false;
+impl Refused {
+    /// A render stopped by `ticks` ends with what Python raised there.
+    fn stopped_by(self, ticks: Ticks) -> Self {
+        match self {
+            Self::Render(RenderError::Interrupted)
+            | Self::Tables(TablesError::Render(RenderError::Interrupted)) => {
+                ticks.raised().map_or(self, Self::Raised)
+            }
+            other => other,
         }
-        self.last_check.set(Instant::now());
-        if let Err(error) = Python::attach(|py| py.check_signals()) {
-            *self.raised.borrow_mut() = Some(error);
-            return true;
+    }
+
+    fn into_py(self) -> PyErr {
+        match self {
+            Self::Raised(error) => error,
+            refused => SakeGlugError::new_err(refused.to_string()),
         }
-        false
     }
 }
 
@@ -142,47 +166,92 @@ impl RenderObserver for PythonSignals {
 /// `sake-glug render` writes to an f32 WAV for the same scene, bit for bit.
 ///
 /// scene: a scene file's path (str or os.PathLike), scene TOML text (a str with a
-///     newline or `=` in it), a dict of the same keys (tables as nested dicts), or None
-///     for the built-in pour. MODEL.md §10 lists the keys.
+///     newline or `=` in it), a dict of the same keys (tables as nested dicts, nested at
+///     most 32 deep, values bool, int, float, str, list or tuple), or None for the built-in
+///     pour. MODEL.md §10 lists the keys. An empty scene ({}, or text of comments alone) is
+///     every key's default, an upright bottle that never pours: 0 samples, as
+///     `sake-glug render` renders an empty scene file (with a UserWarning here); None is the
+///     built-in pour, 90° to 135° in 0.5 s.
 /// sample_rate: overrides the scene's sample rate (Hz), as --sample-rate does.
 /// preset: renders a preset (see presets()) instead of a scene, as --preset does.
+/// progress: called as progress(done, total) about every 20 ms while rendering, with the
+///     samples rendered and the render's length (None for a scene without duration_s, whose
+///     end is known only when it comes); what it raises stops the render and is raised.
 ///
 /// The sample rate of the result is the scene's (or sample_rate if given). The GIL is
-/// released while rendering; Ctrl-C stops it. Raises SakeGlugError with the command
-/// line's message for a scene, preset or sample rate it refuses.
+/// released while rendering; Ctrl-C stops it. The samples are held in memory: a render
+/// that cannot fit (a day at 48 kHz is 16.6 GB) is refused before it starts, or for a scene
+/// without duration_s as soon as it outgrows the memory available, with the figure. Raises
+/// SakeGlugError with the command line's message for a scene, preset or sample rate it
+/// refuses.
 #[pyfunction]
-#[pyo3(signature = (scene=None, *, sample_rate=None, preset=None))]
+#[pyo3(signature = (scene=None, *, sample_rate=None, preset=None, progress=None))]
 fn render<'py>(
     py: Python<'py>,
     scene: Option<&Bound<'py, PyAny>>,
     sample_rate: Option<f64>,
     preset: Option<&str>,
+    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray1<f32>>> {
     let source = SceneSource::of(scene)?;
+    let progress = callback("progress", progress)?;
     let rendered = py.detach(|| {
         let scene = source.load(preset, sample_rate)?;
-        let mut signals = PythonSignals {
-            last_check: Cell::new(Instant::now()),
-            raised: RefCell::new(None),
-        };
-        let mut samples = Vec::new();
-        let sink = |block: &[f32]| {
-            samples.extend_from_slice(block);
-            Ok::<(), RenderError>(())
-        };
-        match render_scene(&scene, sink, &mut signals) {
-            Ok(_) => Ok(samples),
-            Err(RenderError::Interrupted) => Err(signals
-                .raised
-                .into_inner()
-                .map_or(Refused::Render(RenderError::Interrupted), Refused::Signal)),
-            Err(error) => Err(error.into()),
+        let total = scene.duration_samples();
+        let mut samples = match total {
+            Some(total) => Samples::with_room(total, scene.sample_rate),
+            None => Ok(Samples::growing(scene.sample_rate)),
+        }
+        .map_err(Refused::Message)?;
+        let mut ticks = Ticks::new(progress, total);
+        let sink = |block: &[f32]| samples.push(block).map_err(Refused::Message);
+        match render_scene(&scene, sink, &mut ticks) {
+            Ok(_) => Ok(samples.into_vec()),
+            Err(refused) => Err(refused.stopped_by(ticks)),
         }
     });
-    match rendered {
-        Ok(samples) => Ok(PyArray1::from_vec(py, samples)),
-        Err(Refused::Signal(error)) => Err(error),
-        Err(refused) => Err(SakeGlugError::new_err(refused.to_string())),
+    let samples = rendered.map_err(Refused::into_py)?;
+    if samples.is_empty() {
+        PyErr::warn(
+            py,
+            &py.get_type::<PyUserWarning>(),
+            c"the scene renders no samples: its bottle never pours (an empty scene is an \
+              upright bottle, as in `sake-glug render`); render(None) is the built-in pour",
+            1,
+        )?;
+    }
+    Ok(PyArray1::from_vec(py, samples))
+}
+
+/// `value` if it is None or callable, for `name`.
+fn callback(name: &str, value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Py<PyAny>>> {
+    match value.filter(|value| !value.is_none()) {
+        None => Ok(None),
+        Some(value) if value.is_callable() => Ok(Some(value.clone().unbind())),
+        Some(value) => Err(PyTypeError::new_err(format!(
+            "{name} must be callable or None, not {}",
+            value.get_type().name()?
+        ))),
+    }
+}
+
+/// Counts the units of a render that keeps nothing, for the tables it would make.
+struct CountingUnits {
+    ticks: Ticks,
+    units: u64,
+}
+
+impl RenderObserver for CountingUnits {
+    fn progress(&mut self, rendered: u64) {
+        self.ticks.progress(rendered)
+    }
+
+    fn unit_started(&mut self, _onset: &UnitOnset, _voicing: Voicing) {
+        self.units += 1;
+    }
+
+    fn interrupted(&self) -> bool {
+        self.ticks.stop()
     }
 }
 
@@ -193,6 +262,9 @@ fn render<'py>(
 /// each k/state_rate). MODEL.md §14 says what each column is.
 ///
 /// state_rate: rows a second of the state table (Hz, above 0 and at most the sample rate).
+///
+/// The scene renders twice: once keeping nothing, to count what the tables will hold and
+/// refuse them with the figure if they cannot fit in memory, then into the tables.
 #[pyfunction]
 #[pyo3(signature = (scene=None, *, sample_rate=None, preset=None, state_rate=1000.0))]
 fn render_tables<'py>(
@@ -207,24 +279,55 @@ fn render_tables<'py>(
         .map_err(|error| SakeGlugError::new_err(format!("state_rate: {error}")))?;
     let rendered = py.detach(|| {
         let scene = source.load(preset, sample_rate)?;
-        let signals = PythonSignals {
-            last_check: Cell::new(Instant::now()),
-            raised: RefCell::new(None),
+        // A bound: row k is at sample ⌈k·fs/R⌉, before the end.
+        let state_rows =
+            |samples: u64| (samples as f64 * state_rate.hz() / scene.sample_rate as f64) as u64 + 2;
+        let fits = |samples: u64, units: Option<u64>| {
+            let sizes = TableSizes {
+                samples,
+                units,
+                state_rows: state_rows(samples),
+            };
+            sizes
+                .check(
+                    std::mem::size_of::<UnitRow>() as u64,
+                    std::mem::size_of::<(u64, StateRow)>() as u64,
+                    [
+                        UnitRow::COLUMNS.len() as u64,
+                        StateRow::COLUMNS.len() as u64,
+                    ],
+                )
+                .map_err(Refused::Message)
         };
-        match render_tables_until(&scene, state_rate, || signals.interrupted()) {
+        // The state rate against the scene's sample rate, refused before a whole pass: the
+        // tables' render checks it first and stops after its first block.
+        match render_tables_until(&scene, state_rate, || true) {
+            Err(TablesError::Render(RenderError::Interrupted)) => {}
+            Err(error) => return Err(error.into()),
+            Ok(_) => {}
+        }
+        // What a duration tells before anything renders: a day at 48 kHz is refused at once.
+        if let Some(samples) = scene.duration_samples() {
+            fits(samples, None)?;
+        }
+        let mut counting = CountingUnits {
+            ticks: Ticks::new(None, None),
+            units: 0,
+        };
+        let discard = |_: &[f32]| Ok::<(), Refused>(());
+        let summary = match render_scene(&scene, discard, &mut counting) {
+            Ok(summary) => summary,
+            Err(refused) => return Err(refused.stopped_by(counting.ticks)),
+        };
+        fits(summary.samples, Some(counting.units))?;
+        let ticks = Ticks::new(None, None);
+        match render_tables_until(&scene, state_rate, || ticks.stop()) {
             Ok(tables) => Ok(tables),
-            Err(TablesError::Render(RenderError::Interrupted)) => Err(signals
-                .raised
-                .into_inner()
-                .map_or(Refused::Render(RenderError::Interrupted), Refused::Signal)),
-            Err(error) => Err(error.into()),
+            Err(error) => Err(Refused::from(error).stopped_by(ticks)),
         }
     });
-    let tables = match rendered {
-        Ok(tables) => tables,
-        Err(Refused::Signal(error)) => return Err(error),
-        Err(refused) => return Err(SakeGlugError::new_err(refused.to_string())),
-    };
+    let mut tables = rendered.map_err(Refused::into_py)?;
+    tables.samples.shrink_to_fit();
     Ok((
         PyArray1::from_vec(py, tables.samples),
         columns(py, UnitRow::COLUMNS, &tables.units)?,
@@ -257,11 +360,14 @@ fn columns<'py, R>(
 /// what the fit found: {"liquids": {name: {"estimates": {key: {"value", "low", "high",
 /// "in_model"}}, "units", "kept_default": {key: why}, "model": the model file's TOML}},
 /// "warnings": [...]}. Nothing is written. Raises SakeGlugError with the command line's message.
+/// Ctrl-C returns at once; the fit, which cannot be stopped, runs on in the background and its
+/// result is dropped.
 #[pyfunction]
 fn fit(py: Python<'_>, session: PathBuf) -> PyResult<Bound<'_, PyAny>> {
-    let fitted = py
-        .detach(|| FitSession::load(&session).and_then(|session| fit_session(&session)))
-        .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
+    let fitted = interruptible(py, move || {
+        FitSession::load(&session).and_then(|session| fit_session(&session))
+    })?
+    .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
     let liquids: serde_json::Map<String, serde_json::Value> = fitted
         .liquids
         .iter()
@@ -300,35 +406,46 @@ fn fit(py: Python<'_>, session: PathBuf) -> PyResult<Bound<'_, PyAny>> {
 
 /// The paired-comparison analysis of trial logs (`sake-glug analyze paired --json`): the
 /// count matrix, proportions, Thurstone Case V "scale" by stimulus, predicted proportions,
-/// Mosteller's "fit" test and the participants' "agreement" test, as a dict.
+/// Mosteller's "fit" test and the participants' "agreement" test, as a dict. Ctrl-C returns at
+/// once (the analysis runs on in the background, its result dropped).
 #[pyfunction]
 fn analyze_paired(py: Python<'_>, logs: Vec<PathBuf>) -> PyResult<Bound<'_, PyAny>> {
-    let analysis = py
-        .detach(|| analyze_paired_logs(&logs))
+    let analysis = interruptible(py, move || analyze_paired_logs(&logs))?
         .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
     Ok(pythonize::pythonize(py, &paired_json(&analysis))?)
 }
 
 /// The constant-stimuli analysis of trial logs (`sake-glug analyze constant --json`): the
 /// logistic fit pooled and per participant, its 25/50/75 % "points" with 95 % intervals
-/// ("value", "low", "high"), as a dict. resamples, seed and lapse as the command line's options.
+/// ("value", "low", "high"), as a dict. resamples (1 to 100,000), seed and lapse as the command
+/// line's options. Ctrl-C returns at once (the analysis runs on in the background, its result
+/// dropped).
 #[pyfunction]
 #[pyo3(signature = (logs, *, resamples=None, seed=None, lapse=None))]
-fn analyze_constant(
-    py: Python<'_>,
+fn analyze_constant<'py>(
+    py: Python<'py>,
     logs: Vec<PathBuf>,
-    resamples: Option<usize>,
+    resamples: Option<&Bound<'py, PyInt>>,
     seed: Option<u64>,
     lapse: Option<f64>,
-) -> PyResult<Bound<'_, PyAny>> {
+) -> PyResult<Bound<'py, PyAny>> {
     let defaults = PsychometricOptions::default();
+    let resamples = match resamples {
+        None => defaults.resamples,
+        // Past what a usize holds (the analysis refuses the rest with the same words).
+        Some(count) => count.extract::<usize>().map_err(|_| {
+            SakeGlugError::new_err(format!(
+                "{} resamples: from 1 to {MAX_RESAMPLES} are drawn",
+                shown(&count.to_string())
+            ))
+        })?,
+    };
     let options = PsychometricOptions {
-        resamples: resamples.unwrap_or(defaults.resamples),
+        resamples,
         seed: seed.unwrap_or(defaults.seed),
         max_lapse: lapse.unwrap_or(defaults.max_lapse),
     };
-    let analysis = py
-        .detach(|| analyze_constant_logs(&logs, &options))
+    let analysis = interruptible(py, move || analyze_constant_logs(&logs, &options))?
         .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
     Ok(pythonize::pythonize(py, &constant_json(&analysis))?)
 }
@@ -353,6 +470,10 @@ fn presets() -> Vec<(&'static str, &'static str, &'static str, String)> {
 
 #[pymodule]
 fn _sake_glug(module: &Bound<'_, PyModule>) -> PyResult<()> {
+    // rust-numpy fetches NumPy's API on first use, running Python (an import): done here, so that
+    // a Ctrl-C pending as a render returns is raised as KeyboardInterrupt, not met by that
+    // import and turned into a panic.
+    PyArray1::<f32>::zeros(module.py(), 0, false);
     module.add_function(wrap_pyfunction!(render, module)?)?;
     module.add_function(wrap_pyfunction!(render_tables, module)?)?;
     module.add_function(wrap_pyfunction!(fit, module)?)?;

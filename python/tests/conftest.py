@@ -3,6 +3,7 @@ checkout (`cargo build --release --bin sake-glug --no-default-features --feature
 `cargo xtask test` runs first), found in $CARGO_TARGET_DIR or target/, or at $SAKE_GLUG_CLI."""
 
 import os
+import signal
 import struct
 import subprocess
 from pathlib import Path
@@ -57,3 +58,21 @@ def cli_render(cli: Path, tmp_path: Path, *args: str) -> np.ndarray:
     done = run_cli(cli, "render", *args, "-o", str(wav), "--sample-format", "f32")
     assert done.returncode == 0, done.stderr
     return read_f32_wav(wav)
+
+
+class CtrlC(Exception):
+    """What Ctrl-C raises in the tests that send it (`_thread.interrupt_main`): were the code
+    under test to ignore it until later, a KeyboardInterrupt would then stop pytest itself, where
+    this fails the test."""
+
+
+@pytest.fixture
+def ctrl_c():
+    """SIGINT raises CtrlC for the test's duration: Ctrl-C as Python handles it, by the handler."""
+
+    def handler(_signum, _frame):
+        raise CtrlC
+
+    previous = signal.signal(signal.SIGINT, handler)
+    yield CtrlC
+    signal.signal(signal.SIGINT, previous)

@@ -1,7 +1,8 @@
 """sake_glug.render gives the samples of `sake-glug render` of the same scene, bit for bit, and
 refuses what the command line refuses with the same message."""
 
-import os
+import collections
+import itertools
 import threading
 import time
 import _thread
@@ -119,45 +120,109 @@ def test_a_scene_of_another_type_is_a_type_error():
         sake_glug.render(135)
 
 
-# Five minutes of glugs (the bottle tilted slowly): a render of about half a second, far longer
-# than Python's thread switch interval (5 ms) and the render's look for Ctrl-C (20 ms).
-LONG_POUR = {"tilt_deg": [[0.0, 90.0], [300.0, 135.0]], "duration_s": 300.0}
+# A pour as long as a render may be (a day, no duration_s), at a low rate: it cannot end before
+# the tests below stop it, and what it holds until then is small.
+ENDLESS_POUR = {"tilt_deg": [[0.0, 90.0], [86400.0, 135.0]], "sample_rate": 1000}
+
+
+class CallCount:
+    """A progress callback made of C alone: `deque.insert`, which runs no Python code, so calling
+    it never offers the GIL nor runs a pending signal's handler (as Python code would, and
+    as C that prints does). Each call adds an entry; `stop()` fills the deque, and the next call
+    raises IndexError (deque already at its maximum size)."""
+
+    def __init__(self):
+        self.calls = collections.deque(maxlen=1_000_000)
+        self.callback = self.calls.insert
+
+    def __len__(self):
+        return len(self.calls)
+
+    def stop(self):
+        self.calls.extend(itertools.repeat(None, self.calls.maxlen - len(self.calls)))
 
 
 def test_the_gil_is_released_while_rendering():
-    started, spans, ticks = threading.Event(), [], []
+    # The render runs in a thread whose only Python is the C callback: this thread can run
+    # while it renders only if the render released the GIL. Held, this loop would first run
+    # once the render had ended (a day of pouring), and see the count stand still.
+    calls = CallCount()
+    outcome = []
 
     def render():
-        started.set()
-        begin = time.perf_counter()
-        sake_glug.render(LONG_POUR)
-        spans.append((begin, time.perf_counter()))
+        try:
+            sake_glug.render(ENDLESS_POUR, progress=calls.callback)
+        except IndexError as error:
+            outcome.append(str(error))
 
     worker = threading.Thread(target=render)
     worker.start()
-    started.wait()
-    while worker.is_alive():
-        ticks.append(time.perf_counter())
+    while len(calls) == 0 and worker.is_alive():
         time.sleep(0.001)
+    seen = len(calls)
+    while len(calls) == seen and worker.is_alive():
+        time.sleep(0.001)
+    # Seen rendering on while this thread ran: now stop it.
+    calls.stop()
     worker.join()
-    (begin, end) = spans[0]
-    # Holding the GIL, the render would let this thread run only about its start (a switch
-    # interval, or longer if the system took the CPU away) and after its end.
-    assert sum(begin + (end - begin) / 4 < tick < end for tick in ticks) >= 3
+    assert outcome == ["deque already at its maximum size"]
 
 
-def test_ctrl_c_stops_a_render():
-    began = time.perf_counter()
-    sake_glug.render(LONG_POUR)
-    whole = time.perf_counter() - began
-    timer = threading.Timer(whole / 10, _thread.interrupt_main)
-    began = time.perf_counter()
-    timer.start()
+def test_ctrl_c_stops_a_render(ctrl_c):
+    # Ctrl-C comes once the render has begun (its callback was called), from another thread.
+    # The callback is C that looks for no signal, so only the render's own look can raise it,
+    # and it must raise it before calling the callback again. A render that went on instead is
+    # stopped through its callback (IndexError, not CtrlC): a failure, not a hang.
+    calls = CallCount()
+    rendering = threading.Event()
+    interrupted_at = []
+
+    def interrupt_once_rendering():
+        while rendering.is_set() and len(calls) == 0:
+            time.sleep(0.001)
+        if not rendering.is_set():
+            return
+        _thread.interrupt_main()
+        interrupted_at.append(len(calls))
+        while rendering.is_set() and len(calls) == interrupted_at[0]:
+            time.sleep(0.001)
+        if rendering.is_set():
+            calls.stop()
+
+    rendering.set()
+    interrupter = threading.Thread(target=interrupt_once_rendering)
+    interrupter.start()
     try:
-        with pytest.raises(KeyboardInterrupt):
-            sake_glug.render(LONG_POUR)
+        with pytest.raises(ctrl_c):
+            sake_glug.render(ENDLESS_POUR, progress=calls.callback)
     finally:
-        timer.cancel()
-    # Not a speed: a render that ignored Ctrl-C would raise it too, once it had finished; this
-    # one stopped within a check interval (20 ms) of it, long before the same render's end.
-    assert time.perf_counter() - began < whole * 0.6
+        rendering.clear()
+        interrupter.join()
+    assert len(calls) == interrupted_at[0], "the render called back after Ctrl-C"
+
+
+class Stop(Exception):
+    pass
+
+
+def test_what_the_progress_callback_raises_stops_the_render_and_is_raised():
+    calls = []
+
+    def progress(done, total):
+        calls.append((done, total))
+        raise Stop
+
+    with pytest.raises(Stop):
+        sake_glug.render(ENDLESS_POUR, progress=progress)
+    # Called once with the samples so far; a scene without duration_s has no total till its end.
+    [(done, total)] = calls
+    assert done > 0 and total is None
+    day = dict(ENDLESS_POUR, duration_s=86400.0)
+    with pytest.raises(Stop):
+        sake_glug.render(day, progress=progress)
+    assert calls[1][1] == 86400 * 1000 and 0 < calls[1][0] < calls[1][1]
+
+
+def test_a_progress_callback_must_be_callable():
+    with pytest.raises(TypeError, match="progress must be callable or None, not int"):
+        sake_glug.render(progress=3)

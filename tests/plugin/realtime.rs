@@ -124,7 +124,7 @@ fn process_does_not_allocate_while_osc_arrives() {
             .expect("send over loopback");
         // Every other block waits for the socket thread, so that values do arrive mid-session.
         let stats = host.plugin.osc().stats();
-        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(5);
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
         while index % 2 == 0
             && stats.packets.load(std::sync::atomic::Ordering::Relaxed) <= index as u64
         {

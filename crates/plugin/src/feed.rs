@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 use atomic_float::{AtomicF32, AtomicF64};
 
-use sake_glug_engine::UnitOnset;
+use sake_glug_engine::{PerControl, UnitOnset};
 
 /// Scope columns kept (each the min and max of [`SCOPE_COLUMN_S`] of output).
 pub const SCOPE_COLUMNS: usize = 600;
@@ -47,6 +47,9 @@ pub struct Feed {
     pub capacity_ml: AtomicF32,
     /// The tilt the engine uses (the parameter's, or the MIDI device's).
     pub tilt_deg: AtomicF32,
+    /// Each control's value as the engine plays it: the parameter's, or a MIDI or OSC device's
+    /// where one drives the control, for the editor to show beside the parameter.
+    pub played: PerControl<AtomicF32>,
     /// Seconds of output rendered since the plugin was activated.
     pub now_s: AtomicF64,
     /// Units started since the bottle's last reset.
@@ -65,7 +68,7 @@ pub struct Feed {
 
 /// What the editor shows, in a form cheap to compare block by block: when it is unchanged,
 /// the editor is not redrawn.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Visible {
     /// Units started (new envelopes, a new glug on the bottle).
     pub units: u64,
@@ -73,8 +76,23 @@ pub struct Visible {
     pub volume_ml: f32,
     /// The tilt (degrees), as drawn.
     pub tilt_deg: f32,
+    /// Each control as played (a device's value shows beside its slider).
+    pub played: PerControl<f32>,
     /// Whether the output was sounding: the scope moves.
     pub sounding: bool,
+}
+
+/// Nothing drawn yet.
+impl Default for Visible {
+    fn default() -> Self {
+        Self {
+            units: 0,
+            volume_ml: 0.0,
+            tilt_deg: 0.0,
+            played: PerControl::from_fn(|_| 0.0),
+            sounding: false,
+        }
+    }
 }
 
 impl Visible {
@@ -92,6 +110,7 @@ impl Default for Feed {
             volume_ml: AtomicF32::new(0.0),
             capacity_ml: AtomicF32::new(300.0),
             tilt_deg: AtomicF32::new(0.0),
+            played: PerControl::from_fn(|_| AtomicF32::new(0.0)),
             now_s: AtomicF64::new(0.0),
             units_started: AtomicU64::new(0),
             scope_min: columns(),

@@ -8,7 +8,7 @@ use crate::params::GlugParams;
 use crate::transport::TransportWatch;
 use sake_glug_device::live::{LiveControls, LiveReader};
 use sake_glug_device::midi::{CcDecoder, DeviceAction, MidiInput, MidiMap, Overrides};
-use sake_glug_engine::{ControlValues, Controls, Engine, ModelConfig};
+use sake_glug_engine::{Control, ControlValues, Controls, Engine, ModelConfig, PerControl};
 
 /// The longest span rendered at once, so that the editor sees (nearly) every unit start; the
 /// engine's output does not depend on how time is cut.
@@ -239,6 +239,9 @@ impl RealtimeEngine {
         feed.capacity_ml
             .store(self.engine.config().capacity_ml as f32, Relaxed);
         feed.tilt_deg.store(tilt_deg as f32, Relaxed);
+        for &control in Control::ALL {
+            feed.played[control].store(values[control] as f32, Relaxed);
+        }
         feed.now_s
             .store(self.rendered as f64 / sample_rate, Relaxed);
         feed.units_started.store(self.units_seen, Relaxed);
@@ -246,6 +249,7 @@ impl RealtimeEngine {
             units: self.units_seen,
             volume_ml: self.engine.volume_ml() as f32,
             tilt_deg: tilt_deg as f32,
+            played: PerControl::from_fn(|control| values[control] as f32),
             sounding: self.engine.sounding_components() > 0 || self.fade_left > 0,
         };
         feed.publish(shown, self.shown);

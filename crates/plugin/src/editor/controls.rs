@@ -3,6 +3,9 @@
 use nice_plug::prelude::*;
 use nice_plug_egui::widgets::ParamSlider;
 
+use std::sync::atomic::Ordering::Relaxed;
+
+use crate::feed::Feed;
 use crate::params::GlugParams;
 use sake_glug_engine::Control;
 
@@ -12,13 +15,32 @@ const MAIN_SLIDER_WIDTH: f32 = 170.0;
 /// rows fit the column as the main group's do.
 const MODEL_SLIDER_WIDTH: f32 = 110.0;
 
-pub fn show(ui: &mut egui::Ui, params: &GlugParams, setter: &ParamSetter) {
+pub fn show(ui: &mut egui::Ui, params: &GlugParams, feed: &Feed, setter: &ParamSetter) {
     egui::Grid::new("main_group")
-        .num_columns(2)
+        .num_columns(3)
         .spacing([8.0, 6.0])
         .show(ui, |ui| {
             for &control in Control::ALL {
-                row(ui, &params.controls[control], setter, MAIN_SLIDER_WIDTH);
+                let param = &params.controls[control];
+                ui.label(param.name());
+                ui.add(ParamSlider::for_param(param, setter).with_width(MAIN_SLIDER_WIDTH));
+                // A device (MIDI or OSC) that drives the control plays its own value: shown
+                // beside the parameter, which it does not move.
+                let played = feed.played[control].load(Relaxed);
+                if (played - param.value()).abs() > displayed_step(control) {
+                    ui.label(
+                        egui::RichText::new(format!(
+                            "device: {}",
+                            param
+                                .normalized_value_to_string(param.preview_normalized(played), true)
+                        ))
+                        .small()
+                        .weak(),
+                    );
+                } else {
+                    ui.label("");
+                }
+                ui.end_row();
             }
         });
     egui::CollapsingHeader::new("Model").show(ui, |ui| {
@@ -40,4 +62,9 @@ fn row<P: Param>(ui: &mut egui::Ui, param: &P, setter: &ParamSetter, width: f32)
     ui.label(param.name());
     ui.add(ParamSlider::for_param(param, setter).with_width(width));
     ui.end_row();
+}
+
+/// Half the control's knob step: values closer than that show the same.
+fn displayed_step(control: Control) -> f32 {
+    (control.quantity().knob.step() as f32).max(1e-4) / 2.0
 }

@@ -22,13 +22,14 @@ use crate::feed::Feed;
 use crate::osc_input::OscInput;
 use crate::params::GlugParams;
 
-pub const WIDTH: f64 = 760.0;
-pub const HEIGHT: f64 = 640.0;
+pub const WIDTH: f64 = 800.0;
+pub const HEIGHT: f64 = 726.0;
 
 /// The space between the window's edges and the content.
 const MARGIN: f32 = 8.0;
-/// The column of controls, MIDI and OSC settings: as wide as a slider row.
-const CONTROLS_WIDTH: f32 = 320.0;
+/// The column of controls, MIDI and OSC settings: as wide as a slider row and what a device
+/// plays beside it.
+const CONTROLS_WIDTH: f32 = 370.0;
 /// The scope's and the envelopes' height.
 const PANEL_HEIGHT: f32 = 200.0;
 /// What `ui.separator()` takes (its default spacing).
@@ -114,7 +115,7 @@ impl NiceEguiApp for GlugEditor {
                         .show(ui, |ui| {
                             presets::show(ui, &self.params, &setter, &mut self.preset);
                             model_file::show(ui, &self.params, gui, &mut self.model_field);
-                            controls::show(ui, &self.params, &setter);
+                            controls::show(ui, &self.params, &self.feed, &setter);
                             ui.separator();
                             self.midi_edited |= midi_settings::show(ui, &self.params);
                             ui.separator();

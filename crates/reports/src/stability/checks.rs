@@ -85,9 +85,11 @@ impl Property {
                 ENERGY_TOLERANCE * 100.0
             ),
             Property::Time => format!(
-                "engine run time per sample at most {MAX_TIME_RATIO}× that of a normal case \
-                 measured in the same run (fastest of {} runs in the report, of {} in the \
-                 tests): catches denormal slow-downs and runaway work. Never an absolute time",
+                "engine run time per sample against that of a normal case measured in the same \
+                 run (fastest of {} runs in the report, of {} in the tests), marked slow past \
+                 {MAX_TIME_RATIO}×: points at denormal slow-downs and runaway work. A figure and \
+                 a warning, never a failure, since the machine's load moves it (the work itself \
+                 is bounded by the components check); never an absolute time",
                 Scale::Report.repeats(),
                 Scale::Test.repeats()
             ),
@@ -120,10 +122,25 @@ impl std::fmt::Display for Property {
 pub struct Check {
     /// The property checked.
     pub what: Property,
-    /// Whether the property held.
+    /// Whether the property held. A [`Property::Time`] check always holds: the time is a
+    /// figure, and [`Check::slow`] says when it is past its bound.
     pub passed: bool,
+    /// Run time past [`MAX_TIME_RATIO`]: a warning, never a failure, since a machine's load
+    /// moves a time measured on it.
+    pub slow: bool,
     /// The measurement behind the verdict.
     pub detail: String,
+}
+
+impl Check {
+    /// The verdict as the tables show it.
+    pub fn mark(&self) -> &'static str {
+        match (self.passed, self.slow) {
+            (false, _) => "FAILED",
+            (true, true) => "slow",
+            (true, false) => "ok",
+        }
+    }
 }
 
 /// The result of one case.
@@ -150,10 +167,7 @@ impl Outcome {
         let checks: Vec<String> = self
             .checks
             .iter()
-            .map(|c| {
-                let mark = if c.passed { "ok" } else { "FAILED" };
-                format!("{} {mark} ({})", c.what, c.detail)
-            })
+            .map(|c| format!("{} {} ({})", c.what, c.mark(), c.detail))
             .collect();
         format!("{}; {}", checks.join(", "), self.notes)
     }
@@ -163,6 +177,7 @@ pub(super) fn check(what: Property, passed: bool, detail: String) -> Check {
     Check {
         what,
         passed,
+        slow: false,
         detail,
     }
 }
@@ -232,13 +247,16 @@ pub(super) fn limiter_events_in_spans(render: &TimedRender, first: usize) -> u64
     }
 }
 
+/// The case's time per sample against the normal case's: a figure, with a warning past
+/// [`MAX_TIME_RATIO`], never a failure.
 pub(super) fn time_ratio(run: &Run, normal: &Run) -> Check {
     let ratio = run.time_per_sample() / normal.time_per_sample();
-    check(
-        Property::Time,
-        ratio <= MAX_TIME_RATIO,
-        format!("{ratio:.2}× the normal case per sample"),
-    )
+    Check {
+        what: Property::Time,
+        passed: true,
+        slow: ratio > MAX_TIME_RATIO,
+        detail: format!("{ratio:.2}× the normal case per sample"),
+    }
 }
 
 pub(super) fn outcome(
@@ -261,5 +279,49 @@ pub(super) fn outcome(
             run.render.max_sounding,
             run.render.limiter_events
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+
+    fn run_taking(engine_time: Duration) -> Run {
+        Run {
+            render: TimedRender {
+                kept: Vec::new(),
+                engine_time,
+                peak: 0.0,
+                all_finite: true,
+                energies: Vec::new(),
+                span_times: Vec::new(),
+                max_sounding: 0,
+                limiter_events: 0,
+                non_finite_before_limiter: 0,
+                span_limiter_events: Vec::new(),
+                last_onset_by: 0,
+            },
+            sample_rate: 48_000.0,
+            len: 48_000,
+            energy_span: 0,
+            ceiling: 1.0,
+            units_started: 0,
+            units_skipped: 0,
+            given_up: 0,
+        }
+    }
+
+    /// A busy machine can make any case as slow as it likes: the time is a warning, so the
+    /// report's verdict cannot depend on the load.
+    #[test]
+    fn a_slow_case_is_a_warning_not_a_failure() {
+        let normal = run_taking(Duration::from_millis(10));
+        let slow = time_ratio(&run_taking(Duration::from_millis(1000)), &normal);
+        assert!(slow.passed && slow.slow, "{slow:?}");
+        assert_eq!(slow.mark(), "slow");
+        let quick = time_ratio(&run_taking(Duration::from_millis(20)), &normal);
+        assert!(quick.passed && !quick.slow, "{quick:?}");
+        assert_eq!(quick.mark(), "ok");
     }
 }

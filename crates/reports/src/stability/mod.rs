@@ -10,8 +10,9 @@
 //!   one while it ramps to a new one (MODEL.md §6), and how often the limiter acted;
 //! - **energy**: once no unit starts any more, the energy of consecutive spans never grows, judged
 //!   only where the limiter did not act (so the output is the signal before the limiter);
-//! - **time**: engine run time per sample within a factor of a normal case measured in the same
-//!   run (catches denormal slow-downs and runaway work); a ratio, never an absolute time;
+//! - **time**: engine run time per sample against a normal case measured in the same run,
+//!   marked slow past a factor (points at denormal slow-downs and runaway work); a ratio,
+//!   never an absolute time, and a warning, never a failure: a machine's load moves it;
 //! - case-specific properties (components capped, nothing computed above Nyquist, no drift...).
 
 mod checks;
@@ -198,12 +199,12 @@ pub fn report(outcomes: &[Outcome]) -> String {
             .checks
             .iter()
             .map(|c| {
-                format!(
-                    "{}{}: {}",
-                    if c.passed { "" } else { "**FAILED** " },
-                    c.what,
-                    c.detail
-                )
+                let mark = match c.mark() {
+                    "ok" => "",
+                    "slow" => "**slow** ",
+                    _ => "**FAILED** ",
+                };
+                format!("{mark}{}: {}", c.what, c.detail)
             })
             .collect();
         text += &format!(
@@ -216,6 +217,15 @@ pub fn report(outcomes: &[Outcome]) -> String {
         );
     }
     let failed = outcomes.iter().filter(|o| !o.passed()).count();
-    text += &format!("\n{} cases, {} failed.\n", outcomes.len(), failed);
+    let slow = outcomes
+        .iter()
+        .filter(|o| o.checks.iter().any(|c| c.slow))
+        .count();
+    text += &format!(
+        "\n{} cases, {} failed, {} slow (a time, not a verdict: see `time`).\n",
+        outcomes.len(),
+        failed,
+        slow
+    );
     text
 }
