@@ -5,12 +5,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Subcommand};
-use sake_glug_io::text::printable;
+use sake_glug_io::text::{printable, quoted};
 
 use sake_glug_analysis::{
     analyze_constant_logs, analyze_paired_logs, constant_json, draw_constant_plot,
     draw_paired_plot, paired_json, AnalysisError, ChiSquareTest, ConstantAnalysis, PairedAnalysis,
-    PsychometricFit, PsychometricOptions, POINT_PERCENTS,
+    Placement, PsychometricFit, PsychometricOptions, MAX_RESAMPLES, POINT_PERCENTS,
 };
 
 #[derive(Args, Debug)]
@@ -30,9 +30,10 @@ enum Design {
     Constant {
         #[command(flatten)]
         common: Common,
-        /// Bootstrap resamples for the intervals.
-        #[arg(long, default_value_t = PsychometricOptions::default().resamples)]
-        resamples: usize,
+        /// Bootstrap resamples for the intervals (too many is refused with the limit).
+        #[arg(long, default_value_t = PsychometricOptions::default().resamples as u64,
+              value_parser = clap::value_parser!(u64).range(1..=MAX_RESAMPLES as u64))]
+        resamples: u64,
         /// Seed of the resamples (the same seed gives the same intervals).
         #[arg(long, default_value_t = PsychometricOptions::default().seed)]
         seed: u64,
@@ -75,7 +76,7 @@ pub fn run(args: AnalyzeArgs) -> ExitCode {
             lapse,
         } => {
             let options = PsychometricOptions {
-                resamples,
+                resamples: resamples as usize,
                 seed,
                 max_lapse: lapse,
             };
@@ -138,12 +139,9 @@ fn matrix_text(title: &str, names: &[String], cell: impl Fn(usize, usize) -> Str
 }
 
 fn paired_text(analysis: &PairedAnalysis) -> String {
-    // The names come from the logs: shown with their control characters escaped.
-    let names: Vec<String> = analysis
-        .stimuli
-        .iter()
-        .map(|name| printable(name).into_owned())
-        .collect();
+    // The names come from the logs: shown with their control characters escaped, and cut short
+    // (every cell of the matrices is as wide as the widest name).
+    let names: Vec<String> = analysis.stimuli.iter().map(|name| quoted(name)).collect();
     let mut text = format!(
         "{} trials, {} participant(s), {} stimuli\n\n",
         analysis.trials,
@@ -198,11 +196,29 @@ fn fit_text(fit: &PsychometricFit) -> String {
         curve.intercept,
         curve.slope
     );
+    let (lowest, highest) = fit.level_range();
+    let tested = format!("{lowest}–{highest}");
+    // An estimate only within the levels tested; beyond them the curve is the logistic's shape.
+    let end = |level: f64| match Placement::of(level, lowest, highest) {
+        Placement::Within => format!("{level:.4}"),
+        Placement::BelowLevels => format!("below {lowest}"),
+        Placement::AboveLevels => format!("above {highest}"),
+    };
     for (percent, point) in POINT_PERCENTS.iter().zip(&fit.points) {
-        text += &format!(
-            "  {percent:>2} %: {:.4}  95 % [{:.4}, {:.4}]\n",
-            point.value, point.low, point.high
-        );
+        text += &match point.placement {
+            Placement::Within => format!(
+                "  {percent:>2} %: {:.4}  95 % [{}, {}]\n",
+                point.value,
+                end(point.low),
+                end(point.high)
+            ),
+            Placement::BelowLevels => {
+                format!("  {percent:>2} %: below the levels tested ({tested}): no estimate\n")
+            }
+            Placement::AboveLevels => {
+                format!("  {percent:>2} %: above the levels tested ({tested}): no estimate\n")
+            }
+        };
     }
     if fit.failed_resamples > 0 {
         text += &format!(

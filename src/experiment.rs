@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, ValueEnum};
+use sake_glug_io::text::{printable, quoted};
 
 use sake_glug_study::{
     order_seed, plan_trials, render_stimuli, write_dry_run, Equalize, Silent, Spec, StudyError,
@@ -26,12 +27,16 @@ pub struct ExperimentArgs {
     #[arg(long)]
     participant: String,
     /// The trial log (CSV), one row appended per answer.
-    #[arg(long)]
-    log: PathBuf,
+    #[arg(long, required_unless_present = "no_answers")]
+    log: Option<PathBuf>,
     /// Writes every trial's two stimuli as WAV files and the trial list into this new (or
     /// empty) folder, and runs the session without playing anything.
     #[arg(long, value_name = "DIR")]
     dry_run: Option<PathBuf>,
+    /// With --dry-run: writes the folder and ends there, asking for no answers and keeping no
+    /// log (a scripted dry run).
+    #[arg(long, requires = "dry_run", conflicts_with_all = ["log", "resume"])]
+    no_answers: bool,
     /// Continues the session of an existing log after its last trial (same order).
     #[arg(long)]
     resume: bool,
@@ -185,11 +190,8 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         })
     })?;
     // Refused before the audio and the renders: the log is created or reopened after them.
-    if args.resume && !args.log.exists() {
-        return Err(usage(StudyError::NothingToResume(args.log)));
-    }
-    if !args.resume && args.log.exists() {
-        return Err(usage(StudyError::LogExists(args.log)));
+    if let Some(log) = &args.log {
+        TrialLog::check_path(log, args.resume).map_err(usage)?;
     }
     let seed = order_seed(spec.seed, &args.participant);
     let trials = plan_trials(&spec, seed);
@@ -223,7 +225,11 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         spec.stimuli[0].scene.sample_rate
     };
 
-    let rendered = render_stimuli(&spec, sample_rate).map_err(usage)?;
+    #[cfg_attr(
+        not(feature = "audio"),
+        expect(unused_mut, reason = "the player takes the samples")
+    )]
+    let mut rendered = render_stimuli(&spec, sample_rate).map_err(usage)?;
     println!(
         "{} design, {} trials, order seed {seed}, equalize {} ({} Hz):",
         spec.design.name(),
@@ -239,7 +245,7 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
     for (stimulus, rendered) in spec.stimuli.iter().zip(&rendered) {
         println!(
             "  {:<24} {} {:>8.2} dBFS  gain {:>+7.3} dB",
-            stimulus.name,
+            quoted(&stimulus.name),
             kind,
             20.0 * rendered.level.log10(),
             rendered.gain_db
@@ -252,25 +258,35 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         trials: &trials,
         rendered: &rendered,
     };
-    let resumed = if args.resume {
-        let (log, done) = TrialLog::resume(&args.log, &session.expected()).map_err(usage)?;
-        println!("Resuming after trial {done} of {}.", trials.len());
-        Some((log, done))
-    } else {
-        None
+    // Locked and checked whole before anything is written, its own rows or the dry run's.
+    let resumed = match (&args.log, args.resume) {
+        (Some(log), true) => {
+            let (log, done) = TrialLog::resume(log, &session).map_err(usage)?;
+            println!("Resuming after trial {done} of {}.", trials.len());
+            Some((log, done))
+        }
+        _ => None,
     };
     if let Some(dir) = &args.dry_run {
         // A resumed dry run keeps the folder its first run wrote.
         let already = args.resume && dir.join(sake_glug_study::TRIAL_LIST).exists();
         if !already {
             let written = write_dry_run(dir, &session, sample_rate).map_err(usage)?;
-            println!("Wrote {} files into {}.", written.len(), dir.display());
+            println!(
+                "Wrote {} files into {}.",
+                written.len(),
+                printable(&dir.to_string_lossy())
+            );
         }
     }
+    let Some(log_path) = &args.log else {
+        // --no-answers: the folder was the whole job.
+        return Ok(());
+    };
     // Created last, so that a refused folder or spec leaves no log behind.
     let (mut log, done) = match resumed {
         Some(resumed) => resumed,
-        None => (TrialLog::create(&args.log).map_err(usage)?, 0),
+        None => (TrialLog::create(log_path).map_err(usage)?, 0),
     };
     let _ = std::io::stdout().flush();
 
@@ -280,7 +296,18 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         Some(_) => session.run(done, &mut Silent, &mut log, &mut input, &mut prompt),
         #[cfg(feature = "audio")]
         None => {
-            let stimuli = rendered.iter().map(|r| r.samples.clone()).collect();
+            // The player takes the samples; the session keeps the gains for the log.
+            let stimuli = rendered
+                .iter_mut()
+                .map(|r| std::mem::take(&mut r.samples))
+                .collect();
+            let session = StudySession {
+                spec: &spec,
+                participant: &args.participant,
+                seed,
+                trials: &trials,
+                rendered: &rendered,
+            };
             let gap = (spec.gap_s * sample_rate as f64).round() as u64;
             let output = output.expect("opened above without --dry-run");
             let mut player = output

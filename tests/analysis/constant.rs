@@ -198,3 +198,34 @@ fn a_fitted_lapse_stays_within_its_bound_and_the_plot_is_written() {
         .unwrap()
         .starts_with(b"\x89PNG"));
 }
+
+/// The resamples are drawn on every core; the intervals are the same on one core (`taskset`,
+/// which the count of cores the analysis sees follows) as on all of them.
+#[test]
+fn the_intervals_are_the_same_on_one_core_and_on_all() {
+    let folder = tempfile::tempdir().unwrap();
+    std::fs::write(folder.path().join("log.csv"), log_of(&simulated_study(11))).unwrap();
+    let args = [
+        "analyze",
+        "constant",
+        "log.csv",
+        "--json",
+        "--resamples",
+        "300",
+    ];
+    let one_core = std::process::Command::new("taskset")
+        .current_dir(folder.path())
+        .args(["--cpu-list", "0", env!("CARGO_BIN_EXE_sake-glug")])
+        .args(args)
+        .output();
+    let Ok(one_core) = one_core else {
+        eprintln!("skipped: no taskset here");
+        return;
+    };
+    let all = analyze(folder.path(), &args[1..]);
+    assert_eq!(json_of(&one_core), json_of(&all));
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+    if cores < 2 {
+        eprintln!("this machine has one core: both runs drew on one");
+    }
+}

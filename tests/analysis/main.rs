@@ -1,9 +1,12 @@
 //! The analysis of study logs (`sake-glug analyze`): Thurstone scaling of paired comparisons,
 //! the psychometric fit of constant stimuli and the coverage of its intervals, checked by
-//! simulation; bad logs refused with file, line and column; the JSON shapes.
+//! simulation; bad logs refused with file, line and column; hostile logs (too many stimuli, a
+//! device, a log given twice, random answers) refused or reported for what they are; the JSON
+//! shapes.
 
 mod bad_logs;
 mod constant;
+mod hostile_logs;
 mod paired;
 
 use std::path::Path;

@@ -9,19 +9,32 @@ use statrs::distribution::{ContinuousCDF, Normal};
 use crate::{analyze, json_of};
 
 /// The stimuli of the paper's §3: the two-sinusoid model, the high-frequency wave alone, the
-/// low-frequency wave alone.
+/// low-frequency wave alone (the names of experiments/paired-waves.toml).
 const STIMULI: [&str; 3] = ["model", "high", "low"];
 
-/// A count matrix in the shape of the paper's Table 1 (`[i][j]`: how often i was chosen over j),
-/// CONSTRUCTED for this test: the paper's numbers were not at hand. 10 participants, each
-/// judging every ordered pair 3 times: 60 trials a pair.
-const CONSTRUCTED_TABLE_1: [[u32; 3]; 3] = [[0, 45, 50], [15, 0, 34], [10, 26, 0]];
-const PARTICIPANTS: usize = 10;
+/// The paper's Table 1 (§3), read as its scale needs: `[row][column]` is how often the row's
+/// wave was chosen over the column's (the caption says the reverse, but only this reading puts
+/// the modeled wave first, as fig. 2 and the text do). Six participants, each judging every
+/// ordered pair 3 times: 36 answers a pair.
+const TABLE_1: [[u32; 3]; 3] = [[0, 29, 34], [7, 0, 31], [2, 5, 0]];
+const PARTICIPANTS: usize = 6;
 
-/// The table as a runner's log: each participant's 18 trials, every ordered pair 3 times, the
-/// choices of each pair dealt out in turn so every participant has some of each answer.
+/// The Thurstone scale of Table 1 to 3 decimals, as computed from the table in the paper's data
+/// (the paper shows it only as fig. 2): modeled, high-frequency, low-frequency.
+const TABLE_1_SCALE: [f64; 3] = [1.711, 0.967, 0.0];
+
+/// Table 1 entered as trials, shared with the docs.
+const TABLE_1_LOG: &str = "tests/fixtures/studies/table-1.csv";
+
+fn fixture(path: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+}
+
+/// The table as a runner's log: each participant's trials, every ordered pair 3 times (18), the
+/// choices of each pair dealt out to the participants in turn, so every participant has some of
+/// each answer, and the order of presentation alternating.
 fn log_of_table(table: &[[u32; 3]; 3], participants: usize) -> String {
-    let mut log = String::from("participant,trial,design,first,second,answer,rt_s,seed\n");
+    let mut log = String::from("participant,trial,design,first,second,answer\n");
     let mut trial = vec![0; participants];
     for (i, j) in [(0, 1), (0, 2), (1, 2)] {
         let answers = std::iter::repeat_n(i, table[i][j] as usize)
@@ -37,8 +50,12 @@ fn log_of_table(table: &[[u32; 3]; 3], participants: usize) -> String {
             trial[participant] += 1;
             writeln!(
                 log,
-                "p{participant},{},paired,{},{},{},1.25,7",
-                trial[participant], STIMULI[first], STIMULI[second], STIMULI[chosen]
+                "P{},{},paired,{},{},{}",
+                participant + 1,
+                trial[participant],
+                STIMULI[first],
+                STIMULI[second],
+                STIMULI[chosen]
             )
             .unwrap();
         }
@@ -46,15 +63,36 @@ fn log_of_table(table: &[[u32; 3]; 3], participants: usize) -> String {
     log
 }
 
+/// The fixture is the table dealt out by the code above (so the docs that read it read Table 1),
+/// in the paper's design: 6 participants, each every ordered pair 3 times.
 #[test]
-fn table_1_entered_as_trials_gives_back_its_count_matrix_and_the_model_first() {
-    let folder = tempfile::tempdir().unwrap();
-    std::fs::write(
-        folder.path().join("table1.csv"),
-        log_of_table(&CONSTRUCTED_TABLE_1, PARTICIPANTS),
-    )
-    .unwrap();
-    let json = json_of(&analyze(folder.path(), &["paired", "table1.csv", "--json"]));
+fn the_table_1_log_is_the_papers_design() {
+    let log = std::fs::read_to_string(fixture(TABLE_1_LOG)).unwrap();
+    assert_eq!(
+        log,
+        log_of_table(&TABLE_1, PARTICIPANTS),
+        "{TABLE_1_LOG} is not Table 1 entered as trials: write it from `log_of_table`"
+    );
+    let mut reader = csv::Reader::from_reader(log.as_bytes());
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), PARTICIPANTS * 18);
+    for participant in 1..=PARTICIPANTS {
+        let name = format!("P{participant}");
+        for first in STIMULI {
+            for second in STIMULI.iter().filter(|&&second| second != first) {
+                let presented = rows
+                    .iter()
+                    .filter(|row| row[0] == name && &row[3] == first && &row[4] == *second)
+                    .count();
+                assert_eq!(presented, 3, "{name}: {first} then {second}");
+            }
+        }
+    }
+}
+
+#[test]
+fn table_1_entered_as_trials_gives_back_its_counts_and_the_papers_scale() {
+    let json = json_of(&analyze(&fixture(""), &["paired", TABLE_1_LOG, "--json"]));
     let stimuli: Vec<&str> = json["stimuli"]
         .as_array()
         .unwrap()
@@ -63,26 +101,28 @@ fn table_1_entered_as_trials_gives_back_its_count_matrix_and_the_model_first() {
         .collect();
     assert_eq!(stimuli, STIMULI);
     let counts: Vec<Vec<u32>> = serde_json::from_value(json["counts"].clone()).unwrap();
-    assert_eq!(counts, CONSTRUCTED_TABLE_1.map(Vec::from).to_vec());
+    assert_eq!(counts, TABLE_1.map(Vec::from).to_vec());
     let scale = json["scale"].as_object().unwrap();
-    let value = |name: &str| scale[name].as_f64().unwrap();
-    assert!(
-        value("model") > value("high") && value("high") > value("low"),
-        "{scale:?}"
-    );
-    assert_eq!(value("low"), 0.0, "the lowest is shifted to 0");
+    for (name, paper) in STIMULI.iter().zip(TABLE_1_SCALE) {
+        let value = scale[*name].as_f64().unwrap();
+        assert_eq!(
+            format!("{value:.3}"),
+            format!("{paper:.3}"),
+            "{name}: {scale:?}"
+        );
+    }
     assert_eq!(json["participants"], PARTICIPANTS);
-    assert_eq!(json["trials"], 180);
+    assert_eq!(json["trials"], 108);
 }
 
 /// The scale as Thurstone's Case V has it, computed here from the table directly.
 #[test]
 fn the_scale_is_case_v_by_hand() {
-    let trials = trials_of_table(&CONSTRUCTED_TABLE_1);
+    let trials = trials_of_table(&TABLE_1);
     let analysis = scale_paired(&trials).unwrap();
     let normal = Normal::standard();
     let z = |i: usize, j: usize| {
-        let (a, b) = (CONSTRUCTED_TABLE_1[i][j], CONSTRUCTED_TABLE_1[j][i]);
+        let (a, b) = (TABLE_1[i][j], TABLE_1[j][i]);
         if i == j {
             0.0
         } else {
@@ -174,11 +214,7 @@ fn the_agreement_test_has_the_papers_40_degrees_of_freedom_for_21_participants()
 #[test]
 fn the_text_report_shows_the_matrix_the_scale_and_both_tests() {
     let folder = tempfile::tempdir().unwrap();
-    std::fs::write(
-        folder.path().join("log.csv"),
-        log_of_table(&CONSTRUCTED_TABLE_1, PARTICIPANTS),
-    )
-    .unwrap();
+    std::fs::copy(fixture(TABLE_1_LOG), folder.path().join("log.csv")).unwrap();
     let output = analyze(folder.path(), &["paired", "log.csv", "--plot", "scale.png"]);
     assert!(
         output.status.success(),
@@ -186,7 +222,8 @@ fn the_text_report_shows_the_matrix_the_scale_and_both_tests() {
         String::from_utf8_lossy(&output.stderr)
     );
     let text = String::from_utf8(output.stdout).unwrap();
-    for expected in ["chosen over", "scale", "Mosteller", "χ²(1)", "χ²(18)"] {
+    // Agreement: (6 participants − 1)(3 stimuli − 1) = 10 degrees of freedom.
+    for expected in ["chosen over", "scale", "Mosteller", "χ²(1)", "χ²(10)"] {
         assert!(text.contains(expected), "no `{expected}` in\n{text}");
     }
     let png = std::fs::read(folder.path().join("scale.png")).unwrap();

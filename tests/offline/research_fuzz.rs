@@ -1,6 +1,7 @@
 //! Property-based fuzz tests for the files a researcher hands the product besides scenes: model
-//! files (`ModelFile::parse`), study specs (`Spec::parse`), fit sessions (`FitSession::parse`) and study
-//! logs (`analyze_paired_logs`, `analyze_constant_logs`). The libFuzzer targets (fuzz/) cover the
+//! files (`ModelFile::parse`), study specs (`Spec::parse`), fit sessions (`FitSession::parse`),
+//! study logs (`analyze_paired_logs`, `analyze_constant_logs`) and the logs `--resume` continues
+//! (`TrialLog::resume`, whose file must come out byte for byte as it went in). The libFuzzer targets (fuzz/) cover the
 //! renderer's and the plugin's inputs; these parsers came later, so each is fuzzed here from a
 //! valid file, mutated: text replaced, inserted or removed at any place, with the bytes that break
 //! parsers (quotes, brackets, separators, newlines, control characters, numbers at and beyond
@@ -11,13 +12,16 @@
 //! sequence could retitle or recolour it).
 
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 use proptest::prelude::*;
 
 use sake_glug_analysis::{analyze_constant_logs, analyze_paired_logs, PsychometricOptions};
 use sake_glug_fit::FitSession;
 use sake_glug_model_file::ModelFile;
-use sake_glug_study::Spec;
+use sake_glug_study::{
+    order_seed, plan_trials, Rendered, Silent, Spec, StudyError, StudySession, Trial, TrialLog,
+};
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
@@ -113,6 +117,70 @@ const CONSTANT_LOG: &str = "participant,trial,design,first,second,answer,rt_s,se
     p1,8,constant,comparison,standard,standard,0.6,3,0.49,0\n\
     p1,9,constant,standard,comparison,comparison,0.6,3,0.49,1\n";
 
+/// The paper's paired study, participant `p1`: its spec, its trials, its stimuli (unrendered:
+/// a resume checks names, never samples) and a log of its first 7 answers as the runner writes
+/// it.
+struct ResumeBase {
+    spec: Spec,
+    trials: Vec<Trial>,
+    rendered: Vec<Rendered>,
+    seed: u64,
+    log: String,
+}
+
+const PARTICIPANT: &str = "p1";
+
+impl ResumeBase {
+    fn get() -> &'static Self {
+        static BASE: OnceLock<ResumeBase> = OnceLock::new();
+        BASE.get_or_init(|| {
+            let spec = Spec::load(&Path::new(ROOT).join("experiments/paired-waves.toml")).unwrap();
+            let seed = order_seed(spec.seed, PARTICIPANT);
+            let trials = plan_trials(&spec, seed);
+            let rendered = spec
+                .stimuli
+                .iter()
+                .map(|_| Rendered {
+                    samples: Vec::new(),
+                    gain_db: -1.5,
+                    level: 1.0,
+                })
+                .collect();
+            let mut base = ResumeBase {
+                spec,
+                trials,
+                rendered,
+                seed,
+                log: String::new(),
+            };
+            let folder = tempfile::tempdir().unwrap();
+            let path = folder.path().join("log.csv");
+            let mut log = TrialLog::create(&path).unwrap();
+            let mut answers = "\n1\n2\n2\n1\n1\n2\n1\n".as_bytes();
+            let stopped =
+                base.session()
+                    .run(0, &mut Silent, &mut log, &mut answers, &mut std::io::sink());
+            assert!(matches!(
+                stopped,
+                Err(StudyError::InputClosed { answered: 7, .. })
+            ));
+            drop(log);
+            base.log = std::fs::read_to_string(&path).unwrap();
+            base
+        })
+    }
+
+    fn session(&self) -> StudySession<'_> {
+        StudySession {
+            spec: &self.spec,
+            participant: PARTICIPANT,
+            seed: self.seed,
+            trials: &self.trials,
+            rendered: &self.rendered,
+        }
+    }
+}
+
 proptest! {
     // No regression files written next to the sources, as in tests/support/fuzz.rs.
     #![proptest_config(ProptestConfig { failure_persistence: None, ..ProptestConfig::default() })]
@@ -172,6 +240,29 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// A log mutated anywhere (its rows, its answers, its end) resumes or is refused cleanly,
+    /// and in either case is left byte for byte as it was: a resume writes nothing before the
+    /// session's next answer.
+    #[test]
+    fn a_mutated_log_resumes_or_is_refused_and_is_never_changed(
+        edits in prop::collection::vec(edit(), 1..8),
+    ) {
+        let base = ResumeBase::get();
+        let folder = tempfile::tempdir().unwrap();
+        let path = folder.path().join("log.csv");
+        let text = mutate(&base.log, &edits);
+        std::fs::write(&path, &text).unwrap();
+        match TrialLog::resume(&path, &base.session()) {
+            Ok((_, done)) => prop_assert!(done <= base.trials.len()),
+            Err(error) => assert_clean("resumed log", &error.to_string()),
+        }
+        prop_assert_eq!(std::fs::read_to_string(&path).unwrap(), text);
+    }
+}
+
 /// The mutations reach past the parsers' first line of defence: the valid bases load as they
 /// are, so a refusal above is the edit's doing.
 #[test]
@@ -183,6 +274,11 @@ fn the_bases_are_valid() {
     }
     let folder = tempfile::tempdir().unwrap();
     FitSession::parse(SESSION, &folder.path().join("session.toml")).unwrap();
+    let base = ResumeBase::get();
+    let log = folder.path().join("resumed.csv");
+    std::fs::write(&log, &base.log).unwrap();
+    let (_, done) = TrialLog::resume(&log, &base.session()).unwrap();
+    assert_eq!(done, 7);
     for (base, constant) in [(PAIRED_LOG, false), (CONSTANT_LOG, true)] {
         let log = folder.path().join("log.csv");
         std::fs::write(&log, base).unwrap();

@@ -3,7 +3,10 @@
 
 use serde_json::{json, Map, Value};
 
-use super::{ChiSquareTest, ConstantAnalysis, PairedAnalysis, PsychometricFit, POINT_PERCENTS};
+use super::{
+    ChiSquareTest, ConstantAnalysis, PairedAnalysis, Placement, PointEstimate, PsychometricFit,
+    POINT_PERCENTS,
+};
 
 fn test_json(test: Option<ChiSquareTest>) -> Value {
     test.map_or(Value::Null, |test| json!(test))
@@ -33,11 +36,28 @@ pub fn paired_json(analysis: &PairedAnalysis) -> Value {
     })
 }
 
+/// A point as an estimate only within the levels tested: outside them its value and interval
+/// are `null`; an end of its interval outside them is `null` too (beyond the lowest level for
+/// `low`, the highest for `high`).
+fn point_json(point: &PointEstimate, lowest: f64, highest: f64) -> Value {
+    let within = |level: f64| {
+        (point.placement == Placement::Within && (lowest..=highest).contains(&level))
+            .then_some(level)
+    };
+    json!({
+        "value": within(point.value),
+        "low": within(point.low),
+        "high": within(point.high),
+        "placement": point.placement,
+    })
+}
+
 fn fit_json(fit: &PsychometricFit) -> Value {
+    let (lowest, highest) = fit.level_range();
     let points: Map<String, Value> = POINT_PERCENTS
         .iter()
         .zip(&fit.points)
-        .map(|(percent, point)| (percent.to_string(), json!(point)))
+        .map(|(percent, point)| (percent.to_string(), point_json(point, lowest, highest)))
         .collect();
     json!({
         "levels": fit.levels.iter().map(|level| json!({
@@ -54,7 +74,7 @@ fn fit_json(fit: &PsychometricFit) -> Value {
 }
 
 /// `sake-glug analyze constant --json`: the pooled fit (levels, curve, points 25/50/75 with
-/// their 95 % intervals) and each participant's.
+/// their 95 % intervals, `null` outside the levels tested) and each participant's.
 pub fn constant_json(analysis: &ConstantAnalysis) -> Value {
     let participants: Map<String, Value> = analysis
         .participants

@@ -19,13 +19,14 @@ mod plot;
 
 pub use constant::{
     analyze_constant_logs, count_levels, fit_psychometric, ConstantAnalysis, LevelCount, Logistic,
-    PointEstimate, PsychometricFit, PsychometricFitError, PsychometricOptions, CONSTANT_COLUMNS,
-    MAX_LAPSE, MAX_RESAMPLES, POINT_PERCENTS,
+    Placement, PointEstimate, PsychometricFit, PsychometricFitError, PsychometricOptions,
+    CONSTANT_COLUMNS, MAX_LAPSE, MAX_RESAMPLES, POINT_PERCENTS,
 };
 pub use error::AnalysisError;
 pub use json::{constant_json, paired_json};
 pub use paired::{
-    analyze_paired_logs, scale_paired, ChiSquareTest, PairedAnalysis, PairedTrial, PAIRED_COLUMNS,
+    analyze_paired_logs, scale_paired, ChiSquareTest, PairedAnalysis, PairedTrial,
+    MAX_PAIRED_STIMULI, PAIRED_COLUMNS,
 };
 #[cfg(feature = "plot")]
 pub use plot::{draw_constant_plot, draw_paired_plot};

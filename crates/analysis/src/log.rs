@@ -1,11 +1,20 @@
 //! Study logs as the analyses read them: CSV with a header, of which only the columns an
 //! analysis names are read (a log holds many more: the runner logs every stimulus parameter).
+//! A cell the runner marked as text for spreadsheets (a leading `'`) is read as the text it was.
+//! A trial is counted once: a file named twice, or a participant's trial number found twice
+//! (where the logs have a `trial` column), is refused with both places.
 
-use sake_glug_io::read::{self, InputKind};
+use std::collections::HashMap;
 use std::path::Path;
 
 use super::error::{shown, AnalysisError};
-use sake_glug_io::text::printable;
+use sake_glug_io::read::{self, InputKind};
+use sake_glug_io::text::{from_csv_cell, quoted};
+
+/// The column every analysis reads first: who answered.
+const PARTICIPANT: &str = "participant";
+/// The column that numbers a participant's trials, read where a log has it.
+const TRIAL: &str = "trial";
 
 /// One row of a log: where it is, and the fields of the columns asked for, trimmed, in the order
 /// asked for.
@@ -29,28 +38,71 @@ impl<const N: usize> LogRow<N> {
         }
     }
 
-    /// The field of the `index`th column asked for, as a message quotes it.
+    /// The field of the `index`th column asked for, as a message quotes it: escaped, cut short.
     pub fn quoted(&self, index: usize) -> String {
-        format!("`{}`", printable(&self.fields[index]))
+        format!("`{}`", quoted(&self.fields[index]))
     }
 }
 
-/// Every row of every log, the fields of `columns`; blank lines are skipped.
+/// Every row of every log, the fields of `columns` (the first of which is the participant's);
+/// blank lines are skipped.
 pub(crate) fn read_rows<const N: usize>(
     files: &[impl AsRef<Path>],
     columns: [&'static str; N],
 ) -> Result<Vec<LogRow<N>>, AnalysisError> {
+    debug_assert_eq!(columns.first(), Some(&PARTICIPANT));
+    refuse_repeated_files(files)?;
     let mut rows = Vec::new();
+    let mut trials: HashMap<(String, String), (String, u64)> = HashMap::new();
     for file in files {
-        read_file(file.as_ref(), columns, &mut rows)?;
+        read_file(file.as_ref(), columns, &mut rows, &mut trials)?;
     }
     Ok(rows)
+}
+
+/// Refuses a file named twice (by another path, a link: the same device and inode).
+fn refuse_repeated_files(files: &[impl AsRef<Path>]) -> Result<(), AnalysisError> {
+    let mut seen: HashMap<(u64, u64), &Path> = HashMap::new();
+    for file in files {
+        let file = file.as_ref();
+        // A file that cannot be read is refused by the reader, with its reason.
+        let Some(identity) = identity(file) else {
+            continue;
+        };
+        if let Some(first) = seen.insert(identity, file) {
+            return Err(AnalysisError::read(
+                file,
+                format!(
+                    "the same file as {}: each log is read once, or its trials would count twice",
+                    shown(first)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The device and inode of `file`, which name it whatever the path.
+fn identity(file: &Path) -> Option<(u64, u64)> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        std::fs::metadata(file)
+            .ok()
+            .map(|metadata| (metadata.dev(), metadata.ino()))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = file;
+        None
+    }
 }
 
 fn read_file<const N: usize>(
     file: &Path,
     columns: [&'static str; N],
     rows: &mut Vec<LogRow<N>>,
+    trials: &mut HashMap<(String, String), (String, u64)>,
 ) -> Result<(), AnalysisError> {
     let name = shown(file);
     let input = read::open(file, InputKind::STUDY_LOG)
@@ -62,21 +114,37 @@ fn read_file<const N: usize>(
         .headers()
         .map_err(|error| row_error(&name, &error, 1))?
         .clone();
+    let column = |wanted: &str| headers.iter().position(|header| header.trim() == wanted);
     let mut indices = [0; N];
-    for (slot, column) in indices.iter_mut().zip(columns) {
-        *slot = headers
-            .iter()
-            .position(|header| header.trim() == column)
-            .ok_or_else(|| AnalysisError::MissingColumn {
-                file: name.clone(),
-                column,
-                needed: columns.map(|column| format!("`{column}`")).join(", "),
-            })?;
+    for (slot, wanted) in indices.iter_mut().zip(columns) {
+        *slot = column(wanted).ok_or_else(|| AnalysisError::MissingColumn {
+            file: name.clone(),
+            column: wanted,
+            needed: columns.map(|column| format!("`{column}`")).join(", "),
+        })?;
     }
+    let trial_column = column(TRIAL);
     for record in reader.records() {
         let record = record.map_err(|error| row_error(&name, &error, 0))?;
         let line = record.position().map_or(0, |position| position.line());
-        let fields = indices.map(|index| record.get(index).unwrap_or("").trim().to_owned());
+        let field = |index: usize| from_csv_cell(record.get(index).unwrap_or("").trim()).to_owned();
+        let fields = indices.map(field);
+        if let Some(trial) = trial_column.map(field).filter(|trial| !trial.is_empty()) {
+            let key = (fields[0].clone(), trial);
+            if let Some((first_file, first_line)) = trials.get(&key) {
+                return Err(AnalysisError::Row {
+                    file: name,
+                    line,
+                    message: format!(
+                        "participant `{}`, trial `{}` again (first at {first_file}, line \
+                         {first_line}): a trial is counted once; is a log given twice?",
+                        quoted(&key.0),
+                        quoted(&key.1)
+                    ),
+                });
+            }
+            trials.insert(key, (name.clone(), line));
+        }
         rows.push(LogRow {
             file: name.clone(),
             line,

@@ -1,8 +1,10 @@
 //! The paired-comparison study (the paper's §3): every ordered pair of stimuli, the participant
 //! names the one that is more so. Scaled by Thurstone's Case V (docs/studies.md).
 
+use std::collections::HashMap;
 use std::path::Path;
 
+use sake_glug_io::text::quoted;
 use serde::Serialize;
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 
@@ -113,24 +115,41 @@ pub fn analyze_paired_logs(files: &[impl AsRef<Path>]) -> Result<PairedAnalysis,
     scale_paired(&trials).map_err(|message| AnalysisError::design(files, message))
 }
 
+/// The most stimuli a paired analysis scales: its matrices grow with the square of the count
+/// (256² cells each), and Case V needs every pair compared (32,640 pairs), far past any study
+/// of people (the paper's has 3).
+pub const MAX_PAIRED_STIMULI: usize = 256;
+
 /// The Case V scale of `trials`, or what keeps them from being scaled: fewer than two stimuli,
-/// or a pair of stimuli never compared.
+/// more than [`MAX_PAIRED_STIMULI`], or a pair of stimuli never compared.
 pub fn scale_paired(trials: &[PairedTrial]) -> Result<PairedAnalysis, String> {
     let mut stimuli: Vec<String> = Vec::new();
     let mut participants: Vec<String> = Vec::new();
-    let index_in = |names: &mut Vec<String>, name: &str| match names.iter().position(|n| n == name)
-    {
-        Some(index) => index,
-        None => {
-            names.push(name.to_owned());
+    let mut stimulus_index: HashMap<&str, usize> = HashMap::new();
+    let mut participant_index: HashMap<&str, usize> = HashMap::new();
+    let index_in = |names: &mut Vec<String>, index: &mut HashMap<_, usize>, name| {
+        *index.entry(name).or_insert_with(|| {
+            names.push(String::from(name));
             names.len() - 1
-        }
+        })
     };
     let mut choices = Vec::with_capacity(trials.len());
     for trial in trials {
-        let first = index_in(&mut stimuli, &trial.first);
-        let second = index_in(&mut stimuli, &trial.second);
-        let participant = index_in(&mut participants, &trial.participant);
+        let first = index_in(&mut stimuli, &mut stimulus_index, trial.first.as_str());
+        let second = index_in(&mut stimuli, &mut stimulus_index, trial.second.as_str());
+        if stimuli.len() > MAX_PAIRED_STIMULI {
+            return Err(format!(
+                "more than {MAX_PAIRED_STIMULI} stimuli (the {}th is `{}`): a paired analysis \
+                 scales at most {MAX_PAIRED_STIMULI}, whose every pair must be compared",
+                stimuli.len(),
+                quoted(&stimuli[stimuli.len() - 1])
+            ));
+        }
+        let participant = index_in(
+            &mut participants,
+            &mut participant_index,
+            trial.participant.as_str(),
+        );
         let (chosen, other) = if trial.answer == trial.first {
             (first, second)
         } else {
@@ -142,21 +161,34 @@ pub fn scale_paired(trials: &[PairedTrial]) -> Result<PairedAnalysis, String> {
     if n < 2 {
         return Err(match stimuli.first() {
             None => "no trials".into(),
-            Some(only) => format!("one stimulus only (`{only}`): scaling needs two or more"),
+            Some(only) => format!(
+                "one stimulus only (`{}`): scaling needs two or more",
+                quoted(only)
+            ),
         });
     }
+    let pairs = n * (n - 1) / 2;
+    if pairs > trials.len() {
+        return Err(format!(
+            "{n} stimuli make {pairs} pairs, and there are {} trials: some pair is never \
+             compared, and Case V needs every pair",
+            trials.len()
+        ));
+    }
     let mut counts = vec![vec![0u32; n]; n];
-    let mut wins = vec![vec![0u32; n]; participants.len()];
+    // Who chose what, kept sparse: a participant chooses few of many stimuli.
+    let mut wins: HashMap<(usize, usize), u32> = HashMap::new();
     for &(participant, chosen, other) in &choices {
         counts[chosen][other] += 1;
-        wins[participant][chosen] += 1;
+        *wins.entry((participant, chosen)).or_default() += 1;
     }
     for i in 0..n {
         for j in i + 1..n {
             if counts[i][j] + counts[j][i] == 0 {
                 return Err(format!(
                     "`{}` and `{}` are never compared: Case V needs every pair",
-                    stimuli[i], stimuli[j]
+                    quoted(&stimuli[i]),
+                    quoted(&stimuli[j])
                 ));
             }
         }
@@ -197,7 +229,7 @@ pub fn scale_paired(trials: &[PairedTrial]) -> Result<PairedAnalysis, String> {
         .map(|i| (0..n).map(|j| normal.cdf(scale[i] - scale[j])).collect())
         .collect();
     let fit = mosteller_fit(&proportions, &predicted, trials_of);
-    let agreement = homogeneity(&wins);
+    let agreement = homogeneity(&wins, participants.len(), n);
     Ok(PairedAnalysis {
         stimuli,
         counts,
@@ -234,32 +266,31 @@ fn mosteller_fit(
 }
 
 /// Pearson's χ² test of homogeneity of a participants × stimuli table of how often each
-/// participant chose each stimulus: do the participants share one order? A stimulus nobody
-/// chose carries no information and is left out. (P − 1)(k − 1) degrees of freedom.
-fn homogeneity(wins: &[Vec<u32>]) -> Option<ChiSquareTest> {
-    let columns: Vec<usize> = (0..wins.first()?.len())
-        .filter(|&column| wins.iter().any(|row| row[column] > 0))
-        .collect();
-    if wins.len() < 2 || columns.len() < 2 {
+/// participant chose each stimulus (`wins`, its cells that are not 0): do the participants share
+/// one order? A stimulus nobody chose carries no information and is left out. (P − 1)(k − 1)
+/// degrees of freedom. χ² = Σ (O − E)²/E = Σ O²/E − N over every cell, the second form summed
+/// over the cells that are not 0 alone.
+fn homogeneity(
+    wins: &HashMap<(usize, usize), u32>,
+    participants: usize,
+    stimuli: usize,
+) -> Option<ChiSquareTest> {
+    let mut row_totals = vec![0.0; participants];
+    let mut column_totals = vec![0.0; stimuli];
+    for (&(participant, stimulus), &count) in wins {
+        row_totals[participant] += f64::from(count);
+        column_totals[stimulus] += f64::from(count);
+    }
+    let columns = column_totals.iter().filter(|&&total| total > 0.0).count();
+    if participants < 2 || columns < 2 {
         return None;
     }
-    let row_totals: Vec<f64> = wins
-        .iter()
-        .map(|row| columns.iter().map(|&c| f64::from(row[c])).sum())
-        .collect();
-    let column_totals: Vec<f64> = columns
-        .iter()
-        .map(|&c| wins.iter().map(|row| f64::from(row[c])).sum())
-        .collect();
     let total: f64 = row_totals.iter().sum();
-    let mut chi2 = 0.0;
-    for (row, row_total) in wins.iter().zip(&row_totals) {
-        for (&column, column_total) in columns.iter().zip(&column_totals) {
-            let expected = row_total * column_total / total;
-            let difference = f64::from(row[column]) - expected;
-            chi2 += difference * difference / expected;
-        }
+    let mut sum = 0.0;
+    for (&(participant, stimulus), &count) in wins {
+        let expected = row_totals[participant] * column_totals[stimulus] / total;
+        sum += f64::from(count) * f64::from(count) / expected;
     }
-    let df = ((wins.len() - 1) * (columns.len() - 1)) as u32;
-    ChiSquareTest::of(chi2, df)
+    let df = ((participants - 1) * (columns - 1)) as u32;
+    ChiSquareTest::of((sum - total).max(0.0), df)
 }

@@ -2,6 +2,7 @@
 //! tilt, with its start volume or a weight log, and the liquid it holds.
 
 use sake_glug_io::read::{self, InputKind};
+use sake_glug_io::text::quoted;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
@@ -171,8 +172,11 @@ impl FitSession {
                 return Err(FitError::SessionSyntax {
                     path: path.to_owned(),
                     message: format!(
-                        "`{key}.liquid` = {liquid:?}: a liquid names its model file, so it is \
-                         letters, digits, `-` and `_` only"
+                        "`{key}.liquid` = \"{}\" ({} characters): a liquid names its model \
+                         file, so it is 1 to {MAX_LIQUID_CHARS} characters, each a letter, a \
+                         digit, `-` or `_`",
+                        quoted(&liquid),
+                        liquid.chars().count()
                     ),
                 });
             }
@@ -204,11 +208,46 @@ impl FitSession {
     }
 }
 
+/// The longest liquid name: it names a file `<name>.toml`, whose name must fit every system.
+const MAX_LIQUID_CHARS: usize = 64;
+
 /// Whether `name` can name a file `<name>.toml` in any folder, on any system.
 fn is_file_name(name: &str) -> bool {
     !name.is_empty()
-        && name.len() <= 64
+        && name.len() <= MAX_LIQUID_CHARS
         && name
             .chars()
             .all(|ch| ch.is_ascii_alphanumeric() || ch == '-' || ch == '_')
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 300-character liquid was refused as "letters, digits, `-` and `_` only"; the rule is
+    /// also a length, which the message now says, with the name cut short.
+    #[test]
+    fn a_long_liquid_name_is_refused_with_the_real_rule() {
+        let session = |liquid: &str| {
+            format!(
+                "capacity_ml = 300.0\n[[recording]]\naudio = \"a.wav\"\ntilt_deg = 90.0\n\
+                 start_ml = 300.0\nliquid = \"{liquid}\"\n"
+            )
+        };
+        let path = Path::new("session.toml");
+        let long = "a".repeat(300);
+        let message = FitSession::parse(&session(&long), path)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("(300 characters)") && message.contains("1 to 64 characters"),
+            "{message}"
+        );
+        assert!(message.len() < 300, "{message}");
+        FitSession::parse(&session(&"a".repeat(64)), path).unwrap();
+        let message = FitSession::parse(&session("rosé"), path)
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("a letter, a digit"), "{message}");
+    }
 }

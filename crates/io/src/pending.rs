@@ -198,6 +198,23 @@ pub fn temp_file_beside(target: &Path, suffix: &str) -> io::Result<NamedTempFile
         .tempfile_in(folder_of(target))
 }
 
+/// A new empty temporary folder beside the folder `target`, named as [`temp_file_beside`] names a
+/// file (so that [`remove_stale_temps`] removes one a killed process left), with the permissions
+/// any new folder gets (0o777 less the umask), to be filled and renamed onto `target`.
+pub fn temp_dir_beside(target: &Path) -> io::Result<tempfile::TempDir> {
+    let prefix = own_prefix(target);
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(fs::Permissions::from_mode(0o777));
+    }
+    builder
+        .prefix(&prefix)
+        .suffix(".tmp")
+        .tempdir_in(folder_of(target))
+}
+
 /// The previous target kept under a name like its temporary file's (ending in `.old`), made by
 /// `keep` (a hard link or a rename) at the path it is given.
 fn backup_of(
@@ -247,9 +264,9 @@ pub fn remove_own_temps(target: &Path) {
     }
 }
 
-/// Removes the files a render killed outright left beside `target` (their process is gone);
-/// returns those it cannot tell about (where the system does not say which processes run),
-/// for the caller to name.
+/// Removes the files (and the folders of [`temp_dir_beside`]) a process killed outright left
+/// beside `target` (their process is gone); returns those it cannot tell about (where the system
+/// does not say which processes run), for the caller to name.
 pub fn remove_stale_temps(target: &Path) -> Vec<PathBuf> {
     let Ok(entries) = fs::read_dir(folder_of(target)) else {
         return Vec::new();
@@ -266,10 +283,17 @@ pub fn remove_stale_temps(target: &Path) -> Vec<PathBuf> {
         let Some(pid) = pid.filter(|&pid| pid != std::process::id()) else {
             continue;
         };
-        if !entry.file_type().is_ok_and(|kind| kind.is_file()) {
+        // Not followed: a link is nobody's temporary file.
+        let Ok(kind) = entry.file_type() else {
+            continue;
+        };
+        if !kind.is_file() && !kind.is_dir() {
             continue;
         }
         match process_alive(pid) {
+            Some(false) if kind.is_dir() => {
+                let _ = fs::remove_dir_all(entry.path());
+            }
             Some(false) => {
                 let _ = fs::remove_file(entry.path());
             }
@@ -421,5 +445,20 @@ mod tests {
         }
         assert!(remove_stale_temps(&target).is_empty());
         assert!(!dead.exists() && alive.exists() && other.exists());
+    }
+
+    #[test]
+    fn a_temporary_folder_can_be_filled_and_a_dead_ones_is_removed() {
+        use std::os::unix::fs::PermissionsExt;
+        let folder = tempfile::tempdir().unwrap();
+        let target = folder.path().join("dry");
+        let temp = temp_dir_beside(&target).unwrap();
+        let mode = fs::metadata(temp.path()).unwrap().permissions().mode();
+        assert_eq!(mode & 0o100, 0o100, "searchable by its owner: {mode:o}");
+        let dead = folder.path().join(".dry.sake-glug-4294967290.a1b2c3.tmp");
+        fs::create_dir(&dead).unwrap();
+        fs::write(dead.join("trial-001-1-a.wav"), "").unwrap();
+        assert!(remove_stale_temps(&target).is_empty());
+        assert!(!dead.exists() && temp.path().exists());
     }
 }

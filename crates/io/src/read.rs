@@ -233,7 +233,7 @@ pub fn utf8_text(bytes: Vec<u8>) -> Result<String, ReadFailure> {
 }
 
 /// What a file that is not a regular file is, for a message.
-fn kind_of(file_type: FileType) -> &'static str {
+pub(crate) fn kind_of(file_type: FileType) -> &'static str {
     if file_type.is_dir() {
         return "a folder";
     }

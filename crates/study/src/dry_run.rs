@@ -1,13 +1,26 @@
 //! The dry run's folder: every trial's two stimuli as mono 32-bit float WAV files, with the
 //! trial list, written all or nothing (a temporary folder beside the target, renamed onto it).
+//!
+//! What it writes is known before it starts, and refused with the figure if the disk has not the
+//! room; a session has at most [`MAX_TRIALS`](crate::MAX_TRIALS) trials, so a dry run at most
+//! twice as many files and the list. A temporary folder that a killed dry run left is removed by
+//! the next one to the same folder (it is named after its process, as every temporary file).
 
+use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use super::session::StudySession;
 use super::StudyError;
+use sake_glug_io::text::csv_cell;
+use sake_glug_io::{remove_stale_temps, temp_dir_beside};
+use sake_glug_render::human_bytes;
 
 /// The trial list's name inside the folder.
 pub const TRIAL_LIST: &str = "trials.csv";
+
+/// The most a mono float WAV file's header takes (RIFF, `fmt ` with its extension, `fact`,
+/// `data`): a stimulus's file is this and 4 bytes a sample.
+const WAV_HEADER_BYTES: u64 = 100;
 
 /// Writes `session`'s files into the folder `dir`, which must not exist or be empty. Each
 /// stimulus is written once and every trial's file is a hard link to it (a copy where the
@@ -32,29 +45,45 @@ pub fn write_dry_run(
             ));
         }
     }
+    if dir.file_name().is_none() {
+        return Err(folder_error("it names no folder".into()));
+    }
     let parent = match dir.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
-    let name = dir
-        .file_name()
-        .ok_or_else(|| folder_error("it names no folder".into()))?;
-    let temp = sake_glug_io::temp::temp_file_builder()
-        .prefix(&format!(".{}.sake-glug-", name.to_string_lossy()))
-        .suffix(".tmp")
-        .tempdir_in(parent)
-        .map_err(|error| folder_error(error.to_string()))?;
     let io = |path: &Path| {
         let path = path.to_owned();
         move |source| StudyError::Io { path, source }
     };
     let spec = session.spec;
+    let (list, files) = trial_list(session, dir)?;
+    let stimulus_bytes: Vec<u64> = session
+        .rendered
+        .iter()
+        .map(|rendered| WAV_HEADER_BYTES + 4 * rendered.samples.len() as u64)
+        .collect();
+    let room = |needed: u64, how: &str| match free_bytes(parent) {
+        Some(free) if needed > free => Err(folder_error(format!(
+            "{how} it needs {}, and its disk has {} free",
+            human_bytes(needed),
+            human_bytes(free)
+        ))),
+        _ => Ok(()),
+    };
+    room(
+        stimulus_bytes.iter().sum::<u64>() + list.len() as u64,
+        "its stimuli and trial list:",
+    )?;
+    remove_stale_temps(dir);
+    let temp = temp_dir_beside(dir).map_err(|error| folder_error(error.to_string()))?;
     let mut stimulus_files = Vec::new();
-    for (stimulus, rendered) in spec.stimuli.iter().zip(session.rendered) {
-        let path = temp
-            .path()
-            .join(format!(".stimulus-{}.wav", file_safe(&stimulus.name)));
-        let spec = hound::WavSpec {
+    for (index, (stimulus, rendered)) in spec.stimuli.iter().zip(session.rendered).enumerate() {
+        let path = temp.path().join(format!(
+            ".stimulus-{index}-{}.wav",
+            file_safe(&stimulus.name)
+        ));
+        let wav_spec = hound::WavSpec {
             channels: 1,
             sample_rate,
             bits_per_sample: 32,
@@ -64,13 +93,66 @@ pub fn write_dry_run(
             path: path.clone(),
             source: std::io::Error::other(error),
         };
-        let mut writer = hound::WavWriter::create(&path, spec).map_err(wav_error)?;
+        let mut writer = hound::WavWriter::create(&path, wav_spec).map_err(wav_error)?;
         for &sample in &rendered.samples {
             writer.write_sample(sample).map_err(wav_error)?;
         }
         writer.finalize().map_err(wav_error)?;
+        File::open(&path)
+            .and_then(|file| file.sync_all())
+            .map_err(io(&path))?;
         stimulus_files.push(path);
     }
+    let mut written = Vec::new();
+    let mut copies_checked = false;
+    for (trial, names) in session.trials.iter().zip(&files) {
+        for (stimulus, name) in [trial.first, trial.second].into_iter().zip(names) {
+            let path = temp.path().join(name);
+            let source = &stimulus_files[stimulus];
+            if std::fs::hard_link(source, &path).is_err() {
+                if !copies_checked {
+                    // No links here: every trial's file is a copy.
+                    let copies = session
+                        .trials
+                        .iter()
+                        .map(|trial| stimulus_bytes[trial.first] + stimulus_bytes[trial.second])
+                        .sum::<u64>();
+                    room(
+                        copies,
+                        "this file system has no hard links, so every trial's files are copies:",
+                    )?;
+                    copies_checked = true;
+                }
+                std::fs::copy(source, &path).map_err(io(&path))?;
+            }
+            written.push(dir.join(name));
+        }
+    }
+    for file in &stimulus_files {
+        std::fs::remove_file(file).map_err(io(file))?;
+    }
+    let list_path = temp.path().join(TRIAL_LIST);
+    std::fs::write(&list_path, list)
+        .and_then(|()| File::open(&list_path)?.sync_all())
+        .map_err(io(&list_path))?;
+    written.push(dir.join(TRIAL_LIST));
+    // The names in the folder are durable before it is renamed into place.
+    File::open(temp.path())
+        .and_then(|folder| folder.sync_all())
+        .map_err(io(temp.path()))?;
+    // rename(2) replaces an empty folder; a folder that gained files since is refused by it.
+    std::fs::rename(temp.path(), dir).map_err(|error| folder_error(error.to_string()))?;
+    // Renamed: nothing left for the guard to remove.
+    let _ = temp.keep();
+    Ok(written)
+}
+
+/// The trial list's bytes and each trial's two file names: `trial-007-1-model.wav`, ….
+fn trial_list(
+    session: &StudySession,
+    dir: &Path,
+) -> Result<(Vec<u8>, Vec<[String; 2]>), StudyError> {
+    let spec = session.spec;
     let mut list = csv::Writer::from_writer(Vec::new());
     let list_error = |error: csv::Error| StudyError::Io {
         path: dir.join(TRIAL_LIST),
@@ -86,51 +168,63 @@ pub fn write_dry_run(
         "second_gain_db",
     ])
     .map_err(list_error)?;
-    let mut written = Vec::new();
+    let mut files = Vec::with_capacity(session.trials.len());
     for (index, trial) in session.trials.iter().enumerate() {
-        let mut files = Vec::new();
-        for (place, stimulus) in [(1, trial.first), (2, trial.second)] {
-            let file = format!(
+        let [first, second] = [(1, trial.first), (2, trial.second)].map(|(place, stimulus)| {
+            format!(
                 "trial-{:03}-{place}-{}.wav",
                 index + 1,
                 file_safe(&spec.stimuli[stimulus].name)
-            );
-            let path = temp.path().join(&file);
-            std::fs::hard_link(&stimulus_files[stimulus], &path)
-                .or_else(|_| std::fs::copy(&stimulus_files[stimulus], &path).map(drop))
-                .map_err(io(&path))?;
-            written.push(dir.join(&file));
-            files.push(file);
-        }
+            )
+        });
+        // The names are the spec's: a spreadsheet shows them as text, never runs them.
         list.write_record([
             (index + 1).to_string(),
-            spec.stimuli[trial.first].name.clone(),
-            spec.stimuli[trial.second].name.clone(),
-            files[0].clone(),
-            files[1].clone(),
+            csv_cell(&spec.stimuli[trial.first].name).into_owned(),
+            csv_cell(&spec.stimuli[trial.second].name).into_owned(),
+            first.clone(),
+            second.clone(),
             session.rendered[trial.first].gain_db.to_string(),
             session.rendered[trial.second].gain_db.to_string(),
         ])
         .map_err(list_error)?;
+        files.push([first, second]);
     }
-    for file in &stimulus_files {
-        std::fs::remove_file(file).map_err(io(file))?;
+    Ok((list.into_inner().expect("a Vec never fails"), files))
+}
+
+/// The bytes an ordinary user may still write on the file system of `folder`; `None` where the
+/// system does not say.
+fn free_bytes(folder: &Path) -> Option<u64> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let name = std::ffi::CString::new(folder.as_os_str().as_bytes()).ok()?;
+        let mut stats = std::mem::MaybeUninit::<libc::statvfs>::uninit();
+        // SAFETY: `name` is a NUL-terminated path and `stats` is written by a successful call.
+        if unsafe { libc::statvfs(name.as_ptr(), stats.as_mut_ptr()) } != 0 {
+            return None;
+        }
+        let stats = unsafe { stats.assume_init() };
+        #[allow(
+            clippy::unnecessary_cast,
+            reason = "the fields are narrower than u64 on some systems"
+        )]
+        Some((stats.f_bavail as u64).saturating_mul(stats.f_frsize as u64))
     }
-    let list_path = temp.path().join(TRIAL_LIST);
-    std::fs::write(&list_path, list.into_inner().expect("a Vec never fails"))
-        .map_err(io(&list_path))?;
-    written.push(dir.join(TRIAL_LIST));
-    // rename(2) replaces an empty folder; a folder that gained files since is refused by it.
-    std::fs::rename(temp.path(), dir).map_err(|error| folder_error(error.to_string()))?;
-    // Renamed: nothing left for the guard to remove.
-    let _ = temp.keep();
-    Ok(written)
+    #[cfg(not(unix))]
+    {
+        let _ = folder;
+        None
+    }
 }
 
 /// A stimulus name as a file name: what is not a letter, digit, `-`, `_`, `=` or `.` becomes
-/// `_`.
+/// `_`, cut to 64 characters (a name is at most 255 bytes, and the spec's names may be longer).
 fn file_safe(name: &str) -> String {
+    const MAX_CHARS: usize = 64;
     name.chars()
+        .take(MAX_CHARS)
         .map(|c| {
             if c.is_ascii_alphanumeric() || "-_=.".contains(c) {
                 c

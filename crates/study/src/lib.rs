@@ -28,11 +28,11 @@ pub use alsa_out::{AlsaOutput, AlsaPlayer};
 pub use dry_run::{write_dry_run, TRIAL_LIST};
 #[cfg(feature = "audio")]
 pub use jack_out::{JackOutput, JackPlayer};
-pub use log::{header as log_header, Expected, LogRow, TrialLog};
+pub use log::{header as log_header, LogRow, TrialLog};
 pub use session::{Presented, Presenter, Silent, StudySession};
 pub use spec::{
-    level_keys, Channels, Design, Equalize, Spec, Stimulus, MAX_NOISE_DBFS, MIN_NOISE_DBFS,
-    STANDARD,
+    level_keys, Channels, Design, Equalize, Spec, Stimulus, MAX_NOISE_DBFS, MAX_TRIALS,
+    MIN_NOISE_DBFS, STANDARD,
 };
 pub use stimuli::{level_of, render_stimuli, Rendered};
 pub use trials::{order_seed, plan_trials, Trial};
@@ -44,7 +44,7 @@ pub enum StudyError {
     #[error(transparent)]
     Read(#[from] sake_glug_io::ReadError),
     /// A file could not be read or written.
-    #[error("{}: {source}", .path.display())]
+    #[error("{}: {source}", shown(.path))]
     Io {
         /// The file.
         path: PathBuf,
@@ -52,7 +52,7 @@ pub enum StudyError {
         source: std::io::Error,
     },
     /// The spec is not valid: the message names the key.
-    #[error("{}: {message}", .path.display())]
+    #[error("{}: {message}", shown(.path))]
     Spec {
         /// The spec file.
         path: PathBuf,
@@ -60,7 +60,7 @@ pub enum StudyError {
         message: String,
     },
     /// A stimulus could not be made into a scene or rendered.
-    #[error("{}: stimulus `{name}`: {message}", .path.display())]
+    #[error("{}: stimulus `{name}`: {message}", shown(.path))]
     Stimulus {
         /// The spec file.
         path: PathBuf,
@@ -72,14 +72,21 @@ pub enum StudyError {
     /// A new session's log already exists.
     #[error(
         "{} already exists: pass --resume to continue its session, or name a new log",
-        .0.display()
+        shown(.0)
     )]
     LogExists(PathBuf),
+    /// Another session holds the log's lock.
+    #[error(
+        "{}: another session is writing to this log (it is locked); wait for it to end, or \
+         name another log",
+        shown(.0)
+    )]
+    LogInUse(PathBuf),
     /// `--resume` with no log.
-    #[error("{}: no such log, so nothing to resume; leave out --resume to start", .0.display())]
+    #[error("{}: no such log, so nothing to resume; leave out --resume to start", shown(.0))]
     NothingToResume(PathBuf),
     /// A log that cannot be resumed.
-    #[error("{}, line {line}: {message}", .path.display())]
+    #[error("{}, line {line}: {message}", shown(.path))]
     Log {
         /// The log.
         path: PathBuf,
@@ -100,14 +107,22 @@ pub enum StudyError {
         total: usize,
     },
     /// The dry run's folder.
-    #[error("--dry-run {}: {message}", .path.display())]
+    #[error("--dry-run {}: {message}", shown(.path))]
     DryRunFolder {
         /// The folder.
         path: PathBuf,
         /// What was wrong.
         message: String,
     },
+    /// The stimuli cannot be held in memory.
+    #[error("{0}")]
+    Memory(String),
     /// The audio interface.
     #[error("{0}")]
     Audio(String),
+}
+
+/// A path as a message shows it: control characters escaped.
+fn shown(path: &std::path::Path) -> String {
+    sake_glug_io::text::printable(&path.to_string_lossy()).into_owned()
 }

@@ -3,7 +3,7 @@
 use std::io::{BufRead, Write};
 use std::time::Instant;
 
-use super::log::{Expected, LogRow, TrialLog};
+use super::log::{LogRow, TrialLog};
 use super::spec::{Design, Spec};
 use super::stimuli::Rendered;
 use super::trials::Trial;
@@ -56,28 +56,42 @@ pub struct StudySession<'a> {
 }
 
 impl StudySession<'_> {
-    /// What a resumed log must agree with.
-    pub fn expected(&self) -> Expected {
-        Expected {
+    /// The row of trial `index` (0-based) as the plan fixes it once key `pressed` (1 or 2) is
+    /// answered: everything but the response time and the onset frames, which the run fills in
+    /// (and [`TrialLog::resume`] checks a logged row against).
+    pub fn planned_row(&self, index: usize, trial: Trial, pressed: u8) -> LogRow {
+        let (first, second) = (
+            &self.spec.stimuli[trial.first],
+            &self.spec.stimuli[trial.second],
+        );
+        let chosen = if pressed == 1 {
+            trial.first
+        } else {
+            trial.second
+        };
+        let (level, chose_comparison) = match self.spec.design {
+            Design::Paired => (None, None),
+            // The standard is stimulus 0; the comparison is the other one.
+            Design::Constant => (first.level.or(second.level), Some(u8::from(chosen != 0))),
+        };
+        LogRow {
             participant: self.participant.to_owned(),
-            design: self.spec.design.name(),
+            trial: index + 1,
+            design: self.spec.design.name().to_owned(),
+            first: first.name.clone(),
+            second: second.name.clone(),
+            answer: self.spec.stimuli[chosen].name.clone(),
+            pressed,
+            rt_s: 0.0,
             seed: self.seed,
-            trials: self
-                .trials
-                .iter()
-                .map(|trial| {
-                    let (first, second) = (
-                        &self.spec.stimuli[trial.first],
-                        &self.spec.stimuli[trial.second],
-                    );
-                    [
-                        first.name.clone(),
-                        second.name.clone(),
-                        first.params.clone(),
-                        second.params.clone(),
-                    ]
-                })
-                .collect(),
+            level,
+            chose_comparison,
+            first_gain_db: self.rendered[trial.first].gain_db,
+            second_gain_db: self.rendered[trial.second].gain_db,
+            first_onset_frame: None,
+            second_onset_frame: None,
+            first_params: first.params.clone(),
+            second_params: second.params.clone(),
         }
     }
 
@@ -132,39 +146,11 @@ impl StudySession<'_> {
                     _ => say(prompt, format_args!("Please answer 1 or 2: ")),
                 }
             };
-            let rt_s = presented.ended.elapsed().as_secs_f64();
-            let (first, second) = (
-                &self.spec.stimuli[trial.first],
-                &self.spec.stimuli[trial.second],
-            );
-            let chosen = if pressed == 1 {
-                trial.first
-            } else {
-                trial.second
-            };
-            let (level, chose_comparison) = match self.spec.design {
-                Design::Paired => (None, None),
-                // The standard is stimulus 0; the comparison is the other one.
-                Design::Constant => (first.level.or(second.level), Some(u8::from(chosen != 0))),
-            };
             log.append(&LogRow {
-                participant: self.participant.to_owned(),
-                trial: index + 1,
-                design: self.spec.design.name().to_owned(),
-                first: first.name.clone(),
-                second: second.name.clone(),
-                answer: self.spec.stimuli[chosen].name.clone(),
-                pressed,
-                rt_s,
-                seed: self.seed,
-                level,
-                chose_comparison,
-                first_gain_db: self.rendered[trial.first].gain_db,
-                second_gain_db: self.rendered[trial.second].gain_db,
+                rt_s: presented.ended.elapsed().as_secs_f64(),
                 first_onset_frame: presented.onset_frames.map(|(first, _)| first),
                 second_onset_frame: presented.onset_frames.map(|(_, second)| second),
-                first_params: first.params.clone(),
-                second_params: second.params.clone(),
+                ..self.planned_row(index, trial, pressed)
             })?;
         }
         say(prompt, format_args!("Done: {total} trials. Thank you.\n"));

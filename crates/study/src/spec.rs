@@ -8,8 +8,9 @@ use serde::Deserialize;
 
 use super::StudyError;
 use sake_glug_engine::{Constant, Control, Preset};
+use sake_glug_io::keys::{self, KeyedTable};
 use sake_glug_io::read::{self, InputKind};
-use sake_glug_io::text::printable;
+use sake_glug_io::text::{cut_quotes, quoted};
 use sake_glug_render::{Scene, DEFAULT_SCENE, MAX_DURATION_S};
 
 /// The two designs of the paper's studies.
@@ -57,14 +58,11 @@ impl Equalize {
 }
 
 /// Which of the player's output channels (from 1) carry what.
-#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Channels {
-    /// The stimuli (the actuator's amplifier).
-    #[serde(default = "Channels::default_actuator")]
+    /// The stimuli (the actuator's amplifier): channel 1 unless the spec names others.
     pub actuator: Vec<u16>,
-    /// The masking noise (the headphones).
-    #[serde(default)]
+    /// The masking noise (the headphones): none unless the spec names them.
     pub headphones: Vec<u16>,
 }
 
@@ -173,30 +171,6 @@ pub const STANDARD: &str = "standard";
 /// The default question.
 const QUESTION: &str = "Which one?";
 
-/// The spec's top level, as written.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SpecFile {
-    design: Design,
-    question: Option<String>,
-    duration_s: f64,
-    gap_s: f64,
-    repetitions: u32,
-    #[serde(default)]
-    seed: u64,
-    #[serde(default)]
-    equalize: Equalize,
-    noise_dbfs: Option<f64>,
-    #[serde(default)]
-    channels: Option<Channels>,
-    /// Paired: every stimulus by name.
-    stimuli: Option<toml::Table>,
-    /// Constant: what the standard and the comparisons share.
-    stimulus: Option<toml::Table>,
-    standard: Option<toml::Table>,
-    comparisons: Option<toml::Table>,
-}
-
 /// The keys of a stimulus that name what its scene starts from (the rest are scene keys).
 const PRESET: &str = "preset";
 const SCENE: &str = "scene";
@@ -216,24 +190,48 @@ impl Spec {
             path: path.to_owned(),
             message,
         };
-        let file: SpecFile = toml::from_str(text)
-            .map_err(|error| bad(printable(error.to_string().trim_end()).into_owned()))?;
-        if !(file.duration_s > 0.0 && file.duration_s <= MAX_DURATION_S) {
+        let table: toml::Table =
+            toml::from_str(text).map_err(|error| bad(toml_message(&error, text)))?;
+        let mut file = KeyedTable::new(table);
+        let mut take = |key: &str| -> Result<Option<toml::Value>, StudyError> {
+            file.take(key).map_err(|message| bad(cut_quotes(&message)))
+        };
+        let design: Design = required(take("design")?, "design").map_err(bad)?;
+        let question: Option<String> = optional(take("question")?, "question").map_err(bad)?;
+        let duration_s: f64 = required(take("duration_s")?, "duration_s").map_err(bad)?;
+        let gap_s: f64 = required(take("gap_s")?, "gap_s").map_err(bad)?;
+        let repetitions: u32 = required(take("repetitions")?, "repetitions").map_err(bad)?;
+        let seed: u64 = optional(take("seed")?, "seed").map_err(bad)?.unwrap_or(0);
+        let equalize: Equalize = optional(take("equalize")?, "equalize")
+            .map_err(bad)?
+            .unwrap_or_default();
+        let noise_dbfs: Option<f64> = optional(take("noise_dbfs")?, "noise_dbfs").map_err(bad)?;
+        let actuator = optional(take(CHANNELS_ACTUATOR)?, CHANNELS_ACTUATOR).map_err(bad)?;
+        let headphones = optional(take(CHANNELS_HEADPHONES)?, CHANNELS_HEADPHONES).map_err(bad)?;
+        let mut section = |key: &str| -> Result<Option<toml::Table>, StudyError> {
+            optional(take(key)?, key).map_err(bad)
+        };
+        let named_stimuli = section("stimuli")?;
+        let shared = section("stimulus")?;
+        let standard = section("standard")?;
+        let comparisons = section("comparisons")?;
+        file.refuse_unknown()
+            .map_err(|message| bad(cut_quotes(&message)))?;
+
+        if !(duration_s > 0.0 && duration_s <= MAX_DURATION_S) {
             return Err(bad(format!(
-                "`duration_s` = {}: it must lie above 0 and at most {MAX_DURATION_S} s",
-                file.duration_s
+                "`duration_s` = {duration_s}: it must lie above 0 and at most {MAX_DURATION_S} s"
             )));
         }
-        if !(file.gap_s >= 0.0 && file.gap_s <= MAX_DURATION_S) {
+        if !(0.0..=MAX_DURATION_S).contains(&gap_s) {
             return Err(bad(format!(
-                "`gap_s` = {}: it must lie from 0 to {MAX_DURATION_S} s",
-                file.gap_s
+                "`gap_s` = {gap_s}: it must lie from 0 to {MAX_DURATION_S} s"
             )));
         }
-        if file.repetitions == 0 {
+        if repetitions == 0 {
             return Err(bad("`repetitions` = 0: it must be at least 1".into()));
         }
-        if let Some(level) = file.noise_dbfs {
+        if let Some(level) = noise_dbfs {
             if !(MIN_NOISE_DBFS..=MAX_NOISE_DBFS).contains(&level) {
                 return Err(bad(format!(
                     "`noise_dbfs` = {level} is out of range: allowed {MIN_NOISE_DBFS} to \
@@ -241,66 +239,74 @@ impl Spec {
                 )));
             }
         }
-        let channels = file.channels.unwrap_or_default();
-        channels.check(file.noise_dbfs).map_err(bad)?;
+        let channels = Channels {
+            actuator: actuator.unwrap_or_else(Channels::default_actuator),
+            headphones: headphones.unwrap_or_default(),
+        };
+        channels.check(noise_dbfs).map_err(bad)?;
         let folder = path.parent().unwrap_or(Path::new(""));
         let stimulus = |name: String, table: toml::Table, level: Option<f64>| {
-            build_stimulus(path, folder, name, table, level, file.duration_s)
+            build_stimulus(path, folder, name, table, level, duration_s)
         };
         let misplaced = |key: &str| {
             bad(format!(
                 "`{key}` does not belong to the {} design",
-                file.design.name()
+                design.name()
             ))
         };
-        let stimuli = match file.design {
+        let stimuli = match design {
             Design::Paired => {
                 for (key, value) in [
-                    ("stimulus", file.stimulus.is_some()),
-                    ("standard", file.standard.is_some()),
-                    ("comparisons", file.comparisons.is_some()),
+                    ("stimulus", shared.is_some()),
+                    ("standard", standard.is_some()),
+                    ("comparisons", comparisons.is_some()),
                 ] {
                     if value {
                         return Err(misplaced(key));
                     }
                 }
-                let named = file.stimuli.unwrap_or_default();
+                let named = named_stimuli.unwrap_or_default();
                 if named.len() < 2 {
                     return Err(bad(format!(
                         "`stimuli` names {} stimulus(es): a paired comparison needs at least 2",
                         named.len()
                     )));
                 }
+                check_trials(design, named.len(), repetitions).map_err(bad)?;
                 named
                     .into_iter()
                     .map(|(name, value)| match value {
                         toml::Value::Table(table) => stimulus(name, table, None),
                         other => Err(bad(format!(
-                            "`stimuli.{name}`: invalid type: {}, expected a table",
+                            "`{}`: invalid type: {}, expected a table",
+                            quoted(&keys::join("stimuli", &name)),
                             other.type_str()
                         ))),
                     })
                     .collect::<Result<Vec<_>, _>>()?
             }
             Design::Constant => {
-                if file.stimuli.is_some() {
+                if named_stimuli.is_some() {
                     return Err(misplaced("stimuli"));
                 }
-                let base = file.stimulus.unwrap_or_default();
-                let (key, comparisons) = one_level(file.comparisons, "comparisons").map_err(bad)?;
-                let (standard_key, standard) = one_level(file.standard, "standard").map_err(bad)?;
+                let base = shared.unwrap_or_default();
+                let (key, comparisons) = one_level(comparisons, "comparisons").map_err(bad)?;
+                let (standard_key, standard) = one_level(standard, "standard").map_err(bad)?;
                 if standard_key != key {
                     return Err(bad(format!(
-                        "`standard.{standard_key}`: the standard must set the compared key \
-                         `{key}`"
+                        "`{}`: the standard must set the compared key `{key}`",
+                        keys::join("standard", &standard_key)
                     )));
                 }
-                let standard = number(&standard)
-                    .ok_or_else(|| bad(format!("`standard.{key}`: expected a number")))?;
+                let standard = number(&standard).ok_or_else(|| {
+                    bad(format!(
+                        "`{}`: expected a number",
+                        keys::join("standard", &key)
+                    ))
+                })?;
+                let listed = keys::join("comparisons", &key);
                 let toml::Value::Array(comparisons) = comparisons else {
-                    return Err(bad(format!(
-                        "`comparisons.{key}`: expected a list of numbers"
-                    )));
+                    return Err(bad(format!("`{listed}`: expected a list of numbers")));
                 };
                 let levels = comparisons
                     .iter()
@@ -308,20 +314,19 @@ impl Spec {
                     .collect::<Option<Vec<f64>>>()
                     .filter(|levels| !levels.is_empty())
                     .ok_or_else(|| {
-                        bad(format!(
-                            "`comparisons.{key}`: expected a non-empty list of numbers"
-                        ))
+                        bad(format!("`{listed}`: expected a non-empty list of numbers"))
                     })?;
+                check_trials(design, levels.len() + 1, repetitions).map_err(bad)?;
                 let with_level = |value: f64| {
                     let mut table = base.clone();
-                    set_key(&mut table, &key, toml::Value::Float(value));
+                    keys::insert(&mut table, &key, toml::Value::Float(value));
                     table
                 };
                 let mut stimuli = vec![stimulus(STANDARD.into(), with_level(standard), None)?];
                 for (index, &level) in levels.iter().enumerate() {
                     let name = format!("{key}={level}");
                     if levels[..index].contains(&level) {
-                        return Err(bad(format!("`comparisons.{key}` lists {level} twice")));
+                        return Err(bad(format!("`{listed}` lists {level} twice")));
                     }
                     stimuli.push(stimulus(name, with_level(level), Some(level))?);
                 }
@@ -330,18 +335,89 @@ impl Spec {
         };
         Ok(Spec {
             path: path.to_owned(),
-            design: file.design,
-            question: file.question.unwrap_or_else(|| QUESTION.into()),
-            duration_s: file.duration_s,
-            gap_s: file.gap_s,
-            repetitions: file.repetitions,
-            seed: file.seed,
-            equalize: file.equalize,
-            noise_dbfs: file.noise_dbfs,
+            design,
+            question: question.unwrap_or_else(|| QUESTION.into()),
+            duration_s,
+            gap_s,
+            repetitions,
+            seed,
+            equalize,
+            noise_dbfs,
             channels,
             stimuli,
         })
     }
+}
+
+/// The spec's keys of the channel layout.
+const CHANNELS_ACTUATOR: &str = "channels.actuator";
+const CHANNELS_HEADPHONES: &str = "channels.headphones";
+
+/// The most trials a session may have: a long day of the shortest trials, far more than a study
+/// asks of one participant (the paper's are 18 and 90), and a bound on what a session holds in
+/// memory and what its dry run writes (two files a trial).
+pub const MAX_TRIALS: u64 = 10_000;
+
+/// Trials in a session of `design` with `stimuli` stimuli (the standard included) presented
+/// `repetitions` times: every ordered pair, or every comparison.
+fn trial_count(design: Design, stimuli: usize, repetitions: u32) -> u64 {
+    let stimuli = stimuli as u64;
+    let per_repetition = match design {
+        Design::Paired => stimuli * stimuli.saturating_sub(1),
+        Design::Constant => stimuli.saturating_sub(1),
+    };
+    per_repetition.saturating_mul(u64::from(repetitions))
+}
+
+/// Refuses a session of more than [`MAX_TRIALS`] trials, with the figure.
+fn check_trials(design: Design, stimuli: usize, repetitions: u32) -> Result<(), String> {
+    let trials = trial_count(design, stimuli, repetitions);
+    if trials <= MAX_TRIALS {
+        return Ok(());
+    }
+    let what = match design {
+        Design::Paired => format!("{} ordered pairs", trials / u64::from(repetitions)),
+        Design::Constant => format!("{} comparisons", trials / u64::from(repetitions)),
+    };
+    Err(format!(
+        "{what} × `repetitions` = {repetitions} make {trials} trials a session: at most \
+         {MAX_TRIALS} (split the study into sessions, or repeat less)"
+    ))
+}
+
+/// A key's value converted, or a message naming the key.
+fn optional<T: serde::de::DeserializeOwned>(
+    value: Option<toml::Value>,
+    key: &str,
+) -> Result<Option<T>, String> {
+    value
+        .map(|value| {
+            value.try_into().map_err(|error: toml::de::Error| {
+                format!("`{key}`: {}", cut_quotes(error.message().trim_end()))
+            })
+        })
+        .transpose()
+}
+
+/// A key that must be given.
+fn required<T: serde::de::DeserializeOwned>(
+    value: Option<toml::Value>,
+    key: &str,
+) -> Result<T, String> {
+    optional(value, key)?.ok_or_else(|| format!("missing field `{key}`"))
+}
+
+/// A TOML error as a message: where it is (line and column) and what, its quotes of the file cut
+/// short; never the line itself, which toml's own message shows and which may be any file's.
+fn toml_message(error: &toml::de::Error, text: &str) -> String {
+    let what = cut_quotes(error.message().trim_end());
+    let Some(start) = error.span().map(|span| span.start) else {
+        return what;
+    };
+    let before = text.get(..start).unwrap_or(text);
+    let line = 1 + before.matches('\n').count();
+    let column = 1 + before.rsplit('\n').next().unwrap_or("").chars().count();
+    format!("line {line}, column {column}: {what}")
 }
 
 /// The scene keys a constant design may vary: every control's and every constant's, from their
@@ -360,8 +436,7 @@ pub fn level_keys() -> impl Iterator<Item = &'static str> {
 /// The one key (`section.name` for a constant in a section) of `[standard]` or
 /// `[comparisons]`, and its value.
 fn one_level(table: Option<toml::Table>, place: &str) -> Result<(String, toml::Value), String> {
-    let mut leaves = Vec::new();
-    flatten("", table.unwrap_or_default(), &mut leaves);
+    let leaves = keys::flatten(&table.unwrap_or_default());
     let known = || {
         let keys: Vec<String> = level_keys().map(|key| format!("`{key}`")).collect();
         keys.join(", ")
@@ -372,7 +447,8 @@ fn one_level(table: Option<toml::Table>, place: &str) -> Result<(String, toml::V
                 Ok((key, value))
             } else {
                 Err(format!(
-                    "`{place}.{key}`: not a control or constant; expected one of {}",
+                    "`{}`: not a control or constant; expected one of {}",
+                    quoted(&keys::join(place, &key)),
                     known()
                 ))
             }
@@ -382,39 +458,6 @@ fn one_level(table: Option<toml::Table>, place: &str) -> Result<(String, toml::V
             known(),
             leaves.len()
         )),
-    }
-}
-
-/// Every non-table value of `table`, at its dotted key.
-fn flatten(prefix: &str, table: toml::Table, leaves: &mut Vec<(String, toml::Value)>) {
-    for (name, value) in table {
-        let key = if prefix.is_empty() {
-            name
-        } else {
-            format!("{prefix}.{name}")
-        };
-        match value {
-            toml::Value::Table(inner) => flatten(&key, inner, leaves),
-            value => leaves.push((key, value)),
-        }
-    }
-}
-
-/// `value` at the dotted `key` of `table`, creating the sections on the way.
-fn set_key(table: &mut toml::Table, key: &str, value: toml::Value) {
-    match key.split_once('.') {
-        None => {
-            table.insert(key.to_owned(), value);
-        }
-        Some((section, rest)) => {
-            let inner = table
-                .entry(section)
-                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-            if !inner.is_table() {
-                *inner = toml::Value::Table(toml::Table::new());
-            }
-            set_key(inner.as_table_mut().expect("made a table"), rest, value);
-        }
     }
 }
 
@@ -448,7 +491,7 @@ fn build_stimulus(
 ) -> Result<Stimulus, StudyError> {
     let bad = |message: String| StudyError::Stimulus {
         path: spec.to_owned(),
-        name: printable(&name).into_owned(),
+        name: quoted(&name),
         message,
     };
     let params = toml::Value::Table(table.clone()).to_string();
@@ -467,7 +510,7 @@ fn build_stimulus(
             let preset = Preset::find(&value).ok_or_else(|| {
                 bad(format!(
                     "`{PRESET}` = \"{}\": no such preset; the presets are {}",
-                    printable(&value),
+                    quoted(&value),
                     Preset::ids()
                 ))
             })?;
@@ -483,14 +526,14 @@ fn build_stimulus(
             let text = read::text_within(&path, kind.max_bytes).map_err(|failure| {
                 bad(format!(
                     "`{key}` = \"{}\": cannot read it: {failure}",
-                    printable(&file)
+                    quoted(&file)
                 ))
             })?;
             let table: toml::Table = toml::from_str(&text).map_err(|error| {
                 bad(format!(
-                    "`{key}` = \"{}\": {}",
-                    printable(&file),
-                    printable(error.to_string().trim_end())
+                    "`{key}` = \"{}\": not TOML: {}",
+                    quoted(&file),
+                    toml_message(&error, &text)
                 ))
             })?;
             let scene_folder = path.parent().unwrap_or(Path::new("")).to_owned();
@@ -514,7 +557,7 @@ fn build_stimulus(
         &toml::to_string(&base).expect("a table read from TOML is valid TOML"),
         &scene_folder,
     )
-    .map_err(|error| bad(error.to_string()))?;
+    .map_err(|error| bad(cut_quotes(&error.to_string())))?;
     Ok(Stimulus {
         name,
         params,

@@ -2,7 +2,8 @@
 
 use super::spec::{Equalize, Spec};
 use super::StudyError;
-use sake_glug_render::render_scene_to_vec;
+use sake_glug_io::text::{printable, quoted};
+use sake_glug_render::{available_bytes, human_bytes, render_scene, RenderError};
 
 /// One stimulus as presented: its samples with its equalisation gain applied.
 #[derive(Debug, Clone)]
@@ -28,25 +29,40 @@ pub fn level_of(equalize: Equalize, samples: &[f32]) -> f64 {
     }
 }
 
+/// Bytes of a stimulus's sample as it is held (f32).
+const SAMPLE_BYTES: u64 = std::mem::size_of::<f32>() as u64;
+
 /// Renders every stimulus of `spec` at `sample_rate` and matches their levels: each is scaled
 /// down to the quietest one's level, so no gain is above 0 dB and nothing can clip.
+///
+/// Every stimulus is held in memory for the session (the audio interface plays from it); their
+/// memory is known from the spec, so a set that cannot fit (a day-long `duration_s`) is refused
+/// with the figure before anything is rendered, against the memory the system has available and
+/// against what this process may allocate.
 pub fn render_stimuli(spec: &Spec, sample_rate: u32) -> Result<Vec<Rendered>, StudyError> {
+    let mut buffers = reserve_stimuli(spec, sample_rate)?;
     let mut rendered = Vec::with_capacity(spec.stimuli.len());
     for stimulus in &spec.stimuli {
+        let fail = |message: String| StudyError::Stimulus {
+            path: spec.path.clone(),
+            name: quoted(&stimulus.name),
+            message,
+        };
         let scene = stimulus
             .scene
             .clone()
             .with_sample_rate(sample_rate as f64)
-            .map_err(|error| StudyError::Stimulus {
-                path: spec.path.clone(),
-                name: stimulus.name.clone(),
-                message: error.to_string(),
-            })?;
-        let (samples, _) = render_scene_to_vec(&scene).map_err(|error| StudyError::Stimulus {
-            path: spec.path.clone(),
-            name: stimulus.name.clone(),
-            message: error.to_string(),
-        })?;
+            .map_err(|error| fail(error.to_string()))?;
+        let mut samples = buffers.pop().expect("one buffer a stimulus");
+        render_scene(
+            &scene,
+            |block| {
+                samples.extend_from_slice(block);
+                Ok::<(), RenderError>(())
+            },
+            &mut |_: u64| {},
+        )
+        .map_err(|error| fail(error.to_string()))?;
         rendered.push(Rendered {
             level: level_of(spec.equalize, &samples),
             samples,
@@ -59,7 +75,7 @@ pub fn render_stimuli(spec: &Spec, sample_rate: u32) -> Result<Vec<Rendered>, St
     if let Some(silent) = rendered.iter().position(|stimulus| stimulus.level == 0.0) {
         return Err(StudyError::Stimulus {
             path: spec.path.clone(),
-            name: spec.stimuli[silent].name.clone(),
+            name: quoted(&spec.stimuli[silent].name),
             message: format!(
                 "it is silent, so `equalize = \"{}\"` cannot match it to the others",
                 spec.equalize.name()
@@ -78,4 +94,41 @@ pub fn render_stimuli(spec: &Spec, sample_rate: u32) -> Result<Vec<Rendered>, St
         }
     }
     Ok(rendered)
+}
+
+/// An empty buffer for each stimulus of `spec` with room for all its samples, taken before any is
+/// rendered; or the refusal, with what they need.
+fn reserve_stimuli(spec: &Spec, sample_rate: u32) -> Result<Vec<Vec<f32>>, StudyError> {
+    // Every stimulus lasts the spec's duration (the scenes are the spec's with its duration_s).
+    let samples = (spec.duration_s * f64::from(sample_rate)).round() as u64;
+    let count = spec.stimuli.len() as u64;
+    let needed = samples.saturating_mul(SAMPLE_BYTES).saturating_mul(count);
+    let refuse = |why: String| {
+        StudyError::Memory(format!(
+            "{}: the {count} stimuli of {} s at {sample_rate} Hz are held in memory for the \
+             session, {} ({} each); {why}. Shorten `duration_s`, or use fewer stimuli",
+            printable(&spec.path.to_string_lossy()),
+            spec.duration_s,
+            human_bytes(needed),
+            human_bytes(samples.saturating_mul(SAMPLE_BYTES)),
+        ))
+    };
+    if let Some(available) = available_bytes().filter(|&available| needed > available) {
+        return Err(refuse(format!(
+            "more than the {} available",
+            human_bytes(available)
+        )));
+    }
+    let mut buffers = Vec::with_capacity(spec.stimuli.len());
+    for _ in 0..count {
+        let mut buffer = Vec::new();
+        usize::try_from(samples)
+            .ok()
+            .and_then(|samples| buffer.try_reserve_exact(samples).ok())
+            .ok_or_else(|| {
+                refuse("more than this process may allocate (its memory limit)".into())
+            })?;
+        buffers.push(buffer);
+    }
+    Ok(buffers)
 }

@@ -1,9 +1,15 @@
 //! `sake-glug experiment` and the study layer: specs and their errors, the trial order, level
-//! matching, the dry run's folder, the log kept through a killed session and `--resume`.
+//! matching, the dry run's folder, the log kept through a killed session and `--resume`; and
+//! the study under attack (#31): the log protected (`log.rs`), the dry run bounded and open to
+//! every user (`dry_run.rs`), hostile specs (`hostile_specs.rs`).
+
+mod dry_run;
+mod hostile_specs;
+mod log;
 
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use sake_glug_study::{
@@ -267,6 +273,52 @@ fn equalized_stimuli_have_equal_levels() {
             );
         }
     }
+}
+
+/// Runs `sake-glug experiment ARGS` in `dir` to its end with `input` on its stdin; a run that
+/// has not ended after a minute (it waits on something: a FIFO, a lock) is killed and fails.
+fn run(dir: &Path, args: &[&str], input: &str) -> Output {
+    let mut child = start(dir, args);
+    let mut stdin = child.stdin.take().unwrap();
+    // A run that ends early (refused) closes its stdin: what it did not read does not matter.
+    let _ = stdin.write_all(input.as_bytes());
+    drop(stdin);
+    finish(child)
+}
+
+/// `child`'s output once it has ended, or a failure if it is still running after a minute.
+fn finish(mut child: Child) -> Output {
+    let started = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if started.elapsed() > Duration::from_secs(60) {
+            child.kill().unwrap();
+            panic!("still running after a minute: it waits for something");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// The answers of a whole session of `trials` trials: Enter, then `1` each time.
+fn answers(trials: usize) -> String {
+    format!("\n{}", "1\n".repeat(trials))
+}
+
+/// Asserts that `output` is a refusal (exit status 2) whose message holds each of `parts`;
+/// returns the message.
+fn refused(output: &Output, parts: &[&str]) -> String {
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert_eq!(
+        output.status.code(),
+        Some(2),
+        "{:?}: {stderr}",
+        output.status
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for part in parts {
+        assert!(stderr.contains(part), "no `{part}` in: {stderr}");
+    }
+    stderr
 }
 
 /// Runs `sake-glug experiment ARGS` in `dir` with its stdin piped.
