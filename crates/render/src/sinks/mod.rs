@@ -19,7 +19,6 @@ mod csv;
 mod dualsense;
 mod haps;
 mod haptic;
-#[cfg(feature = "plot")]
 mod plot;
 mod rumble;
 mod state;
@@ -36,7 +35,6 @@ use super::tables::{StateRate, StateRateError};
 #[cfg(feature = "ogg")]
 use android_ogg::open as open_ogg;
 use clip::ClipSink;
-#[cfg(feature = "plot")]
 use plot::open as open_plot;
 use sake_glug_engine::{UnitOnset, Voicing};
 pub(crate) use sake_glug_io::{remove_own_temps, remove_stale_temps, PendingFile};
@@ -50,8 +48,10 @@ pub use dualsense::{AudioChannels, DUALSENSE_CHANNELS, DUALSENSE_RATE_HZ};
 pub use haps::{haps_json, HAPS_VERSION};
 pub use haptic::haptic_json;
 #[cfg(feature = "plot")]
-pub use plot::{draw_pour_plot, PlotData, PlotError, Waveform};
+pub use plot::{draw_pour_plot, PlotData, Waveform};
 pub use rumble::rumble_json;
+#[cfg(feature = "plot")]
+pub use sake_glug_plot::PlotError;
 pub use wav::{SampleFormat, WavError};
 
 /// One file of a render, written from the render's single pass. Every method but
@@ -312,14 +312,6 @@ fn one_of(items: impl Iterator<Item = String>) -> String {
         Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
         None => String::new(),
     }
-}
-
-/// Without the `plot` feature a plot is refused by name, not taken for an unknown format.
-#[cfg(not(feature = "plot"))]
-fn open_plot<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    Err(OutputError::NoPlot {
-        path: context.path.to_owned(),
-    })
 }
 
 /// Without the `ogg` feature an `.ogg` is refused by name, not taken for an unknown format.
