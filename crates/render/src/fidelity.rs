@@ -48,15 +48,14 @@ pub struct Fidelity {
     pub limits: String,
 }
 
-/// The formats measured for `scene`: every one but the plot and the tables (not played),
-/// those this build cannot write, and the DualSense's unless the scene is at its rate.
-fn measured_formats(scene: &Scene) -> impl Iterator<Item = OutputFormat> + '_ {
+/// The formats measured: every one but the plot and the tables (not played), and those this
+/// build cannot write.
+fn measured_formats() -> impl Iterator<Item = OutputFormat> {
     OutputFormat::ALL.iter().copied().filter(|&format| {
         // The plot and the tables (MODEL.md §14) are read by people and programs, not played:
         // the tables hold the model's own numbers.
         ![OutputFormat::PLOT, OutputFormat::UNITS, OutputFormat::STATE].contains(&format)
             && (cfg!(feature = "ogg") || format != OutputFormat::ANDROID_OGG)
-            && (scene.sample_rate == DUALSENSE_RATE_HZ || format != OutputFormat::DUALSENSE)
     })
 }
 
@@ -67,7 +66,7 @@ pub fn measure(
     options: &OutputOptions,
 ) -> Result<Vec<Fidelity>, OutputError> {
     let folder = tempfile::tempdir().map_err(OutputError::io(Path::new("a temporary folder")))?;
-    let outputs: Vec<Output> = measured_formats(scene)
+    let outputs: Vec<Output> = measured_formats()
         .map(|format| Output {
             format,
             path: folder.path().join(format.file_name("measured")),
@@ -95,29 +94,15 @@ pub fn measure(
         scene_name,
         seed: scene.config.seed,
     };
-    let mut rows = outputs
+    outputs
         .iter()
         .zip(&report.files)
         .map(|(output, (_, bytes))| {
             let text =
                 || std::fs::read_to_string(&output.path).map_err(OutputError::io(&output.path));
-            measure_one(output.format, &source, &report.summary, *bytes, text)
+            measure_one(output.format, scene, &source, &report.summary, *bytes, text)
         })
-        .collect::<Result<Vec<_>, _>>()?;
-    if scene.sample_rate != DUALSENSE_RATE_HZ {
-        rows.push(Fidelity {
-            format: OutputFormat::DUALSENSE,
-            onset_error_ms: None,
-            envelope_error_db: None,
-            carries_c: "—",
-            bytes: 0,
-            limits: format!(
-                "not written: it plays {DUALSENSE_RATE_HZ} Hz only, the scene renders at {} Hz",
-                scene.sample_rate
-            ),
-        });
-    }
-    Ok(rows)
+        .collect()
 }
 
 /// What a format's file says of the render, read back: its onsets and its envelope.
@@ -134,6 +119,7 @@ struct Reading {
 
 fn measure_one(
     format: OutputFormat,
+    scene: &Scene,
     source: &ClipSource,
     summary: &RenderSummary,
     bytes: u64,
@@ -182,7 +168,14 @@ fn measure_one(
     };
     let Some(reading) = reading else {
         let limits = match format.name() {
-            "dualsense" => "48 kHz only (other rates are refused)".to_owned(),
+            "dualsense" if scene.sample_rate == DUALSENSE_RATE_HZ => {
+                "48 kHz, the scene's own rate (another is resampled: rubato's FFT resampler)"
+                    .to_owned()
+            }
+            "dualsense" => format!(
+                "48 kHz, resampled from the scene's {} Hz (rubato's FFT resampler)",
+                scene.sample_rate
+            ),
             _ => "—".to_owned(),
         };
         return Ok(Fidelity {

@@ -135,7 +135,8 @@ impl OutputFormat {
     pub const RUMBLE: Self = Self::named("rumble", "json", rumble::open);
     /// `.haps`: an Interhaptics / Razer Haptic Composer file (version 5).
     pub const HAPS: Self = Self::new("haps", "haps", haps::open);
-    /// `dualsense` (`.wav`): 4 channels at 48 kHz, the DualSense's audio and actuators.
+    /// `dualsense` (`.wav`): 4 channels at 48 kHz (another rate resampled), the DualSense's audio
+    /// and actuators.
     pub const DUALSENSE: Self = Self::named("dualsense", "wav", dualsense::open);
     /// `.ogg`: Android's haptic-coupled Ogg Vorbis (feature `ogg`; a build without it refuses
     /// one by name).
@@ -408,22 +409,6 @@ pub enum OutputError {
     /// A `state` table's rate does not fit the render.
     #[error(transparent)]
     StateRate(#[from] StateRateError),
-    /// A format plays at one sample rate only, and the scene renders at another.
-    #[error(
-        "{}: a {format} file plays at {needed_hz} Hz, and the scene renders at {scene_hz} Hz; \
-         render it at {needed_hz} Hz (--sample-rate {needed_hz}, or sample_rate in the scene)",
-        path.display()
-    )]
-    WrongRate {
-        /// The file asked for.
-        path: PathBuf,
-        /// The format's name.
-        format: &'static str,
-        /// The rate it plays at (Hz).
-        needed_hz: u32,
-        /// The scene's rate (Hz).
-        scene_hz: u32,
-    },
     /// The Ogg Vorbis encoder refused, or this build has none.
     #[error("cannot write {}: {message}", path.display())]
     Ogg {
