@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use sake_glug_render::sinks::DUALSENSE_RATE_HZ;
 use sake_glug_render::steps::ANDROID_STEP_MS;
-use sake_glug_render::{render_to_files, Output, OutputFormat, OutputOptions, Scene};
+use sake_glug_render::{render_to_files, Output, OutputError, OutputFormat, OutputOptions, Scene};
 
 use super::{android_ogg, android_waveform, android_xml, dualsense, haps, rumble};
 use crate::clips_rendered::{engine_units, onset_s, SCENE};
@@ -297,7 +297,7 @@ fn the_fidelity_report_says_a_dualsense_file_is_resampled() {
 }
 
 /// A rumble rate outside its range is refused before anything is written, naming what was
-/// wrong.
+/// wrong: by the command line, and by the format.
 #[test]
 fn a_rumble_rate_out_of_range_is_refused_up_front() {
     let directory = tempfile::tempdir().unwrap();
@@ -307,6 +307,21 @@ fn a_rumble_rate_out_of_range_is_refused_up_front() {
     );
     assert_eq!(output.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&output.stderr).contains("--rumble-rate"));
+    // The format refuses it itself, for a program that calls the renderer.
+    let path = directory.path().join("pour.json");
+    let output = Output {
+        format: OutputFormat::RUMBLE,
+        path: path.clone(),
+    };
+    let mut options = OutputOptions::default();
+    options.platforms.rumble_rate_hz = 0.0;
+    let scene = Scene::parse("duration_s = 1.0\ntilt_deg = 140.0\n").unwrap();
+    let error = render_to_files(&scene, "pour", &[output], &options, |_| {}).unwrap_err();
+    assert!(
+        matches!(error, OutputError::RumbleRate { .. })
+            && error.to_string().contains("1 to 1000 Hz"),
+        "{error}"
+    );
     assert!(files_in(directory.path()).is_empty());
 }
 

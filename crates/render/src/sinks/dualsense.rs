@@ -10,12 +10,38 @@ use std::path::Path;
 
 use hound::{SampleFormat, WavSpec, WavWriter};
 
-use super::{OutputError, PendingFile, Sink, SinkContext};
+use super::{OutputError, OutputFormat, PendingFile, Sink, SinkContext};
+use crate::fidelity::ReadBack;
 use crate::resample::Resample;
-use crate::RenderSummary;
+use crate::{RenderSummary, Scene};
+
+/// `dualsense` (`.wav`): 4 channels at 48 kHz (another rate resampled), the DualSense's audio
+/// and actuators.
+pub(super) const FORMAT: OutputFormat = OutputFormat {
+    name: "dualsense",
+    extension: "wav",
+    by_extension: false,
+    built: true,
+    open,
+    read_back: Some(ReadBack::Waveform { limits }),
+    carries_c: "the waveform on both actuators (c·a at f1, (1 − c)·a at f2), 16-bit",
+};
 
 /// The rate the controller's USB audio interface runs at.
 pub const DUALSENSE_RATE_HZ: u32 = 48_000;
+
+/// What the controller took of a scene's render: its samples, resampled if the scene is not at
+/// 48 kHz.
+fn limits(scene: &Scene) -> String {
+    if scene.sample_rate == DUALSENSE_RATE_HZ {
+        "48 kHz, the scene's own rate (another is resampled: rubato's FFT resampler)".to_owned()
+    } else {
+        format!(
+            "48 kHz, resampled from the scene's {} Hz (rubato's FFT resampler)",
+            scene.sample_rate
+        )
+    }
+}
 
 /// Its channels: audio left and right, then the left and right actuator.
 pub const DUALSENSE_CHANNELS: u16 = 4;
@@ -90,7 +116,7 @@ fn check_length(path: &Path, frames: u64) -> Result<(), OutputError> {
     }
     Err(OutputError::TooLongFor {
         path: path.to_owned(),
-        format: "dualsense",
+        format: FORMAT.name,
         max_s: MAX_FRAMES as f64 / DUALSENSE_RATE_HZ as f64,
     })
 }

@@ -17,14 +17,26 @@ pub use draw::{draw_pour_plot, PlotData};
 #[cfg(feature = "plot")]
 pub use series::Waveform;
 #[cfg(feature = "plot")]
-pub(super) use sink::open;
+use sink::open;
 
+use super::OutputFormat;
 #[cfg(not(feature = "plot"))]
 use super::{OutputError, Sink, SinkContext};
 
+/// `.png`: the pour plot; read by people, not played.
+pub(super) const FORMAT: OutputFormat = OutputFormat {
+    name: "png",
+    extension: "png",
+    by_extension: true,
+    built: cfg!(feature = "plot"),
+    open,
+    read_back: None,
+    carries_c: "—",
+};
+
 /// Without the `plot` feature a plot is refused by name, not taken for an unknown format.
 #[cfg(not(feature = "plot"))]
-pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
+fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
     Err(OutputError::NoPlot {
         path: context.path.to_owned(),
     })
