@@ -65,7 +65,7 @@ pub fn run(args: AccuracyArgs) -> ExitCode {
     print!("{}", accuracy::table(&rows));
     if let Some(file) = &args.plot {
         if let Err(error) = sake_glug_reports::draw_accuracy_plot(&rows, file) {
-            eprintln!("error: the plot could not be drawn: {error}");
+            eprintln!("error: {error}");
             return ExitCode::FAILURE;
         }
         eprintln!("plot written to {}", file.display());

@@ -15,8 +15,7 @@ use sake_glug_io::text::{printable, quoted};
 use sake_glug_model_file::ModelFile;
 use sake_glug_render::clips::HapticBand;
 use sake_glug_render::fidelity::{self, fidelity_table, Fidelity};
-use sake_glug_render::sinks::AudioChannels;
-use sake_glug_render::steps::{DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
+use sake_glug_render::sinks::{AudioChannels, DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
 use sake_glug_render::{
     human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions,
     PlatformOptions, RenderError, RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
@@ -92,8 +91,17 @@ pub struct RenderArgs {
     /// Sample format of WAV files: f32, s24 or s16.
     #[arg(long, default_value = "f32")]
     sample_format: SampleFormat,
-    /// Frames a second of a rumble file (1 to 1000).
-    #[arg(long, value_name = "HZ", default_value_t = DEFAULT_RUMBLE_RATE_HZ, value_parser = rumble_rate)]
+    #[arg(
+        long,
+        value_name = "HZ",
+        default_value_t = DEFAULT_RUMBLE_RATE_HZ,
+        value_parser = rumble_rate,
+        help = format!(
+            "Frames a second of a rumble file ({} to {})",
+            RUMBLE_RATE_RANGE_HZ.start(),
+            RUMBLE_RATE_RANGE_HZ.end()
+        )
+    )]
     rumble_rate: f64,
     /// What the audio channels of a dualsense or android-ogg file hold: silent or glug (the
     /// actuators and the haptic channel always hold the glug).

@@ -367,7 +367,7 @@ fn a_plot_that_cannot_be_written_is_named_by_its_target() {
     assert_eq!(output.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(
-        stderr.contains("pour plot pour.png") && !stderr.contains(".sake-glug-"),
+        stderr.contains("cannot write pour.png") && !stderr.contains(".sake-glug-"),
         "{stderr}"
     );
     assert!(files_in(dir).is_empty());

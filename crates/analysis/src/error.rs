@@ -63,27 +63,15 @@ pub enum AnalysisError {
     #[error("{0}")]
     Option(String),
     /// A plot that could not be drawn or written (nothing is left at its path).
-    #[error("could not write the plot {path}: {message}")]
-    Plot {
-        /// The plot asked for.
-        path: String,
-        /// Why.
-        message: String,
-    },
+    #[cfg(feature = "plot")]
+    #[error(transparent)]
+    Plot(#[from] sake_glug_plot::PlotError),
 }
 
 impl AnalysisError {
     pub(crate) fn read(file: &Path, error: impl std::fmt::Display) -> Self {
         Self::Read {
             file: shown(file),
-            message: error.to_string(),
-        }
-    }
-
-    #[cfg(feature = "plot")]
-    pub(crate) fn plot(path: &Path, error: impl std::fmt::Display) -> Self {
-        Self::Plot {
-            path: shown(path),
             message: error.to_string(),
         }
     }

@@ -1,56 +1,29 @@
 //! The analyses' figures: the Thurstone scale on a line (the paper's fig. 2) and the fitted
-//! psychometric function over the proportions (fig. 5). Drawn into a temporary file beside the
-//! target and renamed over it once complete, so a failed plot leaves nothing.
+//! psychometric function over the proportions (fig. 5). Drawn and written, all or nothing, by
+//! the plot crate.
 
 use std::path::Path;
 
-use plotters::prelude::*;
+use sake_glug_plot::plotters::prelude::*;
+use sake_glug_plot::{Plot, FONT};
 
 use super::constant::{ConstantAnalysis, POINT_PERCENTS};
 use super::error::AnalysisError;
 use super::paired::PairedAnalysis;
-use sake_glug_io::temp::temp_file_builder;
 
-const SIZE_PX: (u32, u32) = (1000, 620);
-const FONT: &str = "sans-serif";
-
-/// Draws `draw` into a PNG at `path`, all or nothing.
-fn write_png(
-    path: &Path,
-    draw: impl FnOnce(&Path) -> Result<(), String>,
-) -> Result<(), AnalysisError> {
-    plotters::style::register_font(FONT, FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT)
-        .map_err(|_| AnalysisError::plot(path, "the embedded font did not load"))?;
-    if path.is_dir() {
-        return Err(AnalysisError::plot(path, "it is a folder"));
-    }
-    let folder = match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    };
-    let temp = temp_file_builder()
-        .prefix(".sake-glug-analysis-")
-        .suffix(".tmp.png")
-        .tempfile_in(folder)
-        .map_err(|error| AnalysisError::plot(path, error))?;
-    draw(temp.path()).map_err(|message| AnalysisError::plot(path, message))?;
-    temp.as_file()
-        .sync_all()
-        .map_err(|error| AnalysisError::plot(path, error))?;
-    temp.persist(path)
-        .map_err(|error| AnalysisError::plot(path, error.error))?;
-    Ok(())
-}
+/// Fig. 2: the scale on one line.
+const PAIRED_PLOT: Plot = Plot::new("plot", (1000, 300));
+/// Fig. 5: the psychometric function.
+const CONSTANT_PLOT: Plot = Plot::new("plot", (1000, 620));
 
 /// The scale values on one line, each stimulus marked and named (fig. 2).
 pub fn draw_paired_plot(analysis: &PairedAnalysis, path: &Path) -> Result<(), AnalysisError> {
-    write_png(path, |file| {
+    PAIRED_PLOT.write(path, |root| -> Result<(), String> {
         let fail = |error: &dyn std::fmt::Display| error.to_string();
-        let root = BitMapBackend::new(file, (SIZE_PX.0, 300)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| fail(&e))?;
         let top = analysis.scale.iter().copied().fold(0.0, f64::max).max(0.1);
         let margin = 0.08 * top;
-        let mut chart = ChartBuilder::on(&root)
+        let mut chart = ChartBuilder::on(root)
             .margin(30)
             .caption("Thurstone Case V scale", (FONT, 26))
             .x_label_area_size(45)
@@ -90,14 +63,15 @@ pub fn draw_paired_plot(analysis: &PairedAnalysis, path: &Path) -> Result<(), An
                 )))
                 .map_err(|e| fail(&e))?;
         }
-        root.present().map_err(|e| fail(&e))
-    })
+        Ok(())
+    })?;
+    Ok(())
 }
 
 /// The proportion "comparison chosen" per level, the pooled fitted curve, its 25/50/75 %
 /// points with their 95 % intervals, and each participant's curve in grey (fig. 5).
 pub fn draw_constant_plot(analysis: &ConstantAnalysis, path: &Path) -> Result<(), AnalysisError> {
-    write_png(path, |file| {
+    CONSTANT_PLOT.write(path, |root| -> Result<(), String> {
         let fail = |error: &dyn std::fmt::Display| error.to_string();
         let pooled = &analysis.pooled;
         let (first, last) = (
@@ -106,9 +80,8 @@ pub fn draw_constant_plot(analysis: &ConstantAnalysis, path: &Path) -> Result<()
         );
         let pad = 0.05 * (last - first);
         let (low, high) = (first - pad, last + pad);
-        let root = BitMapBackend::new(file, SIZE_PX).into_drawing_area();
         root.fill(&WHITE).map_err(|e| fail(&e))?;
-        let mut chart = ChartBuilder::on(&root)
+        let mut chart = ChartBuilder::on(root)
             .margin(25)
             .caption(
                 "Psychometric function (logistic, maximum likelihood)",
@@ -179,6 +152,7 @@ pub fn draw_constant_plot(analysis: &ConstantAnalysis, path: &Path) -> Result<()
                 )))
                 .map_err(|e| fail(&e))?;
         }
-        root.present().map_err(|e| fail(&e))
-    })
+        Ok(())
+    })?;
+    Ok(())
 }

@@ -120,6 +120,10 @@ pub enum FitError {
         /// Why.
         message: String,
     },
+    /// The plot could not be drawn or written (nor was any other file).
+    #[cfg(feature = "plot")]
+    #[error(transparent)]
+    Plot(#[from] sake_glug_plot::PlotError),
     /// The outputs asked for do not fit the session (one model for several liquids).
     #[error("{0}")]
     Outputs(String),

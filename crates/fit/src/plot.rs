@@ -2,26 +2,26 @@
 //! with f1 and f2, (c) Asum against V with the amplitude law (fig. 7), (d) V(t) per recording
 //! with its drain line (fig. 6).
 
-use std::path::Path;
-
-use plotters::prelude::*;
+use sake_glug_io::PendingFile;
+use sake_glug_plot::plotters::prelude::*;
+use sake_glug_plot::{Canvas, Plot, PlotError};
 
 use super::estimate::SessionFit;
 
-const SIZE_PX: (u32, u32) = (1600, 1100);
+/// The plot: its name in messages and its size.
+const FIT_PLOT: Plot = Plot::new("fit plot", (1600, 1100));
 /// The span of panel (a) (s).
 const UNITS_SPAN_S: f64 = 0.4;
 
-/// Draws the plot of `fit` as a PNG at `path`; the error is plotters' message.
-pub fn draw_fit_plot(fit: &SessionFit, path: &Path) -> Result<(), String> {
+/// Draws the plot of `fit` into `file`, which [`crate::write_fit`] commits with the fit's other
+/// files.
+pub fn draw_fit_plot(fit: &SessionFit, file: &PendingFile) -> Result<(), PlotError> {
+    FIT_PLOT.draw_into(file, |root| draw(fit, root))
+}
+
+/// Draws the four panels on `root`; the error is plotters' message.
+fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
     let e = |error: &dyn std::fmt::Display| error.to_string();
-    plotters::style::register_font(
-        "sans-serif",
-        FontStyle::Normal,
-        epaint_default_fonts::UBUNTU_LIGHT,
-    )
-    .map_err(|_| "the embedded font did not load".to_string())?;
-    let root = BitMapBackend::new(path, SIZE_PX).into_drawing_area();
     root.fill(&WHITE).map_err(|x| e(&x))?;
     let panels = root.split_evenly((2, 2));
     let colours = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];

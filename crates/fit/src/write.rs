@@ -71,10 +71,7 @@ pub fn write_fit(fit: &SessionFit, outputs: &FitOutputs) -> Result<Vec<(PathBuf,
     #[cfg(feature = "plot")]
     if let Some(path) = &outputs.plot {
         let file = pending(path, ".png")?;
-        super::draw_fit_plot(fit, file.temp_path()).map_err(|message| FitError::Write {
-            path: path.clone(),
-            message,
-        })?;
+        super::draw_fit_plot(fit, &file)?;
         files.push(file);
     }
     #[cfg(not(feature = "plot"))]

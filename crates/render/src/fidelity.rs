@@ -1,8 +1,9 @@
-//! What each format keeps of the model, measured: one render written in every format, each
-//! file read back (the steps for the XML, which holds the same entries as the waveform JSON)
-//! and held against the model's own glugs: where its onsets fall, how far its envelope strays
-//! from the felt envelope, what carries the viscosity c, how big it is, and which platform
-//! limits it met. `sake-glug render --fidelity` prints it; the README's table is its output.
+//! What each format keeps of the model, measured: one render written in every format played,
+//! each file read back as its format declares ([`ReadBack`], in the format's own file) and held
+//! against the model's own glugs: where its onsets fall, how far its envelope strays from the
+//! felt envelope, what carries the viscosity c, how big it is, and which platform limits it
+//! met. `sake-glug render --fidelity` prints it; the README's table is its output. Nothing here
+//! knows a format by name: the table of formats says everything.
 
 use std::path::Path;
 
@@ -11,8 +12,8 @@ use serde_json::Value;
 use super::clips::{clip_onsets, ClipSource, Glug};
 use super::render::{RenderObserver, RenderSummary};
 use super::scene::Scene;
-use super::sinks::{Output, OutputError, OutputFormat, OutputOptions, DUALSENSE_RATE_HZ};
-use super::steps::{android_steps, ComponentEnvelopes};
+use super::sinks::{Output, OutputError, OutputFormat, OutputOptions};
+use super::steps::ComponentEnvelopes;
 use sake_glug_engine::{UnitOnset, Voicing};
 
 /// The envelope is compared where the model's is within this of its loudest (−40 dB): the
@@ -25,9 +26,6 @@ const LEVEL_FLOOR: f64 = 1e-3;
 
 /// The envelope is compared every millisecond.
 const COMPARE_EVERY_S: f64 = 0.001;
-
-/// Core Haptics' limit on one continuous event (s), which the `.ahap` splits at.
-const AHAP_EVENT_LIMIT_S: f64 = 30.0;
 
 /// What one format keeps of a render.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,16 +46,51 @@ pub struct Fidelity {
     pub limits: String,
 }
 
-/// The formats measured for `scene`: every one but the plot and the tables (not played),
-/// those this build cannot write, and the DualSense's unless the scene is at its rate.
-fn measured_formats(scene: &Scene) -> impl Iterator<Item = OutputFormat> + '_ {
-    OutputFormat::ALL.iter().copied().filter(|&format| {
-        // The plot and the tables (MODEL.md §14) are read by people and programs, not played:
-        // the tables hold the model's own numbers.
-        ![OutputFormat::PLOT, OutputFormat::UNITS, OutputFormat::STATE].contains(&format)
-            && (cfg!(feature = "ogg") || format != OutputFormat::ANDROID_OGG)
-            && (scene.sample_rate == DUALSENSE_RATE_HZ || format != OutputFormat::DUALSENSE)
-    })
+/// How the fidelity report reads a played format back; a format not played (the plot, the
+/// tables, read by people and programs) declares none and is not measured.
+#[derive(Clone, Copy)]
+pub(crate) enum ReadBack {
+    /// The render's samples themselves: the onsets to the sample, no envelope apart from the
+    /// waveform; `limits` says what the platform took of them for a scene.
+    Waveform {
+        /// The platform limits the file met.
+        limits: fn(&Scene) -> String,
+    },
+    /// A clip: its onsets and its envelope, read from the file.
+    Clip(fn(&WrittenClip) -> Result<Reading, OutputError>),
+}
+
+/// The limits column of a waveform its platform takes as it is: "—".
+pub(crate) fn no_limits(_: &Scene) -> String {
+    "—".to_owned()
+}
+
+/// A clip's file as written, and the model's glugs it was written from.
+pub(crate) struct WrittenClip<'a> {
+    /// The file.
+    pub path: &'a Path,
+    /// The model's glugs.
+    pub source: &'a ClipSource<'a>,
+}
+
+impl WrittenClip<'_> {
+    /// The file as JSON.
+    pub fn json(&self) -> Result<Value, OutputError> {
+        let text = std::fs::read_to_string(self.path).map_err(OutputError::io(self.path))?;
+        serde_json::from_str(&text).map_err(|error| OutputError::Io {
+            path: self.path.to_owned(),
+            source: error.into(),
+        })
+    }
+}
+
+/// The formats measured: every one played that this build writes.
+fn measured_formats() -> impl Iterator<Item = (OutputFormat, ReadBack)> {
+    OutputFormat::ALL
+        .iter()
+        .copied()
+        .filter(|format| format.is_built())
+        .filter_map(|format| Some((format, format.read_back()?)))
 }
 
 /// Renders `scene` once into every format (in a temporary folder) and measures each file.
@@ -67,8 +100,10 @@ pub fn measure(
     options: &OutputOptions,
 ) -> Result<Vec<Fidelity>, OutputError> {
     let folder = tempfile::tempdir().map_err(OutputError::io(Path::new("a temporary folder")))?;
-    let outputs: Vec<Output> = measured_formats(scene)
-        .map(|format| Output {
+    let formats: Vec<(OutputFormat, ReadBack)> = measured_formats().collect();
+    let outputs: Vec<Output> = formats
+        .iter()
+        .map(|&(format, _)| Output {
             format,
             path: folder.path().join(format.file_name("measured")),
         })
@@ -95,124 +130,64 @@ pub fn measure(
         scene_name,
         seed: scene.config.seed,
     };
-    let mut rows = outputs
+    outputs
         .iter()
+        .zip(&formats)
         .zip(&report.files)
-        .map(|(output, (_, bytes))| {
-            let text =
-                || std::fs::read_to_string(&output.path).map_err(OutputError::io(&output.path));
-            measure_one(output.format, &source, &report.summary, *bytes, text)
+        .map(|((output, &(format, read_back)), (_, bytes))| {
+            let fidelity = |onset_error_ms, envelope_error_db, limits| Fidelity {
+                format,
+                onset_error_ms,
+                envelope_error_db,
+                carries_c: format.carries_c(),
+                bytes: *bytes,
+                limits,
+            };
+            Ok(match read_back {
+                ReadBack::Waveform { limits } => fidelity(None, None, limits(scene)),
+                ReadBack::Clip(read) => {
+                    let clip = WrittenClip {
+                        path: &output.path,
+                        source: &source,
+                    };
+                    let reading = read(&clip)?;
+                    fidelity(
+                        onset_error_ms(&source, &reading),
+                        envelope_error_db(&source, &report.summary, &*reading.envelope),
+                        reading.limits,
+                    )
+                }
+            })
         })
-        .collect::<Result<Vec<_>, _>>()?;
-    if scene.sample_rate != DUALSENSE_RATE_HZ {
-        rows.push(Fidelity {
-            format: OutputFormat::DUALSENSE,
-            onset_error_ms: None,
-            envelope_error_db: None,
-            carries_c: "—",
-            bytes: 0,
-            limits: format!(
-                "not written: it plays {DUALSENSE_RATE_HZ} Hz only, the scene renders at {} Hz",
-                scene.sample_rate
-            ),
-        });
-    }
-    Ok(rows)
+        .collect()
 }
 
-/// What a format's file says of the render, read back: its onsets and its envelope.
-struct Reading {
+/// What a clip's file says of the render, read back: its onsets and its envelope.
+pub(crate) struct Reading {
     /// Times (s) the format marks an onset at.
-    onsets: Vec<f64>,
+    pub onsets: Vec<f64>,
     /// Whether a glug shows from the last mark before its onset (a rumble frame carries it
     /// from the frame's start), rather than from the nearest mark.
-    from_mark_before: bool,
+    pub from_mark_before: bool,
     /// The format's level (0..1 of full scale) at a time.
-    envelope: Box<dyn Fn(f64) -> f64>,
-    limits: String,
+    pub envelope: Box<dyn Fn(f64) -> f64>,
+    /// The platform limits the file met.
+    pub limits: String,
 }
 
-fn measure_one(
-    format: OutputFormat,
-    source: &ClipSource,
-    summary: &RenderSummary,
-    bytes: u64,
-    text: impl Fn() -> Result<String, OutputError>,
-) -> Result<Fidelity, OutputError> {
-    let json = || -> Result<Value, OutputError> {
-        serde_json::from_str(&text()?).map_err(|e| OutputError::Io {
-            path: format.file_name("measured").into(),
-            source: e.into(),
-        })
-    };
-    let (reading, carries_c): (Option<Reading>, &'static str) = match format.name() {
-        "haptic" => (
-            Some(read_haptic(&json()?)),
-            "emphasis and envelope frequency (the felt frequency on the band: 1 − c by default)",
-        ),
-        "ahap" => (
-            Some(read_ahap(&json()?)),
-            "HapticSharpness (the felt frequency: 1 − c by default)",
-        ),
-        "haps" => (
-            Some(read_haps(&json()?)),
-            "frequency keyframes in Hz (the felt frequency, c·f1 + (1 − c)·f2 weighted)",
-        ),
-        "android-waveform" => (
-            Some(read_android(&json()?)),
-            "nothing: one motor, amplitude only",
-        ),
-        "android-xml" => (
-            Some(read_steps(source)),
-            "nothing: one motor, amplitude only",
-        ),
-        "rumble" => (
-            Some(read_rumble(&json()?)),
-            "the motors' balance: low = the f1 part (c·a), high = the f2 part ((1 − c)·a)",
-        ),
-        "dualsense" => (
-            None,
-            "the waveform on both actuators (c·a at f1, (1 − c)·a at f2), 16-bit",
-        ),
-        "android-ogg" => (
-            None,
-            "the waveform on the haptic channel, Vorbis-coded (lossy)",
-        ),
-        _ => (None, "the waveform itself (c·a at f1, (1 − c)·a at f2)"),
-    };
-    let Some(reading) = reading else {
-        let limits = match format.name() {
-            "dualsense" => "48 kHz only (other rates are refused)".to_owned(),
-            _ => "—".to_owned(),
-        };
-        return Ok(Fidelity {
-            format,
-            onset_error_ms: None,
-            envelope_error_db: None,
-            carries_c,
-            bytes,
-            limits,
-        });
-    };
+/// Mean and worst distance (ms) from the model's audible onsets to the format's marks.
+fn onset_error_ms(source: &ClipSource, reading: &Reading) -> Option<(f64, f64)> {
     let onsets: Vec<f64> = clip_onsets(source)
         .into_iter()
         .map(|i| source.glugs[i].onset_s)
         .collect();
-    let onset_error_ms = (!onsets.is_empty()).then(|| {
+    (!onsets.is_empty()).then(|| {
         let distances: Vec<f64> = onsets
             .iter()
-            .map(|&onset| distance(&reading, onset) * 1000.0)
+            .map(|&onset| distance(reading, onset) * 1000.0)
             .collect();
         let mean = distances.iter().sum::<f64>() / distances.len() as f64;
         (mean, distances.iter().copied().fold(0.0, f64::max))
-    });
-    Ok(Fidelity {
-        format,
-        onset_error_ms,
-        envelope_error_db: envelope_error_db(source, summary, &*reading.envelope),
-        carries_c,
-        bytes,
-        limits: reading.limits,
     })
 }
 
@@ -253,11 +228,13 @@ fn envelope_error_db(
     (!errors.is_empty()).then(|| errors.iter().sum::<f64>() / errors.len() as f64)
 }
 
-fn number(value: &Value, key: &str) -> f64 {
+/// The number at `key` of `value`, 0 if none.
+pub(crate) fn number(value: &Value, key: &str) -> f64 {
     value.get(key).and_then(Value::as_f64).unwrap_or(0.0)
 }
 
-fn array<'a>(value: &'a Value, pointer: &str) -> &'a [Value] {
+/// The array at `pointer` in `value`, empty if none.
+pub(crate) fn array<'a>(value: &'a Value, pointer: &str) -> &'a [Value] {
     value
         .pointer(pointer)
         .and_then(Value::as_array)
@@ -265,7 +242,7 @@ fn array<'a>(value: &'a Value, pointer: &str) -> &'a [Value] {
 }
 
 /// Straight lines between `(time, level)` points; 0 outside them.
-fn linear(points: Vec<(f64, f64)>) -> Box<dyn Fn(f64) -> f64> {
+pub(crate) fn linear(points: Vec<(f64, f64)>) -> Box<dyn Fn(f64) -> f64> {
     Box::new(move |t| {
         let next = points.partition_point(|p| p.0 <= t);
         if next == 0 || next == points.len() {
@@ -277,7 +254,7 @@ fn linear(points: Vec<(f64, f64)>) -> Box<dyn Fn(f64) -> f64> {
 }
 
 /// Levels held over `(start, end, level)` spans; 0 outside them.
-fn held(mut spans: Vec<(f64, f64, f64)>) -> Box<dyn Fn(f64) -> f64> {
+pub(crate) fn held(mut spans: Vec<(f64, f64, f64)>) -> Box<dyn Fn(f64) -> f64> {
     spans.sort_by(|a, b| a.0.total_cmp(&b.0));
     Box::new(move |t| {
         let next = spans.partition_point(|span| span.0 <= t);
@@ -286,154 +263,6 @@ fn held(mut spans: Vec<(f64, f64, f64)>) -> Box<dyn Fn(f64) -> f64> {
             _ => 0.0,
         }
     })
-}
-
-fn read_haptic(document: &Value) -> Reading {
-    let points = array(document, "/signals/continuous/envelopes/amplitude");
-    Reading {
-        from_mark_before: false,
-        onsets: points
-            .iter()
-            .filter(|p| p.get("emphasis").is_some())
-            .map(|p| number(p, "time"))
-            .collect(),
-        envelope: linear(
-            points
-                .iter()
-                .map(|p| (number(p, "time"), number(p, "amplitude")))
-                .collect(),
-        ),
-        limits: format!("{} breakpoints", points.len()),
-    }
-}
-
-fn read_ahap(document: &Value) -> Reading {
-    let events: Vec<&Value> = array(document, "/Pattern")
-        .iter()
-        .filter_map(|item| item.get("Event"))
-        .collect();
-    let kind =
-        |event: &Value| event.get("EventType").and_then(Value::as_str) == Some("HapticTransient");
-    let intensity = |event: &Value| {
-        array(event, "/EventParameters")
-            .iter()
-            .find(|p| p.get("ParameterID").and_then(Value::as_str) == Some("HapticIntensity"))
-            .map_or(0.0, |p| number(p, "ParameterValue"))
-    };
-    let continuous: Vec<(f64, f64, f64)> = events
-        .iter()
-        .filter(|e| !kind(e))
-        .map(|e| {
-            let start = number(e, "Time");
-            // The intensity is the square root of the step's mean amplitude.
-            (
-                start,
-                start + number(e, "EventDuration"),
-                intensity(e).powi(2),
-            )
-        })
-        .collect();
-    let split = continuous
-        .iter()
-        .filter(|span| span.1 - span.0 >= AHAP_EVENT_LIMIT_S - 1e-9)
-        .count();
-    Reading {
-        from_mark_before: false,
-        onsets: events
-            .iter()
-            .filter(|e| kind(e))
-            .map(|e| number(e, "Time"))
-            .collect(),
-        limits: format!(
-            "{} events; {split} split at Core Haptics' {AHAP_EVENT_LIMIT_S:.0} s",
-            events.len()
-        ),
-        envelope: held(continuous),
-    }
-}
-
-fn read_haps(document: &Value) -> Reading {
-    let notes = array(document, "/m_vibration/m_melodies/0/m_notes");
-    let mut points = Vec::new();
-    for note in notes {
-        let start = number(note, "m_startingPoint");
-        for keyframe in array(note, "/m_hapticEffect/m_amplitudeModulation/m_keyframes") {
-            points.push((
-                start + number(keyframe, "m_time"),
-                number(keyframe, "m_value"),
-            ));
-        }
-    }
-    Reading {
-        from_mark_before: false,
-        onsets: notes.iter().map(|n| number(n, "m_startingPoint")).collect(),
-        limits: format!("{} notes, {} keyframes", notes.len(), points.len()),
-        envelope: linear(points),
-    }
-}
-
-/// Android entries `(duration ms, amplitude)` as held levels, and their starts as onsets.
-fn android_reading(entries: impl Iterator<Item = (u64, u64)>, lifted: usize) -> Reading {
-    let mut at_ms = 0;
-    let mut spans = Vec::new();
-    for (duration_ms, amplitude) in entries {
-        let start = at_ms as f64 / 1000.0;
-        at_ms += duration_ms;
-        spans.push((start, at_ms as f64 / 1000.0, amplitude as f64 / 255.0));
-    }
-    Reading {
-        from_mark_before: false,
-        onsets: spans.iter().map(|span| span.0).collect(),
-        limits: format!(
-            "{} entries of whole ms and 8-bit amplitude; {lifted} at the lowest level, 1",
-            spans.len()
-        ),
-        envelope: held(spans),
-    }
-}
-
-fn read_android(document: &Value) -> Reading {
-    let integers = |key| -> Vec<u64> {
-        array(document, key)
-            .iter()
-            .map(|v| v.as_u64().unwrap_or(0))
-            .collect()
-    };
-    let (timings, amplitudes) = (integers("/timings"), integers("/amplitudes"));
-    let lifted = amplitudes.iter().filter(|&&a| a == 1).count();
-    android_reading(timings.into_iter().zip(amplitudes), lifted)
-}
-
-fn read_steps(source: &ClipSource) -> Reading {
-    let steps = android_steps(source);
-    let lifted = steps.iter().filter(|s| s.amplitude == 1).count();
-    android_reading(
-        steps.iter().map(|s| (s.duration_ms, s.amplitude as u64)),
-        lifted,
-    )
-}
-
-fn read_rumble(document: &Value) -> Reading {
-    let rate_hz = number(document, "rate_hz");
-    let frames = array(document, "/frames");
-    let period_s = 1.0 / rate_hz;
-    let spans: Vec<(f64, f64, f64)> = frames
-        .iter()
-        .map(|f| {
-            let start = number(f, "t_ms") / 1000.0;
-            (
-                start,
-                start + period_s,
-                number(f, "low") + number(f, "high"),
-            )
-        })
-        .collect();
-    Reading {
-        onsets: spans.iter().map(|span| span.0).collect(),
-        from_mark_before: true,
-        limits: format!("{} frames at {rate_hz} Hz", frames.len()),
-        envelope: held(spans),
-    }
 }
 
 /// The measurements as the Markdown table the README shows.

@@ -10,6 +10,7 @@ pub mod fidelity;
 mod memory;
 mod outputs;
 mod render;
+mod resample;
 mod scene;
 pub mod sinks;
 pub mod steps;

@@ -143,14 +143,6 @@ fn android_amplitude(level: f64) -> u8 {
     }
 }
 
-/// The default rate (Hz) of the dual-rumble frames: 10 ms, the step of the Android entries and
-/// about the fastest a rumble motor's speed is worth updating (SDL and the browsers send the
-/// controller a new state at most every few milliseconds).
-pub const DEFAULT_RUMBLE_RATE_HZ: f64 = 100.0;
-
-/// The rumble rates accepted (Hz): at least one frame a second, at most one a millisecond.
-pub const RUMBLE_RATE_RANGE_HZ: std::ops::RangeInclusive<f64> = 1.0..=1000.0;
-
 /// One frame of a dual-rumble effect: from `t_ms` to the next frame, the low-frequency
 /// (strong) motor at `low` and the high-frequency (weak) motor at `high`, both 0..1.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,6 +1,13 @@
-//! The work-precision diagram of the accuracy report, drawn to a PNG (feature `plot`).
+//! The work-precision diagram of the accuracy report, drawn to a PNG (feature `plot`) and
+//! written all or nothing by the plot crate.
+
+use sake_glug_plot::plotters::prelude::*;
+use sake_glug_plot::{Canvas, Plot, PlotError, FONT};
 
 use super::accuracy::{length_label, Measurement, SynthesisPath};
+
+/// The diagram.
+const ACCURACY_PLOT: Plot = Plot::new("accuracy plot", (1000, 680));
 
 /// (speed, error in dB, render length in s) of one path at one length.
 type PlotPoint = (f64, f64, f64);
@@ -10,20 +17,11 @@ const PLOT_FLOOR_DB: f64 = -200.0;
 
 /// Draws the work-precision diagram: speed across, the worst error over the cases up, one line
 /// per path through its render lengths.
-pub fn draw_accuracy_plot(
-    rows: &[Measurement],
-    file: &std::path::Path,
-) -> Result<(), Box<dyn std::error::Error>> {
-    use plotters::prelude::*;
+pub fn draw_accuracy_plot(rows: &[Measurement], file: &std::path::Path) -> Result<(), PlotError> {
+    ACCURACY_PLOT.write(file, |root| draw(rows, root))
+}
 
-    // A font compiled into the binary: no system font library needed.
-    plotters::style::register_font(
-        "sans-serif",
-        FontStyle::Normal,
-        epaint_default_fonts::UBUNTU_LIGHT,
-    )
-    .map_err(|_| "the embedded font did not load")?;
-
+fn draw(rows: &[Measurement], root: &Canvas<'_>) -> Result<(), Box<dyn std::error::Error>> {
     let mut lengths: Vec<f64> = rows.iter().map(|r| r.length_s).collect();
     lengths.sort_by(f64::total_cmp);
     lengths.dedup();
@@ -60,12 +58,11 @@ pub fn draw_accuracy_plot(
     let (low, high) = speeds.fold((f64::INFINITY, 0.0f64), |(l, h), s| (l.min(s), h.max(s)));
     let x_range = (low / 2.0).max(1e-3)..high * 2.0;
 
-    let root = BitMapBackend::new(file, (1000, 680)).into_drawing_area();
     root.fill(&WHITE)?;
-    let mut chart = ChartBuilder::on(&root)
+    let mut chart = ChartBuilder::on(root)
         .caption(
             "Sake Glug: error against run time (48 kHz; worst of the cases)",
-            ("sans-serif", 24),
+            (FONT, 24),
         )
         .margin(20)
         .x_label_area_size(55)
@@ -78,8 +75,8 @@ pub fn draw_accuracy_plot(
         .light_line_style(RGBColor(238, 238, 238))
         .x_desc("speed (× real time, log)")
         .y_desc("largest sample error re peak (dB)")
-        .axis_desc_style(("sans-serif", 18))
-        .label_style(("sans-serif", 15))
+        .axis_desc_style((FONT, 18))
+        .label_style((FONT, 15))
         .draw()?;
     // The error budget of MODEL.md §9.
     chart.draw_series(DashedLineSeries::new(
@@ -91,7 +88,7 @@ pub fn draw_accuracy_plot(
     chart.draw_series(std::iter::once(Text::new(
         "budget: −100 dB at 1 h",
         (low / 1.8, -97.0),
-        ("sans-serif", 14).into_font().color(&RED),
+        (FONT, 14).into_font().color(&RED),
     )))?;
 
     let colours = [BLACK, BLUE, RGBColor(0, 150, 0), MAGENTA];
@@ -122,17 +119,16 @@ pub fn draw_accuracy_plot(
             Text::new(
                 length_label(length_s),
                 (s, e + lift),
-                ("sans-serif", 13).into_font(),
+                (FONT, 13).into_font(),
             )
         }))?;
     }
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 15))
+        .label_font((FONT, 15))
         .background_style(WHITE.mix(0.9))
         .border_style(BLACK)
         .draw()?;
-    root.present()?;
     Ok(())
 }

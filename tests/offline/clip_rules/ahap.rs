@@ -2,6 +2,8 @@
 //! fixtures. Core Haptics clamps out-of-range values on load; these rules refuse them so a
 //! clip plays exactly as written.
 
+// Core Haptics' limit on a continuous event, as the format declares it.
+use sake_glug_render::sinks::CORE_HAPTICS_MAX_EVENT_S;
 use serde_json::{Map, Value};
 
 use super::{check_fixtures, Violation};
@@ -103,7 +105,6 @@ const EVENT_TYPES: [&str; 4] = [
     "AudioCustom",
 ];
 const MAX_CONTROL_POINTS: usize = 16;
-const MAX_EVENT_DURATION_S: f64 = 30.0;
 
 /// An event as read: `(Time, EventType, EventDuration, [(ParameterID, ParameterValue)])`.
 pub struct Event {
@@ -194,7 +195,7 @@ fn check_event(event: &Event, at: &str, violations: &mut Vec<Violation<Rule>>) {
     if event.event_type == "HapticContinuous"
         && !event
             .duration
-            .is_some_and(|d| d > 0.0 && d <= MAX_EVENT_DURATION_S)
+            .is_some_and(|d| d > 0.0 && d <= CORE_HAPTICS_MAX_EVENT_S)
     {
         violations.push(violation(
             Rule::ContinuousDurationOutOfRange,

@@ -385,7 +385,7 @@ fn pour_plot_is_drawn() {
 
     let nowhere = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("no/such/dir/pour.png");
     let error = draw_pour_plot(&data, &nowhere).unwrap_err();
-    assert!(matches!(error, PlotError::Draw { .. }), "{error:?}");
+    assert!(matches!(error, PlotError::Write { .. }), "{error:?}");
     assert!(
         error.to_string().contains("no/such/dir/pour.png"),
         "{error}"

@@ -6,11 +6,24 @@
 //! parameters instead.
 
 use serde::Serialize;
+use serde_json::Value;
 
-use super::{ClipSink, OutputError, Sink, SinkContext};
+use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
 use crate::clips::{
     clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, transient_intensity,
     ClipSource, HapticBand, ENVELOPE_FLOOR,
+};
+use crate::fidelity::{array, held, number, ReadBack, Reading, WrittenClip};
+
+/// `.ahap`: an Apple Core Haptics pattern.
+pub(super) const FORMAT: OutputFormat = OutputFormat {
+    name: "ahap",
+    extension: "ahap",
+    by_extension: true,
+    built: true,
+    open,
+    read_back: Some(ReadBack::Clip(read_back)),
+    carries_c: "HapticSharpness (the felt frequency: 1 − c by default)",
 };
 
 /// The sink of an `.ahap` output (its sharpness always on the default band).
@@ -62,8 +75,8 @@ struct EventParameter {
     parameter_value: f64,
 }
 
-/// Core Haptics' limit on the length of one continuous event.
-const MAX_EVENT_DURATION_S: f64 = 30.0;
+/// Core Haptics' limit on the length of one continuous event (s): longer steps are split.
+pub const CORE_HAPTICS_MAX_EVENT_S: f64 = 30.0;
 
 /// Envelope steps shorter than this (the jump just before an onset) get no continuous event:
 /// the transient carries the jump.
@@ -96,7 +109,7 @@ fn parameters(intensity: f64, sharpness: f64) -> [EventParameter; 2] {
 ///   ([`envelope_breakpoints`]) that rises above [`ENVELOPE_FLOOR`], intensity the
 ///   square root of the step's mean amplitude, sharpness the band position of the felt
 ///   frequency of what rings at the step's start. Steps longer than
-///   `MAX_EVENT_DURATION_S` (Core Haptics' limit) are split.
+///   `CORE_HAPTICS_MAX_EVENT_S` (Core Haptics' limit) are split.
 pub fn ahap_json(source: &ClipSource) -> String {
     let band = HapticBand::default();
     let breakpoints = envelope_breakpoints(source);
@@ -128,7 +141,7 @@ pub fn ahap_json(source: &ClipSource) -> String {
             .map_or(SILENT_SHARPNESS, |hz| band.normalise(hz));
         let mut chunk_start_s = start.time_s;
         while chunk_start_s < end.time_s {
-            let chunk_s = (end.time_s - chunk_start_s).min(MAX_EVENT_DURATION_S);
+            let chunk_s = (end.time_s - chunk_start_s).min(CORE_HAPTICS_MAX_EVENT_S);
             events.push(Event {
                 time: chunk_start_s,
                 event_type: "HapticContinuous",
@@ -158,4 +171,52 @@ pub fn ahap_json(source: &ClipSource) -> String {
         pattern: events.into_iter().map(PatternItem::Event).collect(),
     };
     serde_json::to_string_pretty(&file).expect("a pattern of plain numbers and strings serializes")
+}
+
+/// The pattern read back: its transients as onsets, its continuous events as the envelope (an
+/// event's intensity is the square root of its mean amplitude).
+fn read_back(clip: &WrittenClip) -> Result<Reading, OutputError> {
+    let document = clip.json()?;
+    let events: Vec<&Value> = array(&document, "/Pattern")
+        .iter()
+        .filter_map(|item| item.get("Event"))
+        .collect();
+    let kind =
+        |event: &Value| event.get("EventType").and_then(Value::as_str) == Some("HapticTransient");
+    let intensity = |event: &Value| {
+        array(event, "/EventParameters")
+            .iter()
+            .find(|p| p.get("ParameterID").and_then(Value::as_str) == Some("HapticIntensity"))
+            .map_or(0.0, |p| number(p, "ParameterValue"))
+    };
+    let continuous: Vec<(f64, f64, f64)> = events
+        .iter()
+        .filter(|e| !kind(e))
+        .map(|e| {
+            let start = number(e, "Time");
+            // The intensity is the square root of the step's mean amplitude.
+            (
+                start,
+                start + number(e, "EventDuration"),
+                intensity(e).powi(2),
+            )
+        })
+        .collect();
+    let split = continuous
+        .iter()
+        .filter(|span| span.1 - span.0 >= CORE_HAPTICS_MAX_EVENT_S - 1e-9)
+        .count();
+    Ok(Reading {
+        from_mark_before: false,
+        onsets: events
+            .iter()
+            .filter(|e| kind(e))
+            .map(|e| number(e, "Time"))
+            .collect(),
+        limits: format!(
+            "{} events; {split} split at Core Haptics' {CORE_HAPTICS_MAX_EVENT_S:.0} s",
+            events.len()
+        ),
+        envelope: held(continuous),
+    })
 }

@@ -7,9 +7,35 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use super::{ClipSink, OutputError, Sink, SinkContext};
+use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
 use crate::clips::{clip_onsets, ClipSource};
-use crate::steps::{android_steps, ANDROID_STEP_MS};
+use crate::fidelity::{array, held, ReadBack, Reading, WrittenClip};
+use crate::steps::{android_steps, ANDROID_FULL_AMPLITUDE, ANDROID_STEP_MS};
+
+/// `.xml`: Android's vibration XML (`VibrationXmlParser`).
+pub(super) const XML_FORMAT: OutputFormat = OutputFormat {
+    name: "android-xml",
+    extension: "xml",
+    by_extension: true,
+    built: true,
+    open: open_xml,
+    read_back: Some(ReadBack::Clip(read_back_xml)),
+    carries_c: CARRIES_C,
+};
+
+/// `android-waveform` (`.json`): the arrays of Android's `VibrationEffect.createWaveform`.
+pub(super) const WAVEFORM_FORMAT: OutputFormat = OutputFormat {
+    name: "android-waveform",
+    extension: "json",
+    by_extension: false,
+    built: true,
+    open: open_waveform,
+    read_back: Some(ReadBack::Clip(read_back_waveform)),
+    carries_c: CARRIES_C,
+};
+
+/// What carries c in either Android file.
+const CARRIES_C: &str = "nothing: one motor, amplitude only";
 
 /// Memory a glug takes until the file is written: the glug, its steps (8 at 10 ms between
 /// glugs 80 ms apart) and their text.
@@ -75,4 +101,50 @@ pub fn android_waveform_json(source: &ClipSource) -> String {
         repeat: -1,
     };
     serde_json::to_string(&waveform).expect("arrays of integers serialize")
+}
+
+/// Android entries `(duration ms, amplitude)` as held levels, and their starts as onsets.
+fn android_reading(entries: impl Iterator<Item = (u64, u64)>, lifted: usize) -> Reading {
+    let mut at_ms = 0;
+    let mut spans = Vec::new();
+    for (duration_ms, amplitude) in entries {
+        let start = at_ms as f64 / 1000.0;
+        at_ms += duration_ms;
+        let level = amplitude as f64 / ANDROID_FULL_AMPLITUDE as f64;
+        spans.push((start, at_ms as f64 / 1000.0, level));
+    }
+    Reading {
+        from_mark_before: false,
+        onsets: spans.iter().map(|span| span.0).collect(),
+        limits: format!(
+            "{} entries of whole ms and 8-bit amplitude; {lifted} at the lowest level, 1",
+            spans.len()
+        ),
+        envelope: held(spans),
+    }
+}
+
+/// The waveform JSON read back: its entries.
+fn read_back_waveform(clip: &WrittenClip) -> Result<Reading, OutputError> {
+    let document = clip.json()?;
+    let integers = |key| -> Vec<u64> {
+        array(&document, key)
+            .iter()
+            .map(|v| v.as_u64().unwrap_or(0))
+            .collect()
+    };
+    let (timings, amplitudes) = (integers("/timings"), integers("/amplitudes"));
+    let lifted = amplitudes.iter().filter(|&&a| a == 1).count();
+    Ok(android_reading(timings.into_iter().zip(amplitudes), lifted))
+}
+
+/// The XML read back: it holds the entries of the waveform JSON, the steps of the model's glugs
+/// ([`android_steps`]), which are read from them.
+fn read_back_xml(clip: &WrittenClip) -> Result<Reading, OutputError> {
+    let steps = android_steps(clip.source);
+    let lifted = steps.iter().filter(|s| s.amplitude == 1).count();
+    Ok(android_reading(
+        steps.iter().map(|s| (s.duration_ms, s.amplitude as u64)),
+        lifted,
+    ))
 }

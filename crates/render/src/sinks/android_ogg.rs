@@ -5,14 +5,34 @@
 //! playback). The haptic channel holds the glug; the audio channel the glug or silence
 //! ([`AudioChannels`]). Encoded by libvorbis (aoTuV) through `vorbis_rs`; lossy.
 
+#[cfg(feature = "ogg")]
 use std::fs::File;
+#[cfg(feature = "ogg")]
 use std::io::{BufWriter, Write};
+#[cfg(feature = "ogg")]
 use std::num::{NonZeroU32, NonZeroU8};
 
+#[cfg(feature = "ogg")]
 use vorbis_rs::{VorbisBitrateManagementStrategy, VorbisEncoder, VorbisEncoderBuilder};
 
-use super::{AudioChannels, OutputError, PendingFile, Sink, SinkContext};
+#[cfg(feature = "ogg")]
+use super::{AudioChannels, PendingFile};
+use super::{OutputError, OutputFormat, Sink, SinkContext};
+use crate::fidelity::{no_limits, ReadBack};
+#[cfg(feature = "ogg")]
 use crate::RenderSummary;
+
+/// `.ogg`: Android's haptic-coupled Ogg Vorbis (feature `ogg`; a build without it refuses one
+/// by name).
+pub(super) const FORMAT: OutputFormat = OutputFormat {
+    name: "android-ogg",
+    extension: "ogg",
+    by_extension: true,
+    built: cfg!(feature = "ogg"),
+    open,
+    read_back: Some(ReadBack::Waveform { limits: no_limits }),
+    carries_c: "the waveform on the haptic channel, Vorbis-coded (lossy)",
+};
 
 /// The Vorbis comment that counts the haptic channels (the last channels of the stream).
 pub const ANDROID_HAPTIC_TAG: &str = "ANDROID_HAPTIC";
@@ -22,10 +42,21 @@ pub const ANDROID_OGG_CHANNELS: u8 = 2;
 
 /// Vorbis' quality (−0.2..1): 0.9 keeps the glug's 80–300 Hz within a fraction of a dB; the
 /// file is still a tenth of a 16-bit WAV's size.
+#[cfg(feature = "ogg")]
 const QUALITY: f32 = 0.9;
 
+/// Without the `ogg` feature an `.ogg` is refused by name, not taken for an unknown format.
+#[cfg(not(feature = "ogg"))]
+fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
+    Err(OutputError::Ogg {
+        path: context.path.to_owned(),
+        message: "this build writes no Ogg Vorbis (feature `ogg`)".into(),
+    })
+}
+
 /// The sink of an `android-ogg` output.
-pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
+#[cfg(feature = "ogg")]
+fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
     let path = context.path;
     let file = PendingFile::beside(path, "").map_err(OutputError::io(path))?;
     let writer = file.writer().map_err(OutputError::io(path))?;
@@ -62,6 +93,7 @@ pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, O
 }
 
 /// An Ogg Vorbis stream being written to its temporary file.
+#[cfg(feature = "ogg")]
 struct OggFile {
     file: PendingFile,
     encoder: VorbisEncoder<BufWriter<File>>,
@@ -70,6 +102,7 @@ struct OggFile {
     silence: Vec<f32>,
 }
 
+#[cfg(feature = "ogg")]
 impl OggFile {
     fn error(&self) -> impl FnOnce(vorbis_rs::VorbisError) -> OutputError + '_ {
         |e| OutputError::Ogg {
@@ -79,6 +112,7 @@ impl OggFile {
     }
 }
 
+#[cfg(feature = "ogg")]
 impl Sink for OggFile {
     fn samples(&mut self, block: &[f32]) -> Result<(), OutputError> {
         self.silence.resize(block.len(), 0.0);

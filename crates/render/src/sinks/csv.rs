@@ -6,7 +6,8 @@ use std::fmt::Write as _;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 
-use super::{OutputError, PendingFile, Sink, SinkContext};
+use super::{OutputError, OutputFormat, PendingFile, Sink, SinkContext};
+use crate::fidelity::{no_limits, ReadBack};
 use crate::RenderSummary;
 
 /// How much text is gathered before it is written: large enough that the writer sees few
@@ -51,6 +52,17 @@ fn write_timed_samples(
     }
     out.write_all(block.as_bytes())
 }
+
+/// `.csv`: one sample per line, no header (Syntacts' format).
+pub(super) const FORMAT: OutputFormat = OutputFormat {
+    name: "csv",
+    extension: "csv",
+    by_extension: true,
+    built: true,
+    open,
+    read_back: Some(ReadBack::Waveform { limits: no_limits }),
+    carries_c: super::wav::WAVEFORM_CARRIES_C,
+};
 
 /// The sink of a `.csv` output.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {

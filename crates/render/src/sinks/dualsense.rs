@@ -1,7 +1,8 @@
 //! The DualSense's file (`dualsense`, a 4-channel `.wav`): what the controller plays over USB
 //! audio, 48 kHz, 16-bit, channels 1–2 its speaker/headset audio and 3–4 its left and right
-//! actuators. The actuators get the glug (the render's own samples), the audio channels the
-//! glug or silence, by [`AudioChannels`].
+//! actuators. The actuators get the glug (the render's own samples at 48 kHz; a scene at another
+//! rate is resampled, [`Resample`]), the audio channels the glug or silence, by
+//! [`AudioChannels`].
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -9,11 +10,38 @@ use std::path::Path;
 
 use hound::{SampleFormat, WavSpec, WavWriter};
 
-use super::{OutputError, PendingFile, Sink, SinkContext};
-use crate::RenderSummary;
+use super::{OutputError, OutputFormat, PendingFile, Sink, SinkContext};
+use crate::fidelity::ReadBack;
+use crate::resample::Resample;
+use crate::{RenderSummary, Scene};
+
+/// `dualsense` (`.wav`): 4 channels at 48 kHz (another rate resampled), the DualSense's audio
+/// and actuators.
+pub(super) const FORMAT: OutputFormat = OutputFormat {
+    name: "dualsense",
+    extension: "wav",
+    by_extension: false,
+    built: true,
+    open,
+    read_back: Some(ReadBack::Waveform { limits }),
+    carries_c: "the waveform on both actuators (c·a at f1, (1 − c)·a at f2), 16-bit",
+};
 
 /// The rate the controller's USB audio interface runs at.
 pub const DUALSENSE_RATE_HZ: u32 = 48_000;
+
+/// What the controller took of a scene's render: its samples, resampled if the scene is not at
+/// 48 kHz.
+fn limits(scene: &Scene) -> String {
+    if scene.sample_rate == DUALSENSE_RATE_HZ {
+        "48 kHz, the scene's own rate (another is resampled: rubato's FFT resampler)".to_owned()
+    } else {
+        format!(
+            "48 kHz, resampled from the scene's {} Hz (rubato's FFT resampler)",
+            scene.sample_rate
+        )
+    }
+}
 
 /// Its channels: audio left and right, then the left and right actuator.
 pub const DUALSENSE_CHANNELS: u16 = 4;
@@ -53,21 +81,15 @@ const FRAME_BYTES: u64 = DUALSENSE_CHANNELS as u64 * 2;
 /// header).
 const MAX_FRAMES: u64 = (u32::MAX as u64 - 1024) / FRAME_BYTES;
 
-/// The sink of a `dualsense` output: refused up front for a scene not rendered at 48 kHz (the
-/// controller plays nothing else, and the render's own samples are what it should play, not a
-/// resampled copy), or too long for a WAV file.
+/// The sink of a `dualsense` output: refused up front if too long for a WAV file. A scene at
+/// 48 kHz gives the controller its own samples; one at another rate is resampled to 48 kHz.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
     let (path, scene) = (context.path, context.scene);
-    if scene.sample_rate != DUALSENSE_RATE_HZ {
-        return Err(OutputError::WrongRate {
-            path: path.to_owned(),
-            format: "dualsense",
-            needed_hz: DUALSENSE_RATE_HZ,
-            scene_hz: scene.sample_rate,
-        });
-    }
     if let Some(samples) = scene.duration_samples() {
-        check_length(path, samples)?;
+        check_length(
+            path,
+            Resample::output_len(scene.sample_rate, DUALSENSE_RATE_HZ, samples),
+        )?;
     }
     let file = PendingFile::beside(path, "").map_err(OutputError::io(path))?;
     let writer = file.writer().map_err(OutputError::io(path))?;
@@ -83,6 +105,8 @@ pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, O
         writer,
         audio: context.options.platforms.audio_channels,
         frames: 0,
+        resample: (scene.sample_rate != DUALSENSE_RATE_HZ)
+            .then(|| Resample::new(scene.sample_rate, DUALSENSE_RATE_HZ)),
     }))
 }
 
@@ -92,7 +116,7 @@ fn check_length(path: &Path, frames: u64) -> Result<(), OutputError> {
     }
     Err(OutputError::TooLongFor {
         path: path.to_owned(),
-        format: "dualsense",
+        format: FORMAT.name,
         max_s: MAX_FRAMES as f64 / DUALSENSE_RATE_HZ as f64,
     })
 }
@@ -111,37 +135,90 @@ struct DualSenseFile {
     file: PendingFile,
     writer: WavWriter<BufWriter<File>>,
     audio: AudioChannels,
+    /// Frames written.
     frames: u64,
+    /// The render's samples on their way to 48 kHz, for a scene at another rate.
+    resample: Option<Resample>,
 }
 
 /// A sample in [−1, 1] as a 16-bit integer, rounded and saturated as the mono WAV's s16.
-fn to_i16(sample: f32) -> i16 {
-    (sample as f64 * 32_768.0)
-        .round()
-        .clamp(-32_768.0, 32_767.0) as i16
+fn to_i16(sample: f64) -> i16 {
+    (sample * 32_768.0).round().clamp(-32_768.0, 32_767.0) as i16
+}
+
+/// Writes a frame for each of `samples` (at 48 kHz): the glug on the actuators, the audio as
+/// `audio` says.
+fn write_frames(
+    writer: &mut WavWriter<BufWriter<File>>,
+    path: &Path,
+    audio: AudioChannels,
+    frames: &mut u64,
+    samples: impl ExactSizeIterator<Item = f64>,
+) -> Result<(), OutputError> {
+    *frames += samples.len() as u64;
+    check_length(path, *frames)?;
+    let mut out = writer.get_i16_writer(samples.len() as u32 * 4);
+    for sample in samples {
+        let glug = to_i16(sample);
+        let audio = match audio {
+            AudioChannels::Silent => 0,
+            AudioChannels::Glug => glug,
+        };
+        for channel in [audio, audio, glug, glug] {
+            out.write_sample(channel);
+        }
+    }
+    out.flush().map_err(encode_error(path))
 }
 
 impl Sink for DualSenseFile {
     fn samples(&mut self, block: &[f32]) -> Result<(), OutputError> {
-        self.frames += block.len() as u64;
-        check_length(self.file.path(), self.frames)?;
-        let path = self.file.path().to_owned();
-        let mut frames = self.writer.get_i16_writer(block.len() as u32 * 4);
-        for &sample in block {
-            let glug = to_i16(sample);
-            let audio = match self.audio {
-                AudioChannels::Silent => 0,
-                AudioChannels::Glug => glug,
-            };
-            for channel in [audio, audio, glug, glug] {
-                frames.write_sample(channel);
-            }
+        let Self {
+            file,
+            writer,
+            audio,
+            frames,
+            resample,
+        } = self;
+        let path = file.path();
+        let mut write =
+            |samples: &[f64]| write_frames(writer, path, *audio, frames, samples.iter().copied());
+        match resample {
+            None => write_frames(
+                writer,
+                path,
+                *audio,
+                frames,
+                block.iter().map(|&y| f64::from(y)),
+            ),
+            Some(resample) => resample.push(block, &mut write),
         }
-        frames.flush().map_err(encode_error(&path))
+    }
+
+    fn memory_bytes(&self) -> u64 {
+        self.resample.as_ref().map_or(0, Resample::memory_bytes)
     }
 
     fn finish(self: Box<Self>, _: &RenderSummary) -> Result<PendingFile, OutputError> {
-        let Self { file, writer, .. } = *self;
+        let Self {
+            file,
+            mut writer,
+            audio,
+            mut frames,
+            resample,
+        } = *self;
+        if let Some(resample) = resample {
+            let path = file.path();
+            resample.finish(&mut |samples: &[f64]| {
+                write_frames(
+                    &mut writer,
+                    path,
+                    audio,
+                    &mut frames,
+                    samples.iter().copied(),
+                )
+            })?;
+        }
         writer.finalize().map_err(encode_error(file.path()))?;
         Ok(file)
     }

@@ -4,8 +4,20 @@
 
 use serde::Serialize;
 
-use super::{ClipSink, OutputError, Sink, SinkContext};
+use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
 use crate::clips::{clip_end_s, clip_onsets, envelope_breakpoints, ClipSource};
+use crate::fidelity::{array, linear, number, ReadBack, Reading, WrittenClip};
+
+/// `.haps`: an Interhaptics / Razer Haptic Composer file (version 5).
+pub(super) const FORMAT: OutputFormat = OutputFormat {
+    name: "haps",
+    extension: "haps",
+    by_extension: true,
+    built: true,
+    open,
+    read_back: Some(ReadBack::Clip(read_back)),
+    carries_c: "frequency keyframes in Hz (the felt frequency, c·f1 + (1 − c)·f2 weighted)",
+};
 
 /// Memory a glug takes until the file is written: the glug, its keyframes and their text.
 const BYTES_PER_GLUG: u64 = 1536;
@@ -180,4 +192,26 @@ pub fn haps_json(source: &ClipSource) -> String {
         m_gain: 1.0,
     };
     serde_json::to_string(&file).expect("numbers and strings serialize")
+}
+
+/// The file read back: each note's start as an onset, its amplitude keyframes as the envelope.
+fn read_back(clip: &WrittenClip) -> Result<Reading, OutputError> {
+    let document = clip.json()?;
+    let notes = array(&document, "/m_vibration/m_melodies/0/m_notes");
+    let mut points = Vec::new();
+    for note in notes {
+        let start = number(note, "m_startingPoint");
+        for keyframe in array(note, "/m_hapticEffect/m_amplitudeModulation/m_keyframes") {
+            points.push((
+                start + number(keyframe, "m_time"),
+                number(keyframe, "m_value"),
+            ));
+        }
+    }
+    Ok(Reading {
+        from_mark_before: false,
+        onsets: notes.iter().map(|n| number(n, "m_startingPoint")).collect(),
+        limits: format!("{} notes, {} keyframes", notes.len(), points.len()),
+        envelope: linear(points),
+    })
 }

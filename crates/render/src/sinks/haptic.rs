@@ -3,10 +3,22 @@
 
 use serde::Serialize;
 
-use super::{ClipSink, OutputError, Sink, SinkContext};
+use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
 use crate::clips::{
     clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, transient_intensity,
     ClipSource, HapticBand,
+};
+use crate::fidelity::{array, linear, number, ReadBack, Reading, WrittenClip};
+
+/// `.haptic`: a Meta Haptics Studio 1.0 clip.
+pub(super) const FORMAT: OutputFormat = OutputFormat {
+    name: "haptic",
+    extension: "haptic",
+    by_extension: true,
+    built: true,
+    open,
+    read_back: Some(ReadBack::Clip(read_back)),
+    carries_c: "emphasis and envelope frequency (the felt frequency on the band: 1 − c by default)",
 };
 
 /// The sink of a `.haptic` output, its frequencies on the band of the options.
@@ -168,4 +180,25 @@ pub fn haptic_json(source: &ClipSource, band: &HapticBand) -> String {
         },
     };
     serde_json::to_string_pretty(&file).expect("a clip of plain numbers and strings serializes")
+}
+
+/// The clip read back: its emphases as onsets, its amplitude breakpoints as the envelope.
+fn read_back(clip: &WrittenClip) -> Result<Reading, OutputError> {
+    let document = clip.json()?;
+    let points = array(&document, "/signals/continuous/envelopes/amplitude");
+    Ok(Reading {
+        from_mark_before: false,
+        onsets: points
+            .iter()
+            .filter(|p| p.get("emphasis").is_some())
+            .map(|p| number(p, "time"))
+            .collect(),
+        envelope: linear(
+            points
+                .iter()
+                .map(|p| (number(p, "time"), number(p, "amplitude")))
+                .collect(),
+        ),
+        limits: format!("{} breakpoints", points.len()),
+    })
 }

@@ -7,19 +7,19 @@
 //! WAV or CSV streams its samples to disk and keeps no units, the tables stream their rows; the
 //! clips keep the glugs.
 //!
-//! Every format is one entry of [`OutputFormat::ALL`]: adding one is a file here with its sink
-//! and an `open` function, and an entry in that table.
+//! Every format is declared whole by its own file here, as a `FORMAT` ([`OutputFormat`]): its
+//! name, its extension and whether that picks it, its sink, how the fidelity report reads it
+//! back, what carries c in it, and its platform's limits (as constants beside it). Adding one is
+//! that file and an entry in [`OutputFormat::ALL`]; nothing else knows a format by name.
 
 mod ahap;
 mod android;
-#[cfg(feature = "ogg")]
 mod android_ogg;
 mod clip;
 mod csv;
 mod dualsense;
 mod haps;
 mod haptic;
-#[cfg(feature = "plot")]
 mod plot;
 mod rumble;
 mod state;
@@ -29,29 +29,27 @@ mod wav;
 use std::path::{Path, PathBuf};
 
 use super::clips::HapticBand;
+use super::fidelity::ReadBack;
 use super::memory::human_bytes;
 use super::render::{BottleReport, RenderError, RenderSummary};
 use super::scene::Scene;
 use super::tables::{StateRate, StateRateError};
-#[cfg(feature = "ogg")]
-use android_ogg::open as open_ogg;
 use clip::ClipSink;
-#[cfg(feature = "plot")]
-use plot::open as open_plot;
 use sake_glug_engine::{UnitOnset, Voicing};
 pub(crate) use sake_glug_io::{remove_own_temps, remove_stale_temps, PendingFile};
 
-pub use ahap::ahap_json;
+pub use ahap::{ahap_json, CORE_HAPTICS_MAX_EVENT_S};
 pub use android::{android_waveform_json, android_xml};
-#[cfg(feature = "ogg")]
 pub use android_ogg::{ANDROID_HAPTIC_TAG, ANDROID_OGG_CHANNELS};
 pub use csv::{write_csv_samples, TIMED_SAMPLE_COLUMNS};
 pub use dualsense::{AudioChannels, DUALSENSE_CHANNELS, DUALSENSE_RATE_HZ};
 pub use haps::{haps_json, HAPS_VERSION};
 pub use haptic::haptic_json;
 #[cfg(feature = "plot")]
-pub use plot::{draw_pour_plot, PlotData, PlotError, Waveform};
-pub use rumble::rumble_json;
+pub use plot::{draw_pour_plot, PlotData, Waveform};
+pub use rumble::{rumble_json, DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
+#[cfg(feature = "plot")]
+pub use sake_glug_plot::PlotError;
 pub use wav::{SampleFormat, WavError};
 
 /// One file of a render, written from the render's single pass. Every method but
@@ -99,49 +97,60 @@ pub(crate) struct SinkContext<'a> {
 /// Opens the sink of one format, refusing up front what it knows it cannot write.
 type OpenSink = for<'a> fn(SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError>;
 
-/// A kind of file a render writes: its name in `--formats` and `-o NAME:PATH`, the extension of
-/// its files, whether that extension alone picks it, and how its sink is opened.
+/// A kind of file a render writes, as its own file declares it (its `FORMAT`).
 #[derive(Clone, Copy)]
 pub struct OutputFormat {
+    /// Its name in `--formats` and `-o NAME:PATH`.
     name: &'static str,
+    /// The extension of its files, without the dot.
     extension: &'static str,
     /// Picked by its extension: false for a format that shares its extension with another (a
     /// table in `.csv`, a 4-channel `.wav`), which is picked only by its name.
     by_extension: bool,
+    /// Whether this build writes it: false for one behind a feature the build lacks, whose
+    /// `open` refuses it by name.
+    built: bool,
+    /// How its sink is opened.
     open: OpenSink,
+    /// How the fidelity report reads it back; `None` for a file not played (the plot, the
+    /// tables), which it does not measure.
+    read_back: Option<ReadBack>,
+    /// What carries the viscosity c in it, in the fidelity table's words ("—" if not played).
+    carries_c: &'static str,
 }
 
 impl OutputFormat {
     /// `.wav`: the mono output, for an actuator driven from an audio interface.
-    pub const WAV: Self = Self::new("wav", "wav", wav::open);
+    pub const WAV: Self = wav::FORMAT;
     /// `.haptic`: a Meta Haptics Studio 1.0 clip.
-    pub const HAPTIC: Self = Self::new("haptic", "haptic", haptic::open);
+    pub const HAPTIC: Self = haptic::FORMAT;
     /// `.ahap`: an Apple Core Haptics pattern.
-    pub const AHAP: Self = Self::new("ahap", "ahap", ahap::open);
+    pub const AHAP: Self = ahap::FORMAT;
     /// `.csv`: one sample per line, no header (Syntacts' format).
-    pub const CSV: Self = Self::new("csv", "csv", csv::open);
+    pub const CSV: Self = csv::FORMAT;
     /// `.png`: the pour plot (feature `plot`; a build without it refuses a plot by name).
-    pub const PLOT: Self = Self::new("png", "png", open_plot);
+    pub const PLOT: Self = plot::FORMAT;
     /// `units` (`.csv`): one row per glug unit (MODEL.md §14).
-    pub const UNITS: Self = Self::named("units", "csv", units::open);
+    pub const UNITS: Self = units::FORMAT;
     /// `state` (`.csv`): the bottle at the state rate (MODEL.md §14).
-    pub const STATE: Self = Self::named("state", "csv", state::open);
+    pub const STATE: Self = state::FORMAT;
     /// `.xml`: Android's vibration XML (`VibrationXmlParser`).
-    pub const ANDROID_XML: Self = Self::new("android-xml", "xml", android::open_xml);
+    pub const ANDROID_XML: Self = android::XML_FORMAT;
     /// `android-waveform` (`.json`): the arrays of Android's `VibrationEffect.createWaveform`.
-    pub const ANDROID_WAVEFORM: Self =
-        Self::named("android-waveform", "json", android::open_waveform);
+    pub const ANDROID_WAVEFORM: Self = android::WAVEFORM_FORMAT;
     /// `rumble` (`.json`): frames of a dual-rumble gamepad's two motors.
-    pub const RUMBLE: Self = Self::named("rumble", "json", rumble::open);
+    pub const RUMBLE: Self = rumble::FORMAT;
     /// `.haps`: an Interhaptics / Razer Haptic Composer file (version 5).
-    pub const HAPS: Self = Self::new("haps", "haps", haps::open);
-    /// `dualsense` (`.wav`): 4 channels at 48 kHz, the DualSense's audio and actuators.
-    pub const DUALSENSE: Self = Self::named("dualsense", "wav", dualsense::open);
+    pub const HAPS: Self = haps::FORMAT;
+    /// `dualsense` (`.wav`): 4 channels at 48 kHz (another rate resampled), the DualSense's audio
+    /// and actuators.
+    pub const DUALSENSE: Self = dualsense::FORMAT;
     /// `.ogg`: Android's haptic-coupled Ogg Vorbis (feature `ogg`; a build without it refuses
     /// one by name).
-    pub const ANDROID_OGG: Self = Self::new("android-ogg", "ogg", open_ogg);
+    pub const ANDROID_OGG: Self = android_ogg::FORMAT;
 
-    /// Every format, in the order a file's extension is looked up.
+    /// Every format, in the order a file's extension is looked up and the fidelity report
+    /// lists them.
     pub const ALL: &'static [Self] = &[
         Self::WAV,
         Self::HAPTIC,
@@ -159,26 +168,6 @@ impl OutputFormat {
         Self::ANDROID_OGG,
     ];
 
-    /// A format its extension picks.
-    const fn new(name: &'static str, extension: &'static str, open: OpenSink) -> Self {
-        Self {
-            name,
-            extension,
-            by_extension: true,
-            open,
-        }
-    }
-
-    /// A format that shares its extension with another: picked only by its name.
-    const fn named(name: &'static str, extension: &'static str, open: OpenSink) -> Self {
-        Self {
-            name,
-            extension,
-            by_extension: false,
-            open,
-        }
-    }
-
     /// Its name, as `--formats` and `-o NAME:PATH` take it.
     pub fn name(self) -> &'static str {
         self.name
@@ -187,6 +176,21 @@ impl OutputFormat {
     /// The extension (without the dot) its files get.
     pub fn extension(self) -> &'static str {
         self.extension
+    }
+
+    /// Whether this build writes it (a format behind a feature the build lacks does not).
+    pub fn is_built(self) -> bool {
+        self.built
+    }
+
+    /// What carries the viscosity c in its file, in the fidelity table's words.
+    pub fn carries_c(self) -> &'static str {
+        self.carries_c
+    }
+
+    /// How the fidelity report reads it back, if it is played.
+    pub(crate) fn read_back(self) -> Option<ReadBack> {
+        self.read_back
     }
 
     /// The name of its file for a scene called `stem` in `--out-dir`: `stem.ext`, or
@@ -314,23 +318,6 @@ fn one_of(items: impl Iterator<Item = String>) -> String {
     }
 }
 
-/// Without the `plot` feature a plot is refused by name, not taken for an unknown format.
-#[cfg(not(feature = "plot"))]
-fn open_plot<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    Err(OutputError::NoPlot {
-        path: context.path.to_owned(),
-    })
-}
-
-/// Without the `ogg` feature an `.ogg` is refused by name, not taken for an unknown format.
-#[cfg(not(feature = "ogg"))]
-fn open_ogg<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    Err(OutputError::Ogg {
-        path: context.path.to_owned(),
-        message: "this build writes no Ogg Vorbis (feature `ogg`)".into(),
-    })
-}
-
 /// How the files of a render are written.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct OutputOptions {
@@ -349,7 +336,7 @@ pub struct OutputOptions {
 /// How the platform formats are written.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlatformOptions {
-    /// Frames a second of a `rumble` file ([`crate::steps::RUMBLE_RATE_RANGE_HZ`]).
+    /// Frames a second of a `rumble` file ([`RUMBLE_RATE_RANGE_HZ`]).
     pub rumble_rate_hz: f64,
     /// What the audio channels of a `dualsense` or `android-ogg` file hold.
     pub audio_channels: AudioChannels,
@@ -358,7 +345,7 @@ pub struct PlatformOptions {
 impl Default for PlatformOptions {
     fn default() -> Self {
         Self {
-            rumble_rate_hz: crate::steps::DEFAULT_RUMBLE_RATE_HZ,
+            rumble_rate_hz: DEFAULT_RUMBLE_RATE_HZ,
             audio_channels: AudioChannels::default(),
         }
     }
@@ -416,21 +403,18 @@ pub enum OutputError {
     /// A `state` table's rate does not fit the render.
     #[error(transparent)]
     StateRate(#[from] StateRateError),
-    /// A format plays at one sample rate only, and the scene renders at another.
+    /// A rumble rate the platforms do not take.
     #[error(
-        "{}: a {format} file plays at {needed_hz} Hz, and the scene renders at {scene_hz} Hz; \
-         render it at {needed_hz} Hz (--sample-rate {needed_hz}, or sample_rate in the scene)",
-        path.display()
+        "{}: a rumble file of {rate_hz} frames a second; give a rate from {} to {} Hz",
+        path.display(),
+        RUMBLE_RATE_RANGE_HZ.start(),
+        RUMBLE_RATE_RANGE_HZ.end()
     )]
-    WrongRate {
+    RumbleRate {
         /// The file asked for.
         path: PathBuf,
-        /// The format's name.
-        format: &'static str,
-        /// The rate it plays at (Hz).
-        needed_hz: u32,
-        /// The scene's rate (Hz).
-        scene_hz: u32,
+        /// The rate asked for (Hz).
+        rate_hz: f64,
     },
     /// The Ogg Vorbis encoder refused, or this build has none.
     #[error("cannot write {}: {message}", path.display())]
@@ -489,6 +473,28 @@ impl OutputError {
         move |source| Self::Io {
             path: path.to_owned(),
             source,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each format's declaration stands on its own: its name finds it, an extension that picks
+    /// it picks nothing else, and it says what carries c exactly when it is played.
+    #[test]
+    fn every_format_declares_itself_whole() {
+        for &format in OutputFormat::ALL {
+            assert_eq!(OutputFormat::of_name(format.name()), Some(format));
+            if format.by_extension {
+                assert_eq!(OutputFormat::of_extension(format.extension), Some(format));
+            }
+            assert_eq!(
+                format.read_back().is_some(),
+                format.carries_c() != "—",
+                "{format:?}"
+            );
         }
     }
 }

@@ -3,16 +3,45 @@
 
 use serde::Serialize;
 
-use super::{ClipSink, OutputError, Sink, SinkContext};
+use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
 use crate::clips::{clip_onsets, ClipSource};
+use crate::fidelity::{array, held, number, ReadBack, Reading, WrittenClip};
 use crate::steps::rumble_frames;
+
+/// `rumble` (`.json`): frames of a dual-rumble gamepad's two motors.
+pub(super) const FORMAT: OutputFormat = OutputFormat {
+    name: "rumble",
+    extension: "json",
+    by_extension: false,
+    built: true,
+    open,
+    read_back: Some(ReadBack::Clip(read_back)),
+    carries_c: "the motors' balance: low = the f1 part (c·a), high = the f2 part ((1 − c)·a)",
+};
+
+/// The default frame rate (Hz): 10 ms, the step of the Android entries and about the fastest a
+/// rumble motor's speed is worth updating (SDL and the browsers send the controller a new
+/// state at most every few milliseconds).
+pub const DEFAULT_RUMBLE_RATE_HZ: f64 = 100.0;
+
+/// The frame rates a rumble file takes (Hz): at least one frame a second, at most one a
+/// millisecond.
+pub const RUMBLE_RATE_RANGE_HZ: std::ops::RangeInclusive<f64> = 1.0..=1000.0;
 
 /// Memory a glug takes until the file is written: the glug and its frames' text (8 frames at
 /// 100 Hz between glugs 80 ms apart, ~45 bytes each).
 const BYTES_PER_GLUG: u64 = 1024;
 
-/// The sink of a `rumble` output, at the frame rate of the options.
+/// The sink of a `rumble` output, at the frame rate of the options: one outside
+/// [`RUMBLE_RATE_RANGE_HZ`] is refused.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
+    let rate_hz = context.options.platforms.rumble_rate_hz;
+    if !RUMBLE_RATE_RANGE_HZ.contains(&rate_hz) {
+        return Err(OutputError::RumbleRate {
+            path: context.path.to_owned(),
+            rate_hz,
+        });
+    }
     ClipSink::open(
         context,
         |source, options| rumble_json(source, options.platforms.rumble_rate_hz),
@@ -65,4 +94,30 @@ pub fn rumble_json(source: &ClipSource, rate_hz: f64) -> String {
         frames,
     };
     serde_json::to_string(&rumble).expect("numbers and a string serialize")
+}
+
+/// The file read back: each frame held for its period (both motors' sum), a glug showing from
+/// the start of the frame that carries it.
+fn read_back(clip: &WrittenClip) -> Result<Reading, OutputError> {
+    let document = clip.json()?;
+    let rate_hz = number(&document, "rate_hz");
+    let frames = array(&document, "/frames");
+    let period_s = 1.0 / rate_hz;
+    let spans: Vec<(f64, f64, f64)> = frames
+        .iter()
+        .map(|f| {
+            let start = number(f, "t_ms") / 1000.0;
+            (
+                start,
+                start + period_s,
+                number(f, "low") + number(f, "high"),
+            )
+        })
+        .collect();
+    Ok(Reading {
+        onsets: spans.iter().map(|span| span.0).collect(),
+        from_mark_before: true,
+        limits: format!("{} frames at {rate_hz} Hz", frames.len()),
+        envelope: held(spans),
+    })
 }

@@ -5,10 +5,21 @@ use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 
-use super::{OutputError, PendingFile, Sink, SinkContext};
+use super::{OutputError, OutputFormat, PendingFile, Sink, SinkContext};
 use crate::render::BottleReport;
 use crate::tables::{csv_header, write_row, StateRow, StateSchedule};
 use crate::RenderSummary;
+
+/// `state` (`.csv`): the bottle at the state rate (MODEL.md §14); read by programs, not played.
+pub(super) const FORMAT: OutputFormat = OutputFormat {
+    name: "state",
+    extension: "csv",
+    by_extension: false,
+    built: true,
+    open,
+    read_back: None,
+    carries_c: "—",
+};
 
 /// The sink of a `state` output; a rate above the scene's sample rate is refused here.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {

@@ -4,10 +4,21 @@
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 
-use super::{OutputError, PendingFile, Sink, SinkContext};
+use super::{OutputError, OutputFormat, PendingFile, Sink, SinkContext};
 use crate::tables::{csv_header, write_row, UnitRow};
 use crate::RenderSummary;
 use sake_glug_engine::{UnitOnset, Voicing};
+
+/// `units` (`.csv`): one row per glug unit (MODEL.md §14); read by programs, not played.
+pub(super) const FORMAT: OutputFormat = OutputFormat {
+    name: "units",
+    extension: "csv",
+    by_extension: false,
+    built: true,
+    open,
+    read_back: None,
+    carries_c: "—",
+};
 
 /// The sink of a `units` output.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {

@@ -10,8 +10,23 @@ use std::path::{Path, PathBuf};
 
 use hound::{SampleFormat as HoundFormat, WavSpec, WavWriter};
 
-use super::{OutputError, PendingFile, Sink, SinkContext};
+use super::{OutputError, OutputFormat, PendingFile, Sink, SinkContext};
+use crate::fidelity::{no_limits, ReadBack};
 use crate::RenderSummary;
+
+/// `.wav`: the mono output, for an actuator driven from an audio interface.
+pub(super) const FORMAT: OutputFormat = OutputFormat {
+    name: "wav",
+    extension: "wav",
+    by_extension: true,
+    built: true,
+    open,
+    read_back: Some(ReadBack::Waveform { limits: no_limits }),
+    carries_c: WAVEFORM_CARRIES_C,
+};
+
+/// What carries c in a file of the render's samples: the samples themselves.
+pub(super) const WAVEFORM_CARRIES_C: &str = "the waveform itself (c·a at f1, (1 − c)·a at f2)";
 
 /// The sink of a `.wav` output.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
