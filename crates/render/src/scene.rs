@@ -12,8 +12,8 @@ use sake_glug_device::midi::{MidiMap, MidiSetting};
 use sake_glug_device::midi_take::{read_midi_take, TakeError, TimedInput, MAX_TAKE_BYTES};
 use sake_glug_engine::config;
 use sake_glug_engine::{
-    Constant, Control, ControlSource, ControlValues, Controls, Curve, DrainMode, ModelConfig,
-    PerControl, Preset, PresetValue, Quantity, Range, ValueError,
+    sample_time_s, Constant, Control, ControlSource, ControlValues, Controls, Curve, DrainMode,
+    ModelConfig, PerControl, Preset, PresetValue, Quantity, Range, ValueError,
 };
 use sake_glug_io::text::printable;
 use sake_glug_model_file::{curve_points, ModelFile};
@@ -369,7 +369,7 @@ impl Scene {
 
     /// The inputs at one sample.
     pub fn values_at(&self, sample: u64) -> ControlValues {
-        let time_s = sample as f64 / self.sample_rate as f64;
+        let time_s = sample_time_s(sample, self.sample_rate as f64);
         ControlValues::from_fn(|control| self.lanes[control].value_at(time_s))
     }
 
