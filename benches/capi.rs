@@ -9,7 +9,7 @@ use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use sake_glug_c::*;
+use sake_glug::*;
 
 const FS: u32 = 48_000;
 

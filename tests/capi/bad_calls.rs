@@ -5,7 +5,7 @@
 
 use std::ptr::null_mut;
 
-use sake_glug_c::*;
+use sake_glug::*;
 use sake_glug_engine::Control;
 
 use super::{last_error, Live};

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use sake_glug_c::SakeGlugControl;
+use sake_glug::SakeGlugControl;
 use sake_glug_engine::Control;
 
 const HEADER: &str = "include/sake_glug.h";
@@ -38,7 +38,7 @@ fn the_committed_header_is_current() {
     );
     for function in ["sake_glug_create", "sake_glug_process", "sake_glug_units"] {
         assert!(
-            committed.contains(&format!(" {function}(")),
+            committed.contains(&format!("{function}(")),
             "{function} is declared"
         );
     }

@@ -11,7 +11,7 @@ mod same_samples;
 
 use std::ffi::CString;
 
-use sake_glug_c::*;
+use sake_glug::*;
 
 /// A handle for the tests, destroyed when dropped.
 pub struct Live(*mut SakeGlug);

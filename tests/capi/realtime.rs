@@ -5,7 +5,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use sake_glug_c::*;
+use sake_glug::*;
 
 use super::allocations::counted;
 use super::Live;
@@ -86,40 +86,52 @@ fn more_units_than_are_kept_are_counted_without_allocating() {
 
 #[test]
 fn control_calls_from_another_thread_meet_process_without_allocating() {
+    // The game's thread queues ten times what the queue holds, waiting whenever it is full; the
+    // audio thread renders until the game is done. Neither makes an allocator call.
+    const CALLS: u64 = 10 * SAKE_GLUG_MAX_QUEUED_CONTROLS as u64;
     let live = Live::paper(48_000.0);
     let shared = Shared(live.raw());
-    let stop = AtomicBool::new(false);
+    let done = AtomicBool::new(false);
     std::thread::scope(|scope| {
-        let game = scope.spawn(|| {
+        let done = &done;
+        let game = scope.spawn(move || {
+            // The whole wrapper, not its field (closures capture fields one by one).
             let shared = shared;
-            let (queued, calls) = counted(|| {
-                let mut queued = 0u64;
-                let mut tilt = 0.0;
-                while !stop.load(Ordering::Relaxed) {
-                    tilt = (tilt + 1.0) % 180.0;
+            let (full, calls) = counted(|| {
+                let (mut queued, mut full) = (0u64, 0u64);
+                while queued < CALLS {
+                    let tilt = (queued % 180) as f64;
                     let status = unsafe {
                         sake_glug_ramp(shared.0, SakeGlugControl::Tilt as i32, tilt, 480)
                     };
                     match status {
                         SakeGlugStatus::Ok => queued += 1,
-                        SakeGlugStatus::QueueFull => std::thread::yield_now(),
+                        SakeGlugStatus::QueueFull => {
+                            full += 1;
+                            std::thread::yield_now();
+                        }
                         other => panic!("{other:?}"),
                     }
                 }
-                queued
+                full
             });
+            done.store(true, Ordering::Release);
             assert_eq!(calls, 0, "allocator calls on the game's thread");
-            queued
+            full
         });
         let mut block = vec![0.0f32; 64];
-        let (_, calls) = counted(|| {
-            for _ in 0..3000 {
+        let (rendered, calls) = counted(|| {
+            let mut rendered = 0u64;
+            while !done.load(Ordering::Acquire) {
                 live.process(&mut block);
+                rendered += 1;
             }
+            live.process(&mut block);
+            rendered
         });
-        stop.store(true, Ordering::Relaxed);
-        assert!(game.join().unwrap() > 0);
+        let full = game.join().unwrap();
         assert_eq!(calls, 0, "allocator calls on the audio thread");
         assert!(block.iter().all(|y| y.is_finite()));
+        eprintln!("{rendered} calls of 64 frames; the queue was found full {full} times");
     });
 }

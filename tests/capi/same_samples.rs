@@ -3,7 +3,7 @@
 //! text as `--model`, a refill as a take's, a reset as a new handle; and the units it reports are
 //! the renderer's.
 
-use sake_glug_c::*;
+use sake_glug::*;
 use sake_glug_engine::{Engine, UnitOnset, Voicing};
 use sake_glug_model_file::ModelFile;
 use sake_glug_render::{render_scene, RenderError, Scene, DEFAULT_SCENE};
@@ -242,11 +242,10 @@ fn the_state_is_the_engines() {
     live.process(&mut block);
     let state = live.state();
     let mut engine = Engine::new(48_000.0, Default::default());
-    let controls = Scene::parse("tilt_deg = 135.0").unwrap().controls(
-        0,
-        &mut sake_glug_render::LaneBuffers::default(),
-        48_000,
-    );
+    let mut lanes = sake_glug_render::LaneBuffers::default();
+    let controls = Scene::parse("tilt_deg = 135.0")
+        .unwrap()
+        .controls(0, &mut lanes, 48_000);
     engine.process(&controls, &mut block);
     assert_eq!(state.position, 48_000);
     assert_eq!(state.volume_ml, engine.volume_ml());
