@@ -258,3 +258,37 @@ fn the_state_is_the_engines() {
     assert_eq!(state.settled, 0);
     assert!(state.outflow_ml_per_s > 0.0 && state.volume_ml < 300.0);
 }
+
+#[test]
+fn a_ramps_every_value_is_its_two_point_lanes() {
+    // The tilt of each sample, as the state reports it after a call of one frame, against the
+    // scene's lane with the ramp's two points, bit for bit: ramps that start anywhere, last any
+    // number of samples and go either way, at rates whose sample times are inexact.
+    for (sample_rate, start, samples, from, to) in [
+        (48_000u32, 0u64, 24_000u64, 90.0, 135.0),
+        (44_100, 12_345, 7_777, 17.3, 151.9),
+        (2_000, 333, 1_001, 170.0, 0.1),
+        (96_000, 5, 3, 45.0, 45.5),
+    ] {
+        let fs = sample_rate as f64;
+        let (t0, t1) = (start as f64 / fs, (start + samples) as f64 / fs);
+        let scene = Scene::parse(&format!(
+            "sample_rate = {sample_rate}\ntilt_deg = [[{t0:?}, {from:?}], [{t1:?}, {to:?}]]\n"
+        ))
+        .unwrap();
+        let live = Live::paper(fs);
+        live.set(SakeGlugControl::Tilt, from);
+        let mut ignored = vec![0.0f32; start as usize];
+        if start > 0 {
+            live.process(&mut ignored);
+        }
+        live.ramp(SakeGlugControl::Tilt, to, samples);
+        let mut one = [0.0f32];
+        for sample in start..start + samples + 3 {
+            live.process(&mut one);
+            let expected = scene.values_at(sample).sanitized().tilt_deg;
+            let tilt = live.state().tilt_deg;
+            assert_eq!(tilt.to_bits(), expected.to_bits(), "{sample_rate} Hz, sample {sample}");
+        }
+    }
+}
