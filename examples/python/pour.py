@@ -102,7 +102,8 @@ def write_wav(path, samples, sample_rate):
 
 def main():
     if len(sys.argv) != 2:
-        sys.exit("usage: pour.py OUT.wav")
+        print("usage: pour.py OUT.wav", file=sys.stderr)
+        sys.exit(2)
     sample_rate = 48000
     write_wav(sys.argv[1], render_pour(load(), sample_rate), sample_rate)
 
