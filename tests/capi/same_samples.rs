@@ -288,7 +288,11 @@ fn a_ramps_every_value_is_its_two_point_lanes() {
             live.process(&mut one);
             let expected = scene.values_at(sample).sanitized().tilt_deg;
             let tilt = live.state().tilt_deg;
-            assert_eq!(tilt.to_bits(), expected.to_bits(), "{sample_rate} Hz, sample {sample}");
+            assert_eq!(
+                tilt.to_bits(),
+                expected.to_bits(),
+                "{sample_rate} Hz, sample {sample}"
+            );
         }
     }
 }

@@ -14,6 +14,8 @@
 //!   stamped with the commit and the machine, and the cost
 //!   figures of docs/scaling.md (callgrind, when valgrind is installed; the render benchmark's
 //!   last report, or a new one with `--bench`).
+//! - `cargo xtask latency`: only the live-latency figures of `cargo xtask docs`
+//!   (docs/latency.md).
 //! - `cargo xtask screenshots`: the editor in a real window (the standalone app under Xvfb), idle
 //!   and while a phone's OSC gravity pours, written to docs/editor-idle.png and
 //!   docs/editor-pouring.png.
@@ -105,6 +107,11 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             build_cli()?;
             docs()?;
             scaling_docs(args.iter().any(|arg| arg == "--bench"))
+        }
+        Some("latency") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            build_cli()?;
+            live_latency()
         }
         Some("fuzz") => {
             nice_plug_xtask::chdir_workspace_root()?;

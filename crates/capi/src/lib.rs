@@ -291,8 +291,8 @@ pub unsafe extern "C" fn sake_glug_reset(glug: *mut SakeGlug) -> SakeGlugStatus 
     unsafe { queue(glug, || Ok(Command::Reset)) }
 }
 
-/// The most frames or units a caller's count may claim: a negative count cast to size_t is far
-/// above it.
+/// A frame count within [`SAKE_GLUG_MAX_FRAMES`] (a negative count cast to size_t is far above
+/// it).
 fn checked_frames(frames: usize) -> Result<(), SakeGlugStatus> {
     if frames > SAKE_GLUG_MAX_FRAMES {
         Err(SakeGlugStatus::InvalidSize)
