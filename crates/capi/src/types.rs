@@ -83,7 +83,7 @@ impl SakeGlugControl {
 }
 
 // The header's controls are the engine's, one for one (the order is checked by name in
-// tests/capi/interface.rs).
+// tests/capi/header.rs).
 const _: () = assert!(SakeGlugControl::ALL.len() == Control::ALL.len());
 
 /// A control's range and default, as the engine declares them.
