@@ -10,9 +10,12 @@ use std::path::{Path, PathBuf};
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// How a repository path starts: one of the top-level folders, or it is a top-level file.
-const FOLDERS: [&str; 11] = [
+const FOLDERS: [&str; 14] = [
     "src/",
     "crates/",
+    "include/",
+    "bindings/",
+    "examples/",
     "fuzz/",
     "tests/",
     "docs/",

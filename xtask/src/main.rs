@@ -1,7 +1,7 @@
 //! `cargo xtask`: nice-plug's bundler, plus the project's two everyday jobs.
 //!
-//! - `cargo xtask pour`: build the plugin bundles, the CLI and the standalone app, and render the
-//!   built-in scene to `pour.wav`. Without the app's libraries (pkg-config's `alsa` and `jack`) it
+//! - `cargo xtask pour`: build the plugin bundles, the CLI, the C library and the standalone app,
+//!   and render the built-in scene to `pour.wav`. Without the app's libraries (pkg-config's `alsa` and `jack`) it
 //!   skips the app and ends with one line naming the `apt-get install` that adds them.
 //! - `cargo xtask test`: every test: formatting and lints, the Rust suites, then the bundles in a
 //!   real VST3 host and the standalone app under a JACK server, then the Python package installed
@@ -9,10 +9,13 @@
 //!   stops at once, naming the `apt-get install`.
 //! - `cargo xtask docs [--bench]`: regenerates every table and picture of docs/ from the current
 //!   code (the accuracy table and plot, the stability report, the pour plot, the presets as
-//!   scene files and VST3 preset files, a VST3 ramp measured in Ardour when it is installed),
+//!   scene files and VST3 preset files, a VST3 ramp measured in Ardour when it is installed, the
+//!   standalone app's live latency under a JACK server when one can run),
 //!   stamped with the commit and the machine, and the cost
 //!   figures of docs/scaling.md (callgrind, when valgrind is installed; the render benchmark's
 //!   last report, or a new one with `--bench`).
+//! - `cargo xtask latency`: only the live-latency figures of `cargo xtask docs`
+//!   (docs/latency.md).
 //! - `cargo xtask screenshots`: the editor in a real window (the standalone app under Xvfb), idle
 //!   and while a phone's OSC gravity pours, written to docs/editor-idle.png and
 //!   docs/editor-pouring.png.
@@ -54,6 +57,7 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             nice_plug_xtask::chdir_workspace_root()?;
             let missing = standalone_missing();
             build_bundles_and_cli()?;
+            build_c_library()?;
             if missing.is_empty() {
                 build_standalone()?;
             }
@@ -84,6 +88,8 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             // Built once, with what the host tests need of it: a study played on JACK and ALSA.
             build_cli_with("ogg,audio")?;
             build_standalone()?;
+            // The C library that the examples of examples/ link (tests/host/test_capi.py).
+            build_c_library()?;
             host_tests()?;
             python_tests()
         }
@@ -103,6 +109,11 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             docs()?;
             scaling_docs(args.iter().any(|arg| arg == "--bench"))?;
             pictures_not_regenerated(started)
+        }
+        Some("latency") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            build_cli()?;
+            live_latency()
         }
         Some("fuzz") => {
             nice_plug_xtask::chdir_workspace_root()?;
@@ -197,6 +208,12 @@ fn build_standalone() -> nice_plug_xtask::Result<()> {
         "--features",
         "standalone",
     ])
+}
+
+/// The C library (crates/capi): target/release/libsake_glug.so and libsake_glug.a, for
+/// include/sake_glug.h.
+fn build_c_library() -> nice_plug_xtask::Result<()> {
+    cargo(&["build", "--release", "--package", "sake-glug-c"])
 }
 
 /// The release command line alone, with its default features.
@@ -295,7 +312,48 @@ fn docs() -> nice_plug_xtask::Result<()> {
             "docs/pour-plot.png",
         ],
     )?;
-    vst3_ramp_figures()
+    vst3_ramp_figures()?;
+    live_latency()
+}
+
+/// docs/latency.md's figures: the standalone app under a JACK server with 64-frame periods,
+/// timed from a tilt message to its effect by tests/host/latency.py (a JACK client in Python:
+/// nothing here links libjack); kept, with a line saying so, where it cannot run.
+fn live_latency() -> nice_plug_xtask::Result<()> {
+    let python = ".venv/bin/python";
+    let missing = standalone_missing();
+    let has_jackd = Command::new("jackd").arg("--version").output().is_ok();
+    if !missing.is_empty() || !has_jackd || !Path::new(python).exists() {
+        println!(
+            "docs/latency.md: live-latency kept: it needs the standalone app's libraries, jackd \
+             (`sudo apt-get install libasound2-dev libjack-jackd2-dev jackd2`) and the host \
+             tests' .venv (`cargo xtask test` makes it)"
+        );
+        return Ok(());
+    }
+    build_standalone()?;
+    println!("live latency: a few hundred tilt messages through JACK (a few minutes)");
+    let started = std::time::Instant::now();
+    let app = target_dir().join("release/sake-glug-standalone");
+    let figures = output(
+        python,
+        &[
+            "tests/host/latency.py",
+            "--app",
+            &app.to_string_lossy(),
+            "--cli",
+            &cli(),
+        ],
+    )?;
+    let latency_stamp = stamp(started.elapsed());
+    replace_block(
+        "docs/latency.md",
+        "live-latency",
+        &format!(
+            "{latency_stamp}
+{figures}"
+        ),
+    )
 }
 
 /// The pictures of docs/ that `cargo xtask docs` does not draw, and the command that does.

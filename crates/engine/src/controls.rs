@@ -309,6 +309,32 @@ impl Lane<'_> {
     }
 }
 
+/// A lane's straight line between two automation points `(time_s, value)` (MODEL.md §10): the
+/// one interpolation that a scene's lanes and the C library's ramps both compute, so that a ramp
+/// gives the samples of the two-point lane it stands for, bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinearSegment {
+    /// The earlier point.
+    pub start: (f64, f64),
+    /// The later point; at its time and after, the lane holds its value.
+    pub end: (f64, f64),
+}
+
+impl LinearSegment {
+    /// The value on the line at `time_s`, for a time from the start's up to (not at) the end's.
+    #[inline]
+    pub fn value_at(&self, time_s: f64) -> f64 {
+        let ((t0, v0), (t1, v1)) = (self.start, self.end);
+        v0 + (v1 - v0) * (time_s - t0) / (t1 - t0)
+    }
+}
+
+/// The time of sample `sample` (s) at `sample_rate` (Hz): the time a lane is read at.
+#[inline]
+pub fn sample_time_s(sample: u64, sample_rate: f64) -> f64 {
+    sample as f64 / sample_rate
+}
+
 /// The automatable inputs of the model for one block (MODEL.md §1, §5, §6).
 pub type Controls<'a> = PerControl<Lane<'a>>;
 

@@ -18,7 +18,8 @@ pub mod synthesis;
 pub use amplitude::{SilentBelow, PAPERS_SILENT_BELOW_ML};
 pub use config::{Constant, ConstantSpec, Curve, DrainMode, ModelConfig};
 pub use controls::{
-    Control, ControlSource, ControlSpec, ControlValues, Controls, DeviceInput, Lane, PerControl,
+    sample_time_s, Control, ControlSource, ControlSpec, ControlValues, Controls, DeviceInput, Lane,
+    LinearSegment, PerControl,
 };
 use output::OutputStage;
 use pour::MAX_ONSETS_PER_SAMPLE;

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use serde::de::{self, Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
 
-use sake_glug_engine::Lane;
+use sake_glug_engine::{sample_time_s, Lane, LinearSegment};
 
 /// An automatable scene value: a constant or a list of `[time_s, value]` points.
 #[derive(Debug, Clone, PartialEq)]
@@ -51,7 +51,7 @@ impl Automation {
     /// [`Automation::value_at`] of every sample's time. The points are looked up once per
     /// segment, not once per sample: the samples of one segment are filled in one pass.
     pub fn lane<'a>(&self, first_sample: u64, sample_rate: f64, buffer: &'a mut [f64]) -> Lane<'a> {
-        let time_of = |index: usize| (first_sample + index as u64) as f64 / sample_rate;
+        let time_of = |index: usize| sample_time_s(first_sample + index as u64, sample_rate);
         if let Some(value) = self.constant_over(time_of(0), time_of(buffer.len().saturating_sub(1)))
         {
             return Lane::Constant(value);
@@ -114,13 +114,22 @@ fn value_in(points: &[(f64, f64)], segment: usize, time_s: f64) -> f64 {
     } else if segment == points.len() {
         points[points.len() - 1].1
     } else {
-        let ((t0, v0), (t1, v1)) = (points[segment - 1], points[segment]);
-        v0 + (v1 - v0) * (time_s - t0) / (t1 - t0)
+        segment_line(points, segment).value_at(time_s)
+    }
+}
+
+/// The line from the point before `segment` to the point that ends it.
+#[inline]
+fn segment_line(points: &[(f64, f64)], segment: usize) -> LinearSegment {
+    LinearSegment {
+        start: points[segment - 1],
+        end: points[segment],
     }
 }
 
 /// Fills `values` with the value at `time_of(index)`, every time lying in `segment`: a held
-/// value, or the same interpolation as [`value_in`] in a loop the compiler can vectorise.
+/// value, or the same interpolation as [`value_in`] in a loop the compiler can vectorise (the
+/// line's rise and run are the same for every sample, and computed once).
 #[inline]
 fn fill_segment(
     points: &[(f64, f64)],
@@ -132,10 +141,9 @@ fn fill_segment(
         values.fill(value_in(points, segment, 0.0));
         return;
     }
-    let ((t0, v0), (t1, v1)) = (points[segment - 1], points[segment]);
-    let (rise, run) = (v1 - v0, t1 - t0);
+    let line = segment_line(points, segment);
     for (index, value) in values.iter_mut().enumerate() {
-        *value = v0 + rise * (time_of(index) - t0) / run;
+        *value = line.value_at(time_of(index));
     }
 }
 

@@ -17,7 +17,8 @@ use std::path::Path;
 use super::automation::Automation;
 use sake_glug_device::midi::MidiMap;
 use sake_glug_engine::{
-    Control, ControlSource, ControlValues, Controls, ModelConfig, PerControl, Preset, PresetValue,
+    sample_time_s, Control, ControlSource, ControlValues, Controls, ModelConfig, PerControl,
+    Preset, PresetValue,
 };
 use sake_glug_io::keys;
 use sake_glug_io::read::{self, InputKind};
@@ -182,7 +183,7 @@ impl Scene {
 
     /// The inputs at one sample.
     pub fn values_at(&self, sample: u64) -> ControlValues {
-        let time_s = sample as f64 / self.sample_rate as f64;
+        let time_s = sample_time_s(sample, self.sample_rate as f64);
         ControlValues::from_fn(|control| self.lanes[control].value_at(time_s))
     }
 

@@ -1,0 +1,385 @@
+//! The handle behind the C interface, in safe Rust: the engine, the controls as a scene's lanes
+//! would give them, and the queue that control calls from any thread wait in.
+
+use std::cell::UnsafeCell;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crossbeam_queue::ArrayQueue;
+use sake_glug_engine::config::SAMPLE_RATE_HZ;
+use sake_glug_engine::{
+    sample_time_s, Control, ControlValues, Controls, Engine, Lane, LinearSegment, PerControl,
+    UnitOnset, Voicing,
+};
+use sake_glug_model_file::{ModelFile, MAX_MODEL_BYTES};
+
+use crate::types::{
+    SakeGlugState, SakeGlugStatus, SakeGlugUnit, SAKE_GLUG_MAX_QUEUED_CONTROLS, SAKE_GLUG_MAX_UNITS,
+};
+
+/// Samples rendered per engine call: the most a ramp's lane fills at once. The engine gives the
+/// same samples however time is cut, so this changes no sample.
+const SPAN: usize = 256;
+
+/// A control call, queued until the next process call takes it at its first sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Command {
+    /// The control takes the value from the first sample on (a step).
+    Set(Control, f64),
+    /// The control goes from its value at the first sample to the target over that many samples,
+    /// then holds it.
+    Ramp(Control, f64, u64),
+    /// MODEL.md §8 refill.
+    Refill,
+    /// MODEL.md §8 reset; every control holds the value it had reached.
+    Reset,
+}
+
+/// A control on its way to a target: the two-point lane of a scene from `(p0/fs, from)` to
+/// `(p1/fs, target)` (MODEL.md §10), read at each sample's time exactly as the renderer reads it.
+#[derive(Debug, Clone, Copy)]
+struct Ramp {
+    line: LinearSegment,
+    /// p1: from this sample on the control holds the target.
+    end_sample: u64,
+}
+
+impl Ramp {
+    /// The lane's value at `sample`, which is at or after the ramp's start: on the line before the
+    /// end point's time, the end point's value from then on.
+    #[inline]
+    fn value_at(&self, sample: u64, sample_rate: f64) -> f64 {
+        let time_s = sample_time_s(sample, sample_rate);
+        if time_s >= self.line.end.0 {
+            self.line.end.1
+        } else {
+            self.line.value_at(time_s)
+        }
+    }
+}
+
+/// What only the audio thread touches.
+struct Audio {
+    engine: Engine,
+    /// Each control's value, or the target of its ramp.
+    held: ControlValues,
+    ramps: PerControl<Option<Ramp>>,
+    /// Storage for the ramps' lanes of one span.
+    lanes: PerControl<Box<[f64]>>,
+    /// One span of mono samples, for the interleaved call.
+    mono: Box<[f32]>,
+    /// The units heard first in the last process call, the first `kept` of them.
+    units: Box<[SakeGlugUnit]>,
+    kept: usize,
+    lost: u32,
+    /// θ of the last sample rendered, brought into range.
+    last_tilt_deg: f64,
+}
+
+/// One live glug: the C interface's opaque handle.
+pub struct SakeGlug {
+    commands: ArrayQueue<Command>,
+    failed: AtomicBool,
+    #[cfg(feature = "fault-injection")]
+    fault: AtomicBool,
+    audio: UnsafeCell<Audio>,
+}
+
+// The control calls share `commands` (a lock-free queue) and `failed` (an atomic) from any thread;
+// `audio` is used by one thread at a time, the audio thread, as the header requires of callers.
+unsafe impl Sync for SakeGlug {}
+
+/// Why a handle could not be made: a message for `sake_glug_last_error`.
+pub type CreateError = String;
+
+impl SakeGlug {
+    /// A handle at `sample_rate` (Hz, a whole number in the engine's range) playing the model of
+    /// `model_text` (a model file's text, MODEL.md §12.1) or the paper's bottle, seeded with
+    /// `seed`. Every control starts at the model's value or the engine's default.
+    pub fn new(sample_rate: f64, model_text: Option<&str>, seed: u64) -> Result<Self, CreateError> {
+        let sample_rate = SAMPLE_RATE_HZ
+            .check("sample_rate", sample_rate)
+            .map_err(|error| error.to_string())?;
+        if sample_rate.fract() != 0.0 {
+            return Err(format!(
+                "`sample_rate` = {sample_rate} is not a whole number: a sample rate counts whole \
+                 samples per second"
+            ));
+        }
+        let model = match model_text {
+            None => None,
+            Some(text) if text.len() as u64 > MAX_MODEL_BYTES => {
+                return Err(format!(
+                    "model text: {} bytes, over the limit of {MAX_MODEL_BYTES} bytes",
+                    text.len()
+                ))
+            }
+            Some(text) => Some(
+                ModelFile::parse("model", text).map_err(|error| format!("model text: {error}"))?,
+            ),
+        };
+        let mut config = model
+            .as_ref()
+            .map(|model| *model.config())
+            .unwrap_or_default();
+        config.seed = seed;
+        let held = ControlValues::from_fn(|control| {
+            model
+                .as_ref()
+                .and_then(|model| model.controls()[control])
+                .unwrap_or(control.range().default)
+        });
+        Ok(Self {
+            commands: ArrayQueue::new(SAKE_GLUG_MAX_QUEUED_CONTROLS),
+            failed: AtomicBool::new(false),
+            #[cfg(feature = "fault-injection")]
+            fault: AtomicBool::new(false),
+            audio: UnsafeCell::new(Audio {
+                engine: Engine::new(sample_rate, config),
+                held,
+                ramps: PerControl::splat(None),
+                lanes: PerControl::from_fn(|_| vec![0.0; SPAN].into_boxed_slice()),
+                mono: vec![0.0; SPAN].into_boxed_slice(),
+                units: vec![SakeGlugUnit::default(); SAKE_GLUG_MAX_UNITS].into_boxed_slice(),
+                kept: 0,
+                lost: 0,
+                last_tilt_deg: Control::Tilt.range().sanitize(held.tilt_deg),
+            }),
+        })
+    }
+
+    /// Queues a control call for the next process call; any thread. Checks nothing but room.
+    pub fn queue(&self, command: Command) -> Result<(), SakeGlugStatus> {
+        if self.has_failed() {
+            return Err(SakeGlugStatus::Failed);
+        }
+        self.commands
+            .push(command)
+            .map_err(|_| SakeGlugStatus::QueueFull)
+    }
+
+    /// Whether an earlier call failed (the handle renders silence from then on).
+    pub fn has_failed(&self) -> bool {
+        self.failed.load(Ordering::Relaxed)
+    }
+
+    /// Marks the handle failed after a panic.
+    pub fn fail(&self) {
+        self.failed.store(true, Ordering::Relaxed);
+    }
+
+    /// Makes the next process call panic (the test of the boundary's catch).
+    #[cfg(feature = "fault-injection")]
+    pub fn inject_fault(&self) {
+        self.fault.store(true, Ordering::Relaxed);
+    }
+
+    /// The audio thread's side.
+    ///
+    /// # Safety
+    /// No other reference to it may live: only the audio thread calls this, one call at a time.
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn audio(&self) -> &mut Audio {
+        unsafe { &mut *self.audio.get() }
+    }
+
+    /// Renders `out.len()` mono samples after taking the queued control calls.
+    ///
+    /// # Safety
+    /// The audio thread's call (see [`SakeGlug::audio`]).
+    pub unsafe fn process(&self, out: &mut [f32]) {
+        self.check_fault();
+        let audio = unsafe { self.audio() };
+        audio.start_call(&self.commands);
+        let first = audio.engine.position();
+        for span in out.chunks_mut(SPAN) {
+            audio.render_span(span, first);
+        }
+    }
+
+    /// Renders `out.len() / channels` frames, the mono signal in each of `channels` interleaved
+    /// channels.
+    ///
+    /// # Safety
+    /// The audio thread's call (see [`SakeGlug::audio`]).
+    pub unsafe fn process_interleaved(&self, out: &mut [f32], channels: usize) {
+        self.check_fault();
+        let audio = unsafe { self.audio() };
+        audio.start_call(&self.commands);
+        let first = audio.engine.position();
+        for frames in out.chunks_mut(SPAN * channels) {
+            let len = frames.len() / channels;
+            let mut mono = std::mem::take(&mut audio.mono);
+            audio.render_span(&mut mono[..len], first);
+            for (frame, &sample) in frames.chunks_exact_mut(channels).zip(mono.iter()) {
+                frame.fill(sample);
+            }
+            audio.mono = mono;
+        }
+    }
+
+    /// The bottle after the last process call.
+    ///
+    /// # Safety
+    /// The audio thread's call (see [`SakeGlug::audio`]).
+    pub unsafe fn state(&self) -> SakeGlugState {
+        unsafe { self.audio() }.state()
+    }
+
+    /// The units heard first in the last process call.
+    ///
+    /// # Safety
+    /// The audio thread's call (see [`SakeGlug::audio`]).
+    pub unsafe fn units(&self) -> &[SakeGlugUnit] {
+        let audio = unsafe { self.audio() };
+        &audio.units[..audio.kept]
+    }
+
+    fn check_fault(&self) {
+        #[cfg(feature = "fault-injection")]
+        if self.fault.swap(false, Ordering::Relaxed) {
+            panic!("a fault injected by the test");
+        }
+    }
+}
+
+impl Audio {
+    /// Takes every queued control call, in order, at the first sample of the call.
+    fn start_call(&mut self, commands: &ArrayQueue<Command>) {
+        while let Some(command) = commands.pop() {
+            self.apply(command);
+        }
+        self.kept = 0;
+        self.lost = 0;
+    }
+
+    fn apply(&mut self, command: Command) {
+        let position = self.engine.position();
+        let sample_rate = self.engine.sample_rate();
+        match command {
+            Command::Set(control, value) => {
+                self.ramps[control] = None;
+                self.held[control] = value;
+            }
+            Command::Ramp(control, target, samples) => {
+                let from = self.value_at(control, position);
+                let end_sample = position.saturating_add(samples);
+                // A ramp to the value it starts from is that value held, as the renderer reads a
+                // flat segment.
+                self.ramps[control] = (samples > 0 && from != target).then(|| Ramp {
+                    line: LinearSegment {
+                        start: (sample_time_s(position, sample_rate), from),
+                        end: (sample_time_s(end_sample, sample_rate), target),
+                    },
+                    end_sample,
+                });
+                self.held[control] = target;
+            }
+            Command::Refill => self.engine.refill(),
+            Command::Reset => {
+                for &control in Control::ALL {
+                    self.held[control] = self.value_at(control, position);
+                    self.ramps[control] = None;
+                }
+                self.engine.reset();
+            }
+        }
+    }
+
+    /// The control's value at `sample` (at or after the engine's position).
+    fn value_at(&self, control: Control, sample: u64) -> f64 {
+        match self.ramps[control] {
+            Some(ramp) if sample < ramp.end_sample => {
+                ramp.value_at(sample, self.engine.sample_rate())
+            }
+            _ => self.held[control],
+        }
+    }
+
+    /// Renders one span of at most [`SPAN`] samples, keeping the units first heard in it.
+    fn render_span(&mut self, out: &mut [f32], call_start: u64) {
+        let position = self.engine.position();
+        let sample_rate = self.engine.sample_rate();
+        let Audio {
+            engine,
+            held,
+            ramps,
+            lanes,
+            units,
+            kept,
+            lost,
+            last_tilt_deg,
+            ..
+        } = self;
+        let controls: Controls = lanes.each_mut().into_map(|control, lane| {
+            match &mut ramps[control] {
+                Some(ramp) if position < ramp.end_sample => {
+                    let lane = &mut lane[..out.len()];
+                    for (index, value) in lane.iter_mut().enumerate() {
+                        *value = ramp.value_at(position + index as u64, sample_rate);
+                    }
+                    Lane::Samples(lane)
+                }
+                // A ramp that has ended holds its target, as a lane past its last point.
+                ramp => {
+                    *ramp = None;
+                    Lane::Constant(held[control])
+                }
+            }
+        });
+        engine.process_observed(
+            &controls,
+            out,
+            &mut |onset, voicing| match units.get_mut(*kept) {
+                Some(unit) => {
+                    *unit = unit_of(onset, voicing, call_start);
+                    *kept += 1;
+                }
+                None => *lost = lost.saturating_add(1),
+            },
+        );
+        if let Some(last) = out.len().checked_sub(1) {
+            *last_tilt_deg = controls.values_at(last).sanitized().tilt_deg;
+        }
+    }
+
+    fn state(&self) -> SakeGlugState {
+        let engine = &self.engine;
+        let position = engine.position();
+        let outflow = engine.last_outflow();
+        let ramping = Control::ALL
+            .iter()
+            .any(|&control| self.ramps[control].is_some_and(|ramp| position < ramp.end_sample));
+        SakeGlugState {
+            position,
+            active_until: engine.active_until(),
+            volume_ml: engine.volume_ml(),
+            outflow_ml_per_s: outflow.amount_ml * engine.sample_rate(),
+            tilt_deg: self.last_tilt_deg,
+            output_gain: engine.gain_now(),
+            submerged: outflow.submerged.into(),
+            settled: (engine.is_settled() && !ramping).into(),
+            units: self.kept as u32,
+            units_lost: self.lost,
+        }
+    }
+}
+
+/// A unit as the C interface reports it, first heard at its sample n + 1 of a call that started
+/// at sample `call_start`.
+fn unit_of(onset: &UnitOnset, voicing: Voicing, call_start: u64) -> SakeGlugUnit {
+    SakeGlugUnit {
+        frame: (onset.sample + 1 - call_start) as u32,
+        audible: voicing.audible.into(),
+        sample: onset.sample,
+        fraction: onset.fraction,
+        tilt_deg: onset.tilt_deg,
+        volume_ml: onset.volume_ml,
+        pocket_ml: onset.pocket_ml,
+        amplitude: voicing.output_gain * onset.amplitude,
+        viscosity_c: onset.viscosity,
+        f1_hz: onset.shape.frequency_hz[0],
+        f2_hz: onset.shape.frequency_hz[1],
+        b1_per_s: onset.shape.decay_per_s[0],
+        b2_per_s: onset.shape.decay_per_s[1],
+    }
+}
