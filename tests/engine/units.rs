@@ -36,6 +36,7 @@ fn unit(viscosity: f64, decay_per_s: [f64; 2]) -> UnitOnset {
             decay_per_s,
             amplitude_factor: 1.0,
         },
+        actuator_gain: [1.0, 1.0],
     }
 }
 

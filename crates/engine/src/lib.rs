@@ -5,6 +5,7 @@
 //! randomness: [`pour`]) → a [`Synthesis`] path ([`synthesis`]) → the caller's output buffer.
 //! [`Engine`] ties them together block by block.
 
+pub mod actuator;
 mod amplitude;
 pub mod config;
 mod controls;
@@ -15,6 +16,7 @@ mod presets;
 mod quantity;
 pub mod synthesis;
 
+pub use actuator::{ActuatorResponse, Equalise, ResponseError};
 pub use amplitude::{SilentBelow, PAPERS_SILENT_BELOW_ML};
 pub use config::{Constant, ConstantSpec, Curve, DrainMode, ModelConfig};
 pub use controls::{
@@ -65,6 +67,9 @@ pub struct Engine<S: Synthesis = AnchoredF32> {
     /// first heard in the next block, whose gain is only known when it comes, and are reported
     /// at its start (so that what a unit is heard at never depends on where a block ends).
     deferred: [Option<(UnitOnset, Voicing)>; MAX_ONSETS_PER_SAMPLE as usize],
+    /// The actuator the output drives, if a profile is given: each unit's components are
+    /// compensated for it as the unit starts (MODEL.md §18).
+    actuator: Option<ActuatorResponse>,
 }
 
 impl Engine {
@@ -90,6 +95,7 @@ impl<S: Synthesis> Engine<S> {
             last_outflow: Outflow::NONE,
             block_end: 0,
             deferred: [None; MAX_ONSETS_PER_SAMPLE as usize],
+            actuator: None,
         };
         engine.reset();
         engine
@@ -109,6 +115,27 @@ impl<S: Synthesis> Engine<S> {
     pub fn set_config(&mut self, config: ModelConfig) {
         self.pour.set_config(config);
         self.resting_under = None;
+    }
+
+    /// Compensates the units that start from now on for `actuator` (`None`: plays the model's
+    /// drive as it is), and holds the output within its largest drive (MODEL.md §18).
+    /// Allocation-free: a host may call it between blocks.
+    pub fn set_actuator(&mut self, actuator: Option<ActuatorResponse>) {
+        self.actuator = actuator;
+    }
+
+    /// The actuator the units are compensated for, if any.
+    pub fn actuator(&self) -> Option<&ActuatorResponse> {
+        self.actuator.as_ref()
+    }
+
+    /// The ceiling in force (linear): the model's, and at most the actuator's largest drive.
+    fn ceiling(&self) -> f64 {
+        let ceiling = self.pour.config().ceiling;
+        match &self.actuator {
+            Some(actuator) => ceiling.min(actuator.max_amplitude()),
+            None => ceiling,
+        }
     }
 
     /// MODEL.md §8 reset: refill, silence every unit, re-seed.
@@ -254,7 +281,7 @@ impl<S: Synthesis> Engine<S> {
             // a walk over its grid periods. An empty bank only needs the last period start.
             out.fill(0.0);
             self.output
-                .pass_silence(&controls.gain_db, self.pour.config().ceiling, out.len());
+                .pass_silence(&controls.gain_db, self.ceiling(), out.len());
             let end = self.sample + out.len() as u64;
             let last_period = end / GRID as u64 * GRID as u64;
             if last_period > self.sample {
@@ -290,7 +317,7 @@ impl<S: Synthesis> Engine<S> {
     ) {
         out.fill(0.0);
         self.step_pour(controls, out.len(), on_unit);
-        let ceiling = self.pour.config().ceiling;
+        let ceiling = self.ceiling();
         if self.synthesis.is_empty() {
             self.output
                 .pass_silence(&controls.gain_db, ceiling, out.len());
@@ -320,10 +347,23 @@ impl<S: Synthesis> Engine<S> {
             sample: span_start,
             block_end,
             deferred,
+            actuator,
             ..
         } = self;
         let (span_start, block_end) = (*span_start, *block_end);
         let mut start_unit = |onset: &UnitOnset| {
+            // The unit's gains for the actuator, once, at its start (MODEL.md §18).
+            let compensated;
+            let onset = match actuator {
+                Some(actuator) => {
+                    compensated = UnitOnset {
+                        actuator_gain: actuator.gains(onset.shape.frequency_hz),
+                        ..*onset
+                    };
+                    &compensated
+                }
+                None => onset,
+            };
             let audible = synthesis.start_unit(onset);
             *last_unit = Some(*onset);
             // Heard from the sample after the one it starts in (MODEL.md §6: t_i ≤ t_n).

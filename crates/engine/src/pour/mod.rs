@@ -78,14 +78,18 @@ pub struct UnitOnset {
     pub viscosity: f64,
     /// f1_i, f2_i, B1_i, B2_i and the amplitude's factor as drawn for this unit (§7, §12).
     pub shape: UnitShape,
+    /// Each component's gain from the actuator compensation (§18), `[1, 1]` without a profile:
+    /// the engine sets it as the unit starts.
+    pub actuator_gain: [f64; 2],
 }
 
 impl UnitOnset {
-    /// A1 = c·a, A2 = (1 − c)·a (paper eq. 2).
+    /// A1 = c·a, A2 = (1 − c)·a (paper eq. 2), each times its actuator gain (§18; × 1 changes
+    /// no bit without a profile).
     pub fn component_amplitudes(&self) -> [f64; 2] {
         [
-            self.viscosity * self.amplitude,
-            (1.0 - self.viscosity) * self.amplitude,
+            self.viscosity * self.amplitude * self.actuator_gain[0],
+            (1.0 - self.viscosity) * self.amplitude * self.actuator_gain[1],
         ]
     }
 }
@@ -484,6 +488,7 @@ impl Pour {
                         * shape.amplitude_factor,
                     viscosity,
                     shape,
+                    actuator_gain: [1.0, 1.0],
                 });
             },
         );

@@ -143,6 +143,7 @@ mod tests {
                 decay_per_s: [decay_per_s; 2],
                 amplitude_factor: 1.0,
             },
+            actuator_gain: [1.0, 1.0],
         }
     }
 
