@@ -10,6 +10,7 @@ use std::sync::Arc;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use sake_glug_actuator::{shipped_names, ActuatorProfile, Equalise};
 use sake_glug_engine::Preset;
 use sake_glug_io::text::{printable, quoted};
 use sake_glug_model_file::ModelFile;
@@ -85,6 +86,16 @@ pub struct RenderArgs {
     /// keys a scene sets its own (MODEL.md §12.1).
     #[arg(long, value_name = "MODEL.toml")]
     model: Option<PathBuf>,
+    #[arg(long, value_name = "NAME|FILE.toml", help = format!(
+        "Compensates every unit for an actuator (MODEL.md §18) so that the device delivers the \
+         model's c: a shipped profile ({}) or a profile file (what measure-actuator writes)",
+        shipped_names().join(", ")
+    ))]
+    actuator: Option<String>,
+    /// With --actuator: equalises the level over the skin's threshold at f1 and f2 (Verrillo's
+    /// curve) instead of the acceleration the device delivers.
+    #[arg(long, requires = "actuator")]
+    felt: bool,
     /// Overrides the scenes' sample rate (Hz).
     #[arg(long, value_parser = crate::sample_rate_hz)]
     sample_rate: Option<f64>,
@@ -151,6 +162,19 @@ pub fn run(args: RenderArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let actuator = match args
+        .actuator
+        .as_deref()
+        .map(ActuatorProfile::find)
+        .transpose()
+    {
+        Ok(actuator) if args.felt => actuator.map(|profile| profile.equalising(Equalise::Felt)),
+        Ok(actuator) => actuator,
+        Err(error) => {
+            eprintln!("error: --actuator: {error}");
+            return ExitCode::from(2);
+        }
+    };
     if let Some(directory) = &args.out_dir {
         if let Err(error) = std::fs::create_dir_all(directory) {
             eprintln!("error: cannot create {}: {error}", directory.display());
@@ -174,7 +198,11 @@ pub fn run(args: RenderArgs) -> ExitCode {
         let progress = |fraction| out.progress.set(index, fraction);
         let signal_name =
             |signal| signal_hook::low_level::signal_name(signal).unwrap_or("a signal");
-        match render_job(job, &args, model.as_ref(), &options, &stop, progress) {
+        let inputs = JobInputs {
+            model: model.as_ref(),
+            actuator: actuator.as_ref(),
+        };
+        match render_job(job, &args, inputs, &options, &stop, progress) {
             Ok(Rendered {
                 report,
                 outside,
@@ -474,10 +502,17 @@ fn built_in(text: &str, model: Option<&ModelFile>) -> Result<Scene, SceneError> 
     }
 }
 
+/// What every job of a batch plays on: the model's bottle, the actuator's response.
+#[derive(Clone, Copy)]
+struct JobInputs<'a> {
+    model: Option<&'a ModelFile>,
+    actuator: Option<&'a ActuatorProfile>,
+}
+
 fn render_job(
     job: &Job,
     args: &RenderArgs,
-    model: Option<&ModelFile>,
+    JobInputs { model, actuator }: JobInputs,
     options: &OutputOptions,
     stop: &Stop,
     progress: impl FnMut(f64),
@@ -495,6 +530,7 @@ fn render_job(
     if let Some(sample_rate) = args.sample_rate {
         scene = scene.with_sample_rate(sample_rate)?;
     }
+    scene.actuator = actuator.map(ActuatorProfile::response);
     let observer = JobObserver {
         total: scene.duration_samples(),
         progress,

@@ -47,31 +47,35 @@ pub enum ResponseError {
     #[error("needs 2 to {MAX_RESPONSE_POINTS} [Hz, dB] points, has {0}")]
     PointCount(usize),
     /// A point's frequency or level is NaN or infinite.
-    #[error("point {index} is not two finite numbers")]
+    #[error("point {} is not two finite numbers", index + 1)]
     NotFinite {
-        /// The point, from 0.
+        /// The point, from 0 (messages count from 1).
         index: usize,
     },
     /// A point's frequency is outside [`RESPONSE_HZ`].
-    #[error("point {index}: {hz} Hz is outside {} to {} Hz", RESPONSE_HZ.0, RESPONSE_HZ.1)]
+    #[error("point {}: {hz} Hz is outside {} to {} Hz", index + 1, RESPONSE_HZ.0, RESPONSE_HZ.1)]
     FrequencyOutOfRange {
-        /// The point, from 0.
+        /// The point, from 0 (messages count from 1).
         index: usize,
         /// Its frequency.
         hz: f64,
     },
     /// A point's level is beyond ±[`MAX_RESPONSE_DB`].
-    #[error("point {index}: {db} dB is beyond ±{MAX_RESPONSE_DB} dB")]
+    #[error("point {}: {db} dB is beyond ±{MAX_RESPONSE_DB} dB", index + 1)]
     LevelOutOfRange {
-        /// The point, from 0.
+        /// The point, from 0 (messages count from 1).
         index: usize,
         /// Its level.
         db: f64,
     },
     /// A point's frequency is not above the one before it.
-    #[error("point {index}: {hz} Hz is not above the point before it ({before} Hz): points go up in frequency")]
+    #[error(
+        "point {}: {hz} Hz is not above the point before it ({before} Hz): points go up in \
+         frequency",
+        index + 1
+    )]
     OutOfOrder {
-        /// The point, from 0.
+        /// The point, from 0 (messages count from 1).
         index: usize,
         /// Its frequency.
         hz: f64,

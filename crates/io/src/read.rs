@@ -50,9 +50,12 @@ impl InputKind {
     pub const STUDY_SPEC: Self = Self::new("study spec", MIB);
     /// A study's trial log (64 MiB: a row is under 200 bytes, a study a few thousand rows).
     pub const STUDY_LOG: Self = Self::new("study log", 64 * MIB);
+    /// An actuator profile (64 KiB): a name, a few dozen [Hz, dB] points and their spread, with
+    /// the comments that cite them.
+    pub const ACTUATOR: Self = Self::new("actuator profile", 64 * 1024);
 
     /// Every kind of input, for a test that tries each.
-    pub const ALL: [Self; 9] = [
+    pub const ALL: [Self; 10] = [
         Self::SCENE,
         Self::MODEL,
         Self::MIDI_TAKE,
@@ -62,6 +65,7 @@ impl InputKind {
         Self::WEIGHT_LOG,
         Self::STUDY_SPEC,
         Self::STUDY_LOG,
+        Self::ACTUATOR,
     ];
 
     const fn new(name: &'static str, max_bytes: u64) -> Self {

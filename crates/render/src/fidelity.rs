@@ -3,7 +3,9 @@
 //! against the model's own glugs: where its onsets fall, how far its envelope strays from the
 //! felt envelope, what carries the viscosity c, how big it is, and which platform limits it
 //! met. `sake-glug render --fidelity` prints it; the README's table is its output. Nothing here
-//! knows a format by name: the table of formats says everything.
+//! knows a format by name: the table of formats says everything. With an actuator profile
+//! (`--actuator`, MODEL.md §18) it adds the c the device delivers, with and without the
+//! compensation.
 
 use std::path::Path;
 
@@ -14,7 +16,7 @@ use super::render::{RenderObserver, RenderSummary};
 use super::scene::Scene;
 use super::sinks::{Output, OutputError, OutputFormat, OutputOptions};
 use super::steps::ComponentEnvelopes;
-use sake_glug_engine::{UnitOnset, Voicing};
+use sake_glug_engine::{ActuatorResponse, UnitOnset, Voicing};
 
 /// The envelope is compared where the model's is within this of its loudest (−40 dB): the
 /// glugging part, where a difference can be felt; below it every format is near silence.
@@ -44,6 +46,79 @@ pub struct Fidelity {
     pub bytes: u64,
     /// The platform limits the file met, measured on this render.
     pub limits: String,
+    /// With an actuator profile, the c its device delivers of this format (`None` without one).
+    pub delivered_c: Option<DeliveredC>,
+}
+
+/// The c a device delivers of a format, against the model's (MODEL.md §18).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DeliveredC {
+    /// The format carries the two components as they are (a waveform): each unit's delivered c
+    /// is A1·R(f1) / (A1·R(f1) + A2·R(f2)), R the device's response, driven without and with
+    /// the compensation.
+    Measured {
+        /// Delivered c less the model's c over the audible units, driven as the model says.
+        without: CShift,
+        /// The same, driven as compensated.
+        with: CShift,
+    },
+    /// The format carries c as something the platform plays on its own (a felt frequency, a
+    /// sharpness, a motor balance), not as the two components: the device's response changes
+    /// the level it plays, not the c it carries.
+    AsCarried,
+}
+
+/// How far delivered c lies from the model's over a render's units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CShift {
+    /// Mean of delivered c − model c (below 0: the device plays the liquid thinner).
+    pub mean: f64,
+    /// The largest |delivered c − model c|.
+    pub worst: f64,
+}
+
+impl CShift {
+    /// Over `(delivered, model)` pairs; 0 for none.
+    fn of(pairs: impl Iterator<Item = (f64, f64)>) -> Self {
+        let (mut sum, mut worst, mut count) = (0.0, 0.0f64, 0usize);
+        for (delivered, model) in pairs {
+            sum += delivered - model;
+            worst = worst.max((delivered - model).abs());
+            count += 1;
+        }
+        Self {
+            mean: sum / count.max(1) as f64,
+            worst,
+        }
+    }
+}
+
+/// A unit as the device receives it: its glug (driven as compensated) and its compensation
+/// gains (1 without a profile).
+struct DrivenUnit {
+    glug: Glug,
+    gains: [f64; 2],
+}
+
+/// The c `actuator` delivers of each audible unit, driven without and with the compensation.
+fn delivered_c(actuator: &ActuatorResponse, units: &[DrivenUnit]) -> DeliveredC {
+    let c_of = |amplitudes: [f64; 2], unit: &DrivenUnit| {
+        let [d1, d2] = actuator.delivered(amplitudes, unit.glug.frequency_hz);
+        d1 / (d1 + d2)
+    };
+    let audible = || {
+        units
+            .iter()
+            .filter(|unit| unit.glug.amplitudes.iter().sum::<f64>() > 0.0)
+    };
+    let without = CShift::of(audible().map(|unit| {
+        let [a1, a2] = unit.glug.amplitudes;
+        let model = [a1 / unit.gains[0], a2 / unit.gains[1]];
+        (c_of(model, unit), unit.glug.viscosity)
+    }));
+    let with =
+        CShift::of(audible().map(|unit| (c_of(unit.glug.amplitudes, unit), unit.glug.viscosity)));
+    DeliveredC::Measured { without, with }
 }
 
 /// How the fidelity report reads a played format back; a format not played (the plot, the
@@ -110,23 +185,31 @@ pub fn measure(
         .collect();
     struct Glugs {
         glugs: Vec<Glug>,
+        driven: Vec<DrivenUnit>,
         sample_rate: u32,
     }
     impl RenderObserver for &mut Glugs {
         fn unit_started(&mut self, onset: &UnitOnset, voicing: Voicing) {
             let glug = Glug::of_unit(onset, voicing.output_gain, self.sample_rate);
             self.glugs.push(glug);
+            if voicing.audible {
+                self.driven.push(DrivenUnit {
+                    glug,
+                    gains: onset.actuator_gain,
+                });
+            }
         }
     }
     let mut glugs = Glugs {
         glugs: Vec::new(),
+        driven: Vec::new(),
         sample_rate: scene.sample_rate,
     };
     let report = super::render_to_files(scene, scene_name, &outputs, options, &mut glugs)?;
     let source = ClipSource {
         duration_s: report.summary.duration_s(),
         glugs: &glugs.glugs,
-        ceiling: scene.config.ceiling,
+        ceiling: scene.output_ceiling(),
         scene_name,
         seed: scene.config.seed,
     };
@@ -135,16 +218,28 @@ pub fn measure(
         .zip(&formats)
         .zip(&report.files)
         .map(|((output, &(format, read_back)), (_, bytes))| {
-            let fidelity = |onset_error_ms, envelope_error_db, limits| Fidelity {
+            let delivered = |waveform: bool| {
+                scene.actuator.as_ref().map(|actuator| {
+                    if waveform {
+                        delivered_c(actuator, &glugs.driven)
+                    } else {
+                        DeliveredC::AsCarried
+                    }
+                })
+            };
+            let fidelity = |onset_error_ms, envelope_error_db, limits, delivered_c| Fidelity {
                 format,
                 onset_error_ms,
                 envelope_error_db,
                 carries_c: format.carries_c(),
                 bytes: *bytes,
                 limits,
+                delivered_c,
             };
             Ok(match read_back {
-                ReadBack::Waveform { limits } => fidelity(None, None, limits(scene)),
+                ReadBack::Waveform { limits } => {
+                    fidelity(None, None, limits(scene), delivered(true))
+                }
                 ReadBack::Clip(read) => {
                     let clip = WrittenClip {
                         path: &output.path,
@@ -155,6 +250,7 @@ pub fn measure(
                         onset_error_ms(&source, &reading),
                         envelope_error_db(&source, &report.summary, &*reading.envelope),
                         reading.limits,
+                        delivered(false),
                     )
                 }
             })
@@ -265,12 +361,18 @@ pub(crate) fn held(mut spans: Vec<(f64, f64, f64)>) -> Box<dyn Fn(f64) -> f64> {
     })
 }
 
-/// The measurements as the Markdown table the README shows.
+/// The measurements as the Markdown table the README shows; with an actuator profile, two more
+/// columns: the c its device delivers without and with the compensation.
 pub fn fidelity_table(rows: &[Fidelity]) -> String {
+    let on_device = rows.iter().any(|row| row.delivered_c.is_some());
     let mut lines = vec![
         "| format | onset error, mean / worst (ms) | envelope error (dB) | what carries c | size | limits met |".to_owned(),
         "|---|---|---|---|---|---|".to_owned(),
     ];
+    if on_device {
+        lines[0] += " delivered c − model c, mean / worst: uncompensated | compensated |";
+        lines[1] += "---|---|";
+    }
     for row in rows {
         let onset = row
             .onset_error_ms
@@ -280,13 +382,25 @@ pub fn fidelity_table(rows: &[Fidelity]) -> String {
         let envelope = row
             .envelope_error_db
             .map_or("— (the waveform)".to_owned(), |db| format!("{db:.1}"));
-        lines.push(format!(
+        let mut line = format!(
             "| `{}` | {onset} | {envelope} | {} | {} | {} |",
             row.format.name(),
             row.carries_c,
             super::human_bytes(row.bytes),
             row.limits
-        ));
+        );
+        let shift = |shift: CShift| format!("{:+.3} / {:.3}", shift.mean, shift.worst);
+        match row.delivered_c {
+            Some(DeliveredC::Measured { without, with }) => {
+                line += &format!(" {} | {} |", shift(without), shift(with));
+            }
+            Some(DeliveredC::AsCarried) => {
+                line += " as carried (the platform plays it) | as carried |"
+            }
+            None if on_device => line += " — | — |",
+            None => {}
+        }
+        lines.push(line);
     }
     lines.join("\n") + "\n"
 }

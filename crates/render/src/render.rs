@@ -132,6 +132,7 @@ pub fn render_scene<E: From<RenderError>>(
     }
     let sample_rate = scene.sample_rate as f64;
     let mut engine = Engine::new(sample_rate, scene.config);
+    engine.set_actuator(scene.actuator);
     let mut lanes = LaneBuffers::default();
     let mut block = vec![0.0f32; BLOCK_SIZE];
     let total = scene.duration_samples();

@@ -17,8 +17,8 @@ use std::path::Path;
 use super::automation::Automation;
 use sake_glug_device::midi::MidiMap;
 use sake_glug_engine::{
-    sample_time_s, Control, ControlSource, ControlValues, Controls, ModelConfig, PerControl,
-    Preset, PresetValue,
+    sample_time_s, ActuatorResponse, Control, ControlSource, ControlValues, Controls, ModelConfig,
+    PerControl, Preset, PresetValue,
 };
 use sake_glug_io::keys;
 use sake_glug_io::read::{self, InputKind};
@@ -58,6 +58,9 @@ pub struct Scene {
     pub midi: MidiMap,
     /// The files read for the CSV lanes and the take, in the order read.
     pub inputs: Vec<InputFile>,
+    /// The actuator the render is compensated for (MODEL.md §18): no scene key, set by the
+    /// caller (`--actuator`); `None` plays the model's drive as it is.
+    pub actuator: Option<ActuatorResponse>,
 }
 
 /// A scene file's text, read as a regular file within [`MAX_SCENE_BYTES`], in UTF-8.
@@ -112,6 +115,15 @@ impl Scene {
         let mut file = SceneFile::parse(text)?;
         file.layer_over(model);
         file.validate(folder)
+    }
+
+    /// The output's ceiling (linear): the scene's, and at most the actuator's largest drive, as
+    /// the engine holds it.
+    pub fn output_ceiling(&self) -> f64 {
+        match &self.actuator {
+            Some(actuator) => self.config.ceiling.min(actuator.max_amplitude()),
+            None => self.config.ceiling,
+        }
     }
 
     /// The same scene at another sample rate, refused as a scene's `sample_rate` would be: out

@@ -153,6 +153,7 @@ impl SceneFile {
             take,
             midi,
             inputs,
+            actuator: None,
         })
     }
 }

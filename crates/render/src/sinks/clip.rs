@@ -69,7 +69,7 @@ pub(super) fn clip_source<'g>(
     ClipSource {
         duration_s: summary.duration_s(),
         glugs,
-        ceiling: context.scene.config.ceiling,
+        ceiling: context.scene.output_ceiling(),
         scene_name: context.scene_name,
         seed: context.scene.config.seed,
     }

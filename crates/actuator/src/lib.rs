@@ -1,0 +1,17 @@
+//! Actuator profiles (MODEL.md §18): what a device does to each frequency, as a TOML file.
+//!
+//! [`ActuatorProfile`] reads and checks one (through `sake_glug_io::read`, every refusal naming
+//! its key) into the engine's plain [`ActuatorResponse`]; [`SHIPPED`] are the profiles of
+//! `actuators/`, embedded, found by name; [`ProfileText`] writes one.
+//!
+//! The profile is its own crate, not part of the engine (which reads no file) nor of the model
+//! files (a model is a bottle and a liquid; a profile is the device that plays them, chosen
+//! apart from it): the renderer, the plugin and the C library each link it, and it links only
+//! the engine, the file layer and toml.
+
+mod profile;
+mod shipped;
+
+pub use profile::{ActuatorProfile, ProfileError, ProfileText};
+pub use sake_glug_engine::{ActuatorResponse, Equalise};
+pub use shipped::{shipped_names, SHIPPED};
