@@ -7,16 +7,13 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 use super::axis::{tilt_from_gravity, Axis};
-use sake_glug_io::text::printable;
+use sake_glug_io::text::{cut_short, printable};
 
 /// The column of times, in seconds from the start of the take.
 pub const TIME_COLUMN: &str = "time_s";
 
 /// The largest take file read ([`sake_glug_io::InputKind::CSV_LANE`]).
 pub const MAX_CSV_LANE_BYTES: u64 = sake_glug_io::InputKind::CSV_LANE.max_bytes;
-
-/// The most of a field an error quotes: enough to see what it is, never a whole line.
-const QUOTED_FIELD_CHARS: usize = 32;
 
 /// Which values of a CSV take make the lane.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -127,14 +124,6 @@ pub enum CsvFault {
     Unreadable(String),
 }
 
-/// The start of `field`, for an error to quote.
-fn quoted(field: &str) -> String {
-    match field.char_indices().nth(QUOTED_FIELD_CHARS) {
-        Some((end, _)) => format!("{}…", &field[..end]),
-        None => field.to_owned(),
-    }
-}
-
 /// Reads the lane `spec` picks from the CSV `text` of `file` (named in errors only) as
 /// `(time_s, value)` points, in the file's order.
 ///
@@ -224,8 +213,8 @@ pub fn read_csv_lane(
             let name = &header[index];
             match field.parse::<f64>() {
                 Ok(value) if value.is_finite() => Ok(value),
-                Ok(_) => Err(fail(line, &[name], CsvFault::NotFinite(quoted(field)))),
-                Err(_) => Err(fail(line, &[name], CsvFault::NotANumber(quoted(field)))),
+                Ok(_) => Err(fail(line, &[name], CsvFault::NotFinite(cut_short(field)))),
+                Err(_) => Err(fail(line, &[name], CsvFault::NotANumber(cut_short(field)))),
             }
         };
 

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use super::error::FitError;
+use sake_glug_engine::curves::REFERENCE_TILT_DEG;
 use sake_glug_engine::{Constant, Control};
 
 /// The liquid of a recording that names none.
@@ -15,8 +16,10 @@ pub const DEFAULT_LIQUID: &str = "liquid";
 /// A validated session, its paths resolved against the session file's folder.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitSession {
-    /// The session file (for messages).
+    /// The session file (for messages), or the first clip of a fit of clips.
     pub path: PathBuf,
+    /// Whether it is a fit of clips named on the command line (no session file).
+    pub from_clips: bool,
     /// The bottle's capacity C (ml).
     pub capacity_ml: f64,
     /// Every recording, in the file's order.
@@ -26,8 +29,10 @@ pub struct FitSession {
 /// One `[[recording]]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordingSpec {
-    /// Its place in messages: `recording[0]`.
+    /// Its place in messages: `recording[0]` (a clip: its file).
     pub key: String,
+    /// Its audio's place in messages: `recording[0].audio` (a clip: its file).
+    pub audio_key: String,
     /// The WAV file.
     pub audio: PathBuf,
     /// The tilt the bottle was held at (degrees).
@@ -171,12 +176,14 @@ impl FitSession {
                 return Err(FitError::SessionSyntax {
                     path: path.to_owned(),
                     message: format!(
-                        "`{key}.liquid` = {liquid:?}: a liquid names its model file, so it is \
-                         letters, digits, `-` and `_` only"
+                        "`{key}.liquid` = {:?}: a liquid names its model file, so it is 1 to 64 \
+                         letters, digits, `-` and `_`",
+                        sake_glug_io::text::cut_short(&liquid)
                     ),
                 });
             }
             recordings.push(RecordingSpec {
+                audio_key: format!("{key}.audio"),
                 key,
                 audio: folder.join(recording.audio),
                 tilt_deg: recording.tilt_deg,
@@ -187,6 +194,60 @@ impl FitSession {
         }
         Ok(FitSession {
             path: path.to_owned(),
+            from_clips: false,
+            capacity_ml,
+            recordings,
+        })
+    }
+
+    /// A session of clips without a session file: a bottle of `capacity_ml` (default: the
+    /// model's) held at `tilt_deg` (default 135°), full at each clip's first sample, one liquid.
+    pub fn of_clips(
+        clips: &[PathBuf],
+        capacity_ml: Option<f64>,
+        tilt_deg: Option<f64>,
+    ) -> Result<Self, FitError> {
+        let first = clips.first().ok_or_else(|| {
+            FitError::Outputs("no recording: name a session file or WAV clips".into())
+        })?;
+        let argument_error = |name: &str, value: f64, why: &str| {
+            FitError::Outputs(format!("--{name} {value}: {why}"))
+        };
+        let capacity = Constant::Capacity.quantity();
+        let capacity_ml = capacity_ml.unwrap_or(capacity.range.default);
+        if !capacity.range.contains(capacity_ml) {
+            return Err(argument_error(
+                "capacity-ml",
+                capacity_ml,
+                "outside the capacity's range (see `sake-glug parameters`)",
+            ));
+        }
+        let tilt_deg = tilt_deg.unwrap_or(REFERENCE_TILT_DEG);
+        if !Control::Tilt.range().contains(tilt_deg) {
+            return Err(argument_error(
+                "tilt-deg",
+                tilt_deg,
+                "a tilt lies within 0 to 180 degrees",
+            ));
+        }
+        let recordings = clips
+            .iter()
+            .map(|clip| {
+                let shown = sake_glug_io::text::printable(&clip.to_string_lossy()).into_owned();
+                RecordingSpec {
+                    key: shown.clone(),
+                    audio_key: shown,
+                    audio: clip.clone(),
+                    tilt_deg,
+                    start_ml: Some(capacity_ml),
+                    weight: None,
+                    liquid: DEFAULT_LIQUID.to_owned(),
+                }
+            })
+            .collect();
+        Ok(FitSession {
+            path: first.clone(),
+            from_clips: true,
             capacity_ml,
             recordings,
         })

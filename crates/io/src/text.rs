@@ -20,3 +20,32 @@ pub fn printable(text: &str) -> Cow<'_, str> {
     }
     Cow::Owned(escaped)
 }
+
+/// The most characters of a field of another file that a message quotes: enough to see what it
+/// is, never a whole line.
+pub const QUOTED_FIELD_CHARS: usize = 32;
+
+/// The start of `field`: at most [`QUOTED_FIELD_CHARS`] characters, then `…` if it was cut. A
+/// field of another file quoted in a message never carries that file whole (a 50 MB field, or the
+/// next line of a file that is no CSV); quote it with `{:?}` or [`printable`].
+pub fn cut_short(field: &str) -> String {
+    match field.char_indices().nth(QUOTED_FIELD_CHARS) {
+        Some((end, _)) => format!("{}…", &field[..end]),
+        None => field.to_owned(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_long_field_is_cut_and_a_short_one_kept() {
+        let long = "é".repeat(50_000);
+        assert_eq!(
+            cut_short(&long),
+            format!("{}…", "é".repeat(QUOTED_FIELD_CHARS))
+        );
+        assert_eq!(cut_short("short"), "short");
+    }
+}

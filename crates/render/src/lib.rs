@@ -16,7 +16,7 @@ pub mod steps;
 mod tables;
 
 pub use automation::Automation;
-pub use memory::human_bytes;
+pub use memory::{available_bytes, human_bytes};
 pub use outputs::{remove_temporary_files, render_to_files, RenderReport};
 pub use render::{
     render_scene, render_scene_to_vec, BottleReport, RenderError, RenderObserver, RenderSummary,

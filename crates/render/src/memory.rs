@@ -43,7 +43,7 @@ pub(crate) fn max_units(scene: &Scene) -> u64 {
 
 /// Memory the system can give a new process without swapping (Linux: `MemAvailable` of
 /// `/proc/meminfo`); `None` where it cannot be told, and nothing is refused then.
-pub(crate) fn available_bytes() -> Option<u64> {
+pub fn available_bytes() -> Option<u64> {
     let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = meminfo
         .lines()
