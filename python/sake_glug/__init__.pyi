@@ -64,9 +64,11 @@ def render_tables(
     `--state`). Raises SakeGlugError for what it refuses."""
 
 def fit(session: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
-    """Fits a model to the recordings of a session file (`sake-glug fit`, MODEL.md §13):
-    {"liquids": {name: {"estimates": {key: {"value", "low", "high", "in_model"}}, "units",
-    "kept_default", "model"}}, "warnings": [...]}. Writes nothing."""
+    """Fits a model to the recordings of a session file (`sake-glug fit`, MODEL.md §13) and
+    returns what `sake-glug fit --json` prints: {"units": {"detected", "used"}, "explained":
+    {recording: share}, "estimates": {key: {"value", "low", "high", "n", "in_model", "note"}},
+    "liquids": {name: {"estimates", "units", "detected", "kept_default", "model"}},
+    "warnings": [...]}. Writes nothing."""
 
 def analyze_paired(logs: List[Union[str, "os.PathLike[str]"]]) -> Dict[str, Any]:
     """The paired-comparison analysis of trial logs, as `sake-glug analyze paired --json`."""
