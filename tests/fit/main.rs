@@ -4,6 +4,7 @@
 
 mod bad_input;
 mod command;
+mod real;
 mod round_trip;
 
 use std::path::{Path, PathBuf};

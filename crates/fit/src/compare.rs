@@ -4,6 +4,7 @@
 //! recording's bins). The same for the paper's default bottle, so that a fit shows whether it
 //! came closer than the default.
 
+use sake_glug_io::keys;
 use sake_glug_render::{render_scene_to_vec, Scene};
 
 use super::session_fit::SessionFit;
@@ -14,7 +15,7 @@ pub const COMPARED_BAND_HZ: (f64, f64) = (50.0, 1000.0);
 /// Each bin is averaged with its neighbours within this distance (Hz).
 const SMOOTHING_HZ: f64 = 25.0;
 /// The length of a model's render compared (s): several glugs at any pour time.
-pub const RENDER_S: f64 = 5.0;
+pub const RENDER_S: f64 = 10.0;
 /// The default bottle: a scene of nothing but the tilt of a model file.
 const DEFAULT_BOTTLE: &str = "tilt_deg = 135.0\n";
 
@@ -80,9 +81,24 @@ fn pearson(pairs: &[(f64, f64)]) -> f64 {
 }
 
 /// The samples of the model file `model_toml` (a scene) rendered for [`RENDER_S`] at
-/// `sample_rate`; the renderer's message if it refuses.
+/// `sample_rate`, the bottle kept full (it glugs all along); the renderer's message if it
+/// refuses.
 pub fn render_model(model_toml: &str, sample_rate: u32) -> Result<Vec<f32>, String> {
-    let text = format!("sample_rate = {sample_rate}\nduration_s = {RENDER_S}\n{model_toml}");
+    let mut table: toml::Table = toml::from_str(model_toml).map_err(|error| error.to_string())?;
+    keys::insert(
+        &mut table,
+        "sample_rate",
+        toml::Value::Integer(sample_rate.into()),
+    );
+    keys::insert(&mut table, "duration_s", toml::Value::Float(RENDER_S));
+    // The bottle kept full: it glugs all along, at the level of the recordings' start, so that
+    // the spectrum is of many glugs rather than a few.
+    keys::insert(
+        &mut table,
+        "output.drain",
+        toml::Value::String("follow".into()),
+    );
+    let text = toml::to_string(&table).map_err(|error| error.to_string())?;
     let scene = Scene::parse(&text).map_err(|error| error.to_string())?;
     render_scene_to_vec(&scene)
         .map(|(samples, _)| samples)

@@ -4,9 +4,10 @@
 
 use super::curves::FittedCurves;
 use super::estimate::Estimate;
+use super::estimate::MIN_UNITS_FOR_MODEL;
 use super::model_toml::model_toml;
 use super::pour::{intervals, pockets, rate_error};
-use super::recording::{FittedUnit, RecordingFit};
+use super::recording::{FittedUnit, RecordingFit, LOW_EXPLAINED};
 use super::stats::{bootstrap, iqr, median, Line, NORMAL_IQR};
 use super::units::Modes;
 use sake_glug_engine::curves::REFERENCE_TILT_DEG;
@@ -200,7 +201,7 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
             Estimate::from_units(key, value, interval, n, in_model)
         })
         .collect();
-    if units.len() < super::estimate::MIN_UNITS_FOR_MODEL {
+    if units.len() < MIN_UNITS_FOR_MODEL {
         warnings.push(format!(
             "liquid `{liquid}`: the paper's model describes {} of its {detected} detected \
              unit(s): too few for a model of its glugs, whose constants keep their defaults",
@@ -236,7 +237,27 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
     }
     let kept_default = kept_at_default(&estimates, inputs.curves);
     let law = amplitude_law(&units);
-    let model_toml = model_toml(liquid, &estimates, inputs.curves, &kept_default);
+    // Where the model describes a recording poorly, its file says so before anything else.
+    let cautions: Vec<String> = recordings
+        .iter()
+        .filter(|r| r.explained < LOW_EXPLAINED)
+        .map(|r| {
+            format!(
+                "the units fitted explain only {:.0} % of {}: the paper's model describes it \
+                 poorly, and this model may not sound like it",
+                100.0 * r.explained.max(0.0),
+                r.name()
+            )
+        })
+        .chain((units.len() < MIN_UNITS_FOR_MODEL).then(|| {
+            format!(
+                "only {} unit(s) are described by the paper's model: the glug's constants keep \
+                 their defaults",
+                units.len()
+            )
+        }))
+        .collect();
+    let model_toml = model_toml(liquid, &estimates, inputs.curves, &kept_default, &cautions);
     LiquidFit {
         liquid: liquid.to_owned(),
         units: units.len(),

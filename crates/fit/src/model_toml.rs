@@ -17,6 +17,7 @@ pub(crate) fn model_toml(
     estimates: &[Estimate],
     curves: &FittedCurves,
     kept_default: &[(String, String)],
+    cautions: &[String],
 ) -> String {
     let mut table = toml::Table::new();
     keys::insert(
@@ -46,6 +47,9 @@ pub(crate) fn model_toml(
         "# The model of `{liquid}`, fitted by `sake-glug fit` (MODEL.md §13): a scene file that \
          plays the fitted bottle.\n"
     );
+    for caution in cautions {
+        text.push_str(&format!("# Caution: {}.\n", printable(caution)));
+    }
     for (key, why) in kept_default {
         // A comment line ends at a newline: a reason never carries one raw.
         text.push_str(&format!(

@@ -14,7 +14,10 @@ use nalgebra::{DMatrix, DVector, Owned, SMatrix, SVector, U7, U8};
 use num_complex::Complex;
 
 use super::window::{Span, Window};
-use super::{Component, Rejection, Strides, UnitFit, UnitMethod, MAX_DECAY_PER_S, MIN_EXPLAINED};
+use super::{
+    Component, Fitted, Placed, Rejection, Strides, UnitFit, UnitMethod, MAX_DECAY_PER_S,
+    MIN_EXPLAINED,
+};
 
 type Vector7 = SVector<f64, 7>;
 type Matrix7 = SMatrix<f64, 7, 7>;
@@ -94,6 +97,7 @@ pub(super) fn fit(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<U
         frequency_hz: p[3 + k],
         glide_hz_per_s: 0.0,
         heard_hz: p[3 + k],
+        in_span: 0.0,
         decay_per_s: p[5 + k],
         amplitude: p[1 + k].max(0.0),
         phase: 0.0,
@@ -109,11 +113,16 @@ pub(super) fn fit(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<U
         return Err(Rejection::OnsetMoved { shift_s });
     }
     Ok(UnitFit::new(
-        onset_s,
-        &components,
-        explained,
-        (span.first, span.end),
-        strides.fit,
+        Fitted {
+            onset_s,
+            components: &components,
+            explained,
+        },
+        Placed {
+            window: (span.first, span.end),
+            stride: strides.fit,
+            fs,
+        },
         Some(start),
         UnitMethod::Eq1,
     ))

@@ -31,9 +31,8 @@ const BEFORE_ONSET_S: f64 = 0.004;
 const BEFORE_NEXT_S: f64 = 0.004;
 /// The longest span (s): the components are 50 dB down by then at 40 /s.
 const LONGEST_WINDOW_S: f64 = 0.15;
-/// The shortest span (s) a unit is fitted in: less than a period of the low component says
-/// little about it.
-const SHORTEST_WINDOW_S: f64 = 0.012;
+/// The shortest span (s) a unit is fitted in: a period of 125 Hz, several of a bubble's.
+const SHORTEST_WINDOW_S: f64 = 0.008;
 /// Samples per period of the highest component the pencil keeps (it decimates to this).
 const PENCIL_SAMPLES_PER_PERIOD: f64 = 8.0;
 /// Samples per period of the highest component the least-squares fit keeps: it fits every k-th
@@ -47,8 +46,9 @@ pub const MIN_EXPLAINED: f64 = 0.5;
 pub(crate) const MAX_DECAY_PER_S: f64 = 5_000.0;
 /// The lowest frequency of a resonance (Hz): below it lie drift and handling noise.
 pub(crate) const LOWEST_HZ: f64 = 20.0;
-/// The stronger component lies at the unit's own spectral peak when within this share of the
-/// peak's frequency, or within one bin of a spectrum as long as the span (1/span Hz), if wider.
+/// The stronger component lies at the unit's own spectral peak (the strongest peak of the samples
+/// fitted) when within this share of the peak's frequency, or within one bin of a spectrum as
+/// long as those samples (1/their length), if wider.
 pub const AT_PEAK_SHARE: f64 = 0.1;
 /// A fitted unit is subtracted until it has decayed by this factor (−80 dB).
 const SUBTRACT_UNTIL: f64 = 1e-4;
@@ -74,6 +74,9 @@ pub struct Component {
     pub amplitude: f64,
     /// φ (radians): 0 in the paper's eq. 1.
     pub phase: f64,
+    /// Its energy in the span fitted under a Hann window: what the span's spectrum sees of it,
+    /// which tells a unit's stronger component.
+    pub in_span: f64,
 }
 
 impl Component {
@@ -81,11 +84,6 @@ impl Component {
     pub fn value(&self, tau: f64) -> f64 {
         let cycles = (self.frequency_hz + 0.5 * self.glide_hz_per_s * tau) * tau;
         self.amplitude * (-self.decay_per_s * tau).exp() * (TAU * cycles + self.phase).sin()
-    }
-
-    /// Its energy from the onset on, A²/(4B) (the sine's mean square ½ under e^(−2Bτ)).
-    pub fn energy(&self) -> f64 {
-        self.amplitude * self.amplitude / (4.0 * self.decay_per_s)
     }
 
     /// Why it is no resonance of a recording at `fs`, if it is not one.
@@ -149,26 +147,21 @@ pub struct UnitFit {
 }
 
 impl UnitFit {
-    fn new(
-        onset_s: f64,
-        fitted: &[Component],
-        explained: f64,
-        window: (usize, usize),
-        stride: usize,
-        start: Option<[f64; 7]>,
-        method: UnitMethod,
-    ) -> Self {
-        let mut sorted = fitted.to_vec();
+    fn new(fitted: Fitted, placed: Placed, start: Option<[f64; 7]>, method: UnitMethod) -> Self {
+        let mut sorted = fitted.components.to_vec();
         sorted.sort_by(|a, b| a.heard_hz.total_cmp(&b.heard_hz));
+        for component in &mut sorted {
+            component.in_span = in_span(component, fitted.onset_s, placed);
+        }
         let mut unit = Self {
-            onset_s,
+            onset_s: fitted.onset_s,
             components: [sorted.first().copied(), sorted.get(1).copied()],
             amplitude: [0.0; 2],
             frequency_hz: [f64::NAN; 2],
             decay_per_s: [f64::NAN; 2],
-            r_squared: explained,
-            window,
-            stride,
+            r_squared: fitted.explained,
+            window: placed.window,
+            stride: placed.stride,
             start: start.unwrap_or([f64::NAN; 7]),
             method,
         };
@@ -187,7 +180,7 @@ impl UnitFit {
         let count = self.fitted().count();
         for (index, component) in self.fitted().enumerate() {
             let mode = modes.mode_of(component.heard_hz, index, count);
-            if best[mode].is_none_or(|b| b.energy() < component.energy()) {
+            if best[mode].is_none_or(|b| b.in_span < component.in_span) {
                 best[mode] = Some(*component);
             }
         }
@@ -209,33 +202,10 @@ impl UnitFit {
         self.amplitude[0] / self.amplitude_sum()
     }
 
-    /// Its stronger component (by energy).
+    /// Its stronger component: the one with more energy in the span fitted, as the span's
+    /// spectrum sees it.
     pub fn stronger(&self) -> Option<&Component> {
-        self.fitted()
-            .max_by(|a, b| a.energy().total_cmp(&b.energy()))
-    }
-
-    /// Its stronger component as its span's spectrum sees it: by energy in the recording's
-    /// samples `[first, end)` under the Hann window that spectrum takes.
-    pub fn stronger_in(&self, first: usize, end: usize, fs: f64) -> Option<&Component> {
-        let width = (end - first) as f64;
-        let energy = |component: &Component| {
-            (first..end)
-                .map(|n| {
-                    let hann = 0.5 - 0.5 * (TAU * (n - first) as f64 / width).cos();
-                    let tau = n as f64 / fs - self.onset_s;
-                    if tau < 0.0 {
-                        0.0
-                    } else {
-                        (hann * component.value(tau)).powi(2)
-                    }
-                })
-                .sum::<f64>()
-        };
-        self.fitted()
-            .map(|c| (c, energy(c)))
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(c, _)| c)
+        self.fitted().max_by(|a, b| a.in_span.total_cmp(&b.in_span))
     }
 
     /// Its samples at `time_s`: every component fitted.
@@ -246,6 +216,39 @@ impl UnitFit {
         }
         self.fitted().map(|c| c.value(tau)).sum()
     }
+}
+
+/// A fit's result: its onset (s), components and the share of the samples it explains.
+struct Fitted<'a> {
+    onset_s: f64,
+    components: &'a [Component],
+    explained: f64,
+}
+
+/// Where a fit lies: its span `[first, end)` of the recording, read every `stride`-th sample, at
+/// the rate `fs`.
+#[derive(Debug, Clone, Copy)]
+struct Placed {
+    window: (usize, usize),
+    stride: usize,
+    fs: f64,
+}
+
+/// The energy of `component` (from `onset_s`) in the span under a Hann window.
+fn in_span(component: &Component, onset_s: f64, placed: Placed) -> f64 {
+    let (first, end) = placed.window;
+    let width = (end - first) as f64;
+    (first..end)
+        .map(|n| {
+            let hann = 0.5 - 0.5 * (TAU * (n - first) as f64 / width).cos();
+            let tau = n as f64 / placed.fs - onset_s;
+            if tau < 0.0 {
+                0.0
+            } else {
+                (hann * component.value(tau)).powi(2)
+            }
+        })
+        .sum()
 }
 
 /// Why a detected unit was not used.
@@ -486,14 +489,15 @@ fn fit_unit(
     strides: Strides,
 ) -> Result<UnitFit, (Rejection, Option<UnitFit>)> {
     let peaks = own_peaks(&span.samples, span.fs);
-    let Some(&(peak_hz, _)) = peaks.first() else {
+    if peaks.is_empty() {
         return Err((Rejection::NoResonance, None));
-    };
-    let at_peak = |unit: UnitFit, span_s: f64| -> Result<UnitFit, (Rejection, Option<UnitFit>)> {
-        let component_hz = unit
-            .stronger_in(span.first, span.end, span.fs)
-            .map_or(f64::NAN, |c| c.heard_hz);
-        let tolerance = (AT_PEAK_SHARE * peak_hz).max(1.0 / span_s);
+    }
+    // The stronger component must lie at the strongest peak of the samples it was fitted to.
+    let at_peak = |unit: UnitFit| -> Result<UnitFit, (Rejection, Option<UnitFit>)> {
+        let fitted = &span.samples[..unit.window.1 - span.first];
+        let peak_hz = own_peaks(fitted, span.fs).first().map_or(f64::NAN, |p| p.0);
+        let component_hz = unit.stronger().map_or(f64::NAN, |c| c.heard_hz);
+        let tolerance = (AT_PEAK_SHARE * peak_hz).max(span.fs / fitted.len() as f64);
         if (component_hz - peak_hz).abs() <= tolerance {
             Ok(unit)
         } else {
@@ -508,7 +512,7 @@ fn fit_unit(
     };
     let paper = eq1::fit(span, start_hz, strides)
         .map_err(|rejection| (rejection, None))
-        .and_then(|unit| at_peak(unit, span.duration_s()));
+        .and_then(at_peak);
     let Err(first_reason) = paper else {
         return paper;
     };
@@ -547,17 +551,22 @@ fn fit_unit(
         )
         .map(|fitted| {
             UnitFit::new(
-                fitted.onset_s,
-                &fitted.components,
-                fitted.explained,
-                (span.first, end),
-                own_strides.fit,
+                Fitted {
+                    onset_s: fitted.onset_s,
+                    components: &fitted.components,
+                    explained: fitted.explained,
+                },
+                Placed {
+                    window: (span.first, end),
+                    stride: own_strides.fit,
+                    fs: span.fs,
+                },
                 None,
                 method,
             )
         })
         .and_then(|unit| check(unit, span.fs))
-        .and_then(|unit| at_peak(unit, (end - span.first) as f64 / span.fs));
+        .and_then(at_peak);
         match attempt {
             Ok(unit) => return Ok(unit),
             Err(reason) => best = better(best, reason),

@@ -109,6 +109,7 @@ pub(super) fn fit(
                 decay_per_s: decay,
                 amplitude: sine.hypot(cosine),
                 phase: cosine.atan2(sine),
+                in_span: 0.0,
             }
         })
         .collect();
@@ -373,6 +374,7 @@ mod tests {
                 decay_per_s: 60.0,
                 amplitude: 0.5,
                 phase: 1.2,
+                in_span: 0.0,
             },
             Component {
                 frequency_hz: 1300.0,
@@ -381,6 +383,7 @@ mod tests {
                 decay_per_s: 90.0,
                 amplitude: 0.2,
                 phase: -2.0,
+                in_span: 0.0,
             },
         ];
         let onset_s = 0.004;
@@ -436,6 +439,7 @@ mod tests {
             decay_per_s: 40.0,
             amplitude: 0.5,
             phase: 0.3,
+            in_span: 0.0,
         };
         let onset_s = 0.004;
         let stride = 2;

@@ -62,11 +62,6 @@ impl Span {
             fs: self.fs,
         }
     }
-
-    /// Its length (s).
-    pub fn duration_s(&self) -> f64 {
-        self.samples.len() as f64 / self.fs
-    }
 }
 
 /// Every `stride`-th sample of the recording from `first` on: what a fit reads.
