@@ -82,7 +82,8 @@ impl Audio {
                 available,
             });
         }
-        let mut samples = Vec::with_capacity(frames as usize);
+        // A header may announce more than the file holds: reserve no more than 16 Mi samples.
+        let mut samples = Vec::with_capacity(frames.min(1 << 24) as usize);
         let outcome = match spec.sample_format {
             hound::SampleFormat::Float => collect(
                 reader.samples::<f32>().step_by(channels),
