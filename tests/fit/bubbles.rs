@@ -110,7 +110,7 @@ pub fn simulate(pour: &Pour) -> Simulated {
         let level = 0.6 + 0.4 * draws.uniform();
         let first = (t * fs).ceil() as usize;
         let mut phase_bubble = 0.0f64;
-        for n in first..len {
+        for (n, sample) in dry.iter_mut().enumerate().skip(first) {
             let tau = n as f64 / fs - t;
             let envelope_bubble = (-decay * tau).exp();
             let envelope_column = (-pour.column_decay * tau).exp();
@@ -118,7 +118,7 @@ pub fn simulate(pour: &Pour) -> Simulated {
                 break;
             }
             let hz = f0 * (1.0 + pour.rise * (1.0 - (-rise_rate * tau).exp()));
-            dry[n] += level
+            *sample += level
                 * (pour.bubble_share * envelope_bubble * phase_bubble.sin()
                     + (1.0 - pour.bubble_share) * envelope_column * (TAU * column_hz * tau).sin());
             phase_bubble += TAU * hz / fs;
@@ -142,8 +142,8 @@ pub fn simulate(pour: &Pour) -> Simulated {
         // Sparse taps of the tail (every 16th): a coarse room is enough, and quick.
         for (k, &tap) in tail.iter().enumerate().step_by(16) {
             let gain = reverb_level * tap / tail_energy * 4.0;
-            for n in k..len {
-                wet[n] += gain * dry[n - k];
+            for (n, sample) in wet.iter_mut().enumerate().skip(k) {
+                *sample += gain * dry[n - k];
             }
         }
     }

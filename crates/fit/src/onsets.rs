@@ -44,7 +44,7 @@ pub fn detect_onsets(samples: &[f32], sample_rate: f64, low_hz: f64) -> Vec<usiz
     const RESUM: usize = 1 << 16;
     let (mut behind, mut ahead) = (0.0, 0.0);
     for n in before..samples.len() - after {
-        if (n - before) % RESUM == 0 {
+        if (n - before).is_multiple_of(RESUM) {
             (behind, ahead) = (sum(n - before, before), sum(n, after));
         } else {
             behind += square(n - 1) - square(n - 1 - before);

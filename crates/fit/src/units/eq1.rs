@@ -42,7 +42,7 @@ const LM_PATIENCE: usize = 25;
 /// the nearest pencil pole); why not if the fit is implausible or explains too little.
 pub(super) fn fit(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<UnitFit, Rejection> {
     let fs = span.fs;
-    let poles = pencil_poles(span.from_onset(PENCIL_S), strides.pencil, fs);
+    let poles = pencil_poles(span.after_onset(PENCIL_S), strides.pencil, fs);
     let mut frequency_hz = start_hz;
     let mut decay_per_s = [DECAY_GUESS_PER_S; 2];
     for k in 0..2 {

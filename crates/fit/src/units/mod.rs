@@ -184,8 +184,7 @@ impl UnitFit {
                 best[mode] = Some(*component);
             }
         }
-        for mode in 0..2 {
-            let component = best[mode];
+        for (mode, component) in best.into_iter().enumerate() {
             self.amplitude[mode] = component.map_or(0.0, |c| c.amplitude);
             self.frequency_hz[mode] = component.map_or(f64::NAN, |c| c.heard_hz);
             self.decay_per_s[mode] = component.map_or(f64::NAN, |c| c.decay_per_s);
@@ -217,6 +216,9 @@ impl UnitFit {
         self.fitted().map(|c| c.value(tau)).sum()
     }
 }
+
+/// A fit not kept: why, and the fit if one was made (boxed: a unit is large).
+type Failed = Box<(Rejection, Option<UnitFit>)>;
 
 /// A fit's result: its onset (s), components and the share of the samples it explains.
 struct Fitted<'a> {
@@ -462,11 +464,14 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
                     rejection: None,
                 });
             }
-            Err((rejection, fit)) => detected.push(DetectedUnit {
-                onset_s,
-                fit,
-                rejection: Some(rejection),
-            }),
+            Err(failure) => {
+                let (rejection, fit) = *failure;
+                detected.push(DetectedUnit {
+                    onset_s,
+                    fit,
+                    rejection: Some(rejection),
+                });
+            }
         }
     }
     let energy = |signal: &[f32]| signal.iter().map(|&y| f64::from(y).powi(2)).sum::<f64>();
@@ -483,17 +488,13 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
 
 /// The unit `span` holds: eq. 1 if it describes it, else a phased fit from its own peaks, else
 /// the same in the first part of the span; or why none does, with the best fit rejected.
-fn fit_unit(
-    span: &Span,
-    start_hz: [f64; 2],
-    strides: Strides,
-) -> Result<UnitFit, (Rejection, Option<UnitFit>)> {
+fn fit_unit(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<UnitFit, Failed> {
     let peaks = own_peaks(&span.samples, span.fs);
     if peaks.is_empty() {
-        return Err((Rejection::NoResonance, None));
+        return Err(Box::new((Rejection::NoResonance, None)));
     }
     // The stronger component must lie at the strongest peak of the samples it was fitted to.
-    let at_peak = |unit: UnitFit| -> Result<UnitFit, (Rejection, Option<UnitFit>)> {
+    let at_peak = |unit: UnitFit| -> Result<UnitFit, Failed> {
         let fitted = &span.samples[..unit.window.1 - span.first];
         let peak_hz = own_peaks(fitted, span.fs).first().map_or(f64::NAN, |p| p.0);
         let component_hz = unit.stronger().map_or(f64::NAN, |c| c.heard_hz);
@@ -501,17 +502,17 @@ fn fit_unit(
         if (component_hz - peak_hz).abs() <= tolerance {
             Ok(unit)
         } else {
-            Err((
+            Err(Box::new((
                 Rejection::OffPeak {
                     component_hz,
                     peak_hz,
                 },
                 Some(unit),
-            ))
+            )))
         }
     };
     let paper = eq1::fit(span, start_hz, strides)
-        .map_err(|rejection| (rejection, None))
+        .map_err(|rejection| Box::new((rejection, None)))
         .and_then(at_peak);
     let Err(first_reason) = paper else {
         return paper;
@@ -519,7 +520,7 @@ fn fit_unit(
     let own_hz: Vec<f64> = peaks.iter().map(|p| p.0).collect();
     let highest = own_hz.iter().copied().fold(0.0, f64::max);
     let own_strides = Strides::for_highest(highest, span.fs);
-    let poles = eq1::pencil_poles(span.from_onset(0.04), own_strides.pencil, span.fs);
+    let poles = eq1::pencil_poles(span.after_onset(0.04), own_strides.pencil, span.fs);
     let starts: Vec<(f64, f64)> = own_hz
         .iter()
         .map(|&hz| eq1::nearest_pole(&poles, hz).unwrap_or((hz, eq1::DECAY_GUESS_PER_S)))
@@ -549,6 +550,7 @@ fn fit_unit(
             &starts[..count],
             method == UnitMethod::Glide,
         )
+        .map_err(|rejection| Box::new((rejection, None)))
         .map(|fitted| {
             UnitFit::new(
                 Fitted {
@@ -576,27 +578,24 @@ fn fit_unit(
 }
 
 /// A phased fit checked: finite, resonant and explaining enough.
-fn check(unit: UnitFit, fs: f64) -> Result<UnitFit, (Rejection, Option<UnitFit>)> {
+fn check(unit: UnitFit, fs: f64) -> Result<UnitFit, Failed> {
     for component in unit.fitted() {
-        component.check(fs).map_err(|r| (r, Some(unit)))?;
+        component.check(fs).map_err(|r| Box::new((r, Some(unit))))?;
     }
     if unit.r_squared < MIN_EXPLAINED {
-        return Err((
+        return Err(Box::new((
             Rejection::Unexplained {
                 share: unit.r_squared,
             },
             Some(unit),
-        ));
+        )));
     }
     Ok(unit)
 }
 
 /// Of two rejections, the one whose fit explains more (a fit over none).
-fn better(
-    a: (Rejection, Option<UnitFit>),
-    b: (Rejection, Option<UnitFit>),
-) -> (Rejection, Option<UnitFit>) {
-    let share = |r: &(Rejection, Option<UnitFit>)| r.1.map_or(f64::NEG_INFINITY, |u| u.r_squared);
+fn better(a: Failed, b: Failed) -> Failed {
+    let share = |r: &Failed| r.1.map_or(f64::NEG_INFINITY, |u| u.r_squared);
     if share(&b) > share(&a) {
         b
     } else {

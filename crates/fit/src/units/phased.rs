@@ -14,7 +14,7 @@ use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
 
 use super::window::Window;
-use super::{Component, Rejection, UnitFit};
+use super::{Component, Rejection};
 
 /// The onset grid: this range around the detected onset (s), in steps.
 const ONSET_GRID_S: (f64, f64, f64) = (-0.004, 0.002, 0.00025);
@@ -46,8 +46,8 @@ pub(super) fn fit(
     detected_s: f64,
     starts: &[(f64, f64)],
     glide: bool,
-) -> Result<PhasedFit, (Rejection, Option<UnitFit>)> {
-    let not_finite = || (Rejection::NotFinite, None);
+) -> Result<PhasedFit, Rejection> {
+    let not_finite = || Rejection::NotFinite;
     let per = if glide { 5 } else { 4 };
     // Each component's (f at the onset, g, B) to start from.
     let mut starts: Vec<(f64, f64, f64)> = starts
@@ -215,7 +215,8 @@ fn refine(
         .with_patience(LM_PATIENCE)
         .minimize(problem);
     let sum_of_squares = problem.residuals()?.norm_squared();
-    (problem.params.iter().all(|v| v.is_finite()) && sum_of_squares.is_finite()).then(|| Refined {
+    let finite = problem.params.iter().all(|v| v.is_finite()) && sum_of_squares.is_finite();
+    finite.then_some(Refined {
         onset_s,
         params: problem.params,
         sum_of_squares,

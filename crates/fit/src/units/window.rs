@@ -37,7 +37,7 @@ impl Span {
     }
 
     /// Its samples from the detected onset on, at most `seconds` of them.
-    pub fn from_onset(&self, seconds: f64) -> &[f64] {
+    pub fn after_onset(&self, seconds: f64) -> &[f64] {
         let from = (self.onset - self.first).min(self.samples.len());
         let to = (from + (seconds * self.fs) as usize).min(self.samples.len());
         &self.samples[from..to]
