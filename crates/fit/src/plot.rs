@@ -110,7 +110,12 @@ pub fn draw_fit_plot(fit: &SessionFit, path: &Path) -> Result<(), String> {
             .map_err(|x| e(&x))?;
         if let Some(liquid) = fit.liquids.first() {
             for key in ["glug.f1_hz", "glug.f2_hz"] {
-                if let Some(estimate) = liquid.estimates.iter().find(|x| x.key == key) {
+                // An estimate without a value (a mode no unit rings) draws no line.
+                if let Some(estimate) = liquid
+                    .estimates
+                    .iter()
+                    .find(|x| x.key == key && x.has_value())
+                {
                     let f = estimate.value;
                     chart
                         .draw_series(std::iter::once(PathElement::new(

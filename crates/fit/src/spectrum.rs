@@ -23,9 +23,21 @@ pub(crate) const PEAK_SEPARATION: f64 = 1.4;
 const WEAKEST_OWN_PEAK: f64 = 1e-2;
 
 /// A unit's spectrum is zero-padded to at least this many times its length, and to a bin of at
-/// most [`OWN_BIN_HZ`]: fine enough to place a peak within a few hertz.
-const OWN_PADDING: usize = 4;
-const OWN_BIN_HZ: f64 = 2.0;
+/// most [`OWN_BIN_HZ`]: with a parabola through the peak's bins, fine enough to place a peak
+/// within a few hertz.
+const OWN_PADDING: usize = 2;
+const OWN_BIN_HZ: f64 = 4.0;
+
+thread_local! {
+    /// rustfft's planner keeps the plans it made: a fit asks for the same few lengths again and
+    /// again.
+    static PLANNER: std::cell::RefCell<FftPlanner<f64>> = std::cell::RefCell::new(FftPlanner::new());
+}
+
+/// The forward FFT of `len` points, planned once per length and thread.
+fn forward(len: usize) -> std::sync::Arc<dyn rustfft::Fft<f64>> {
+    PLANNER.with(|planner| planner.borrow_mut().plan_fft_forward(len))
+}
 
 /// The averaged power spectrum of a recording.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,7 +55,7 @@ impl Spectrum {
         let len = ((SEGMENT_S * sample_rate) as usize)
             .next_power_of_two()
             .min(samples.len().next_power_of_two().max(16));
-        let fft = FftPlanner::new().plan_fft_forward(len);
+        let fft = forward(len);
         let window: Vec<f64> = (0..len)
             .map(|n| 0.5 - 0.5 * (std::f64::consts::TAU * n as f64 / len as f64).cos())
             .collect();
@@ -111,7 +123,7 @@ impl Spectrum {
         let len = (OWN_PADDING * samples.len())
             .max((sample_rate / OWN_BIN_HZ) as usize)
             .next_power_of_two();
-        let fft = FftPlanner::new().plan_fft_forward(len);
+        let fft = forward(len);
         let width = samples.len() as f64;
         let mut buffer: Vec<Complex<f64>> = (0..len)
             .map(|n| {

@@ -74,8 +74,9 @@ pub struct Component {
     pub amplitude: f64,
     /// φ (radians): 0 in the paper's eq. 1.
     pub phase: f64,
-    /// Its energy in the span fitted under a Hann window: what the span's spectrum sees of it,
-    /// which tells a unit's stronger component.
+    /// The height of its peak in the spectrum of the span fitted (its samples alone, under the
+    /// Hann window, at the frequency it is heard at, from the samples the fit read): which tells a
+    /// unit's stronger component.
     pub in_span: f64,
 }
 
@@ -201,8 +202,7 @@ impl UnitFit {
         self.amplitude[0] / self.amplitude_sum()
     }
 
-    /// Its stronger component: the one with more energy in the span fitted, as the span's
-    /// spectrum sees it.
+    /// Its stronger component: the one whose peak in the spectrum of the span fitted is taller.
     pub fn stronger(&self) -> Option<&Component> {
         self.fitted().max_by(|a, b| a.in_span.total_cmp(&b.in_span))
     }
@@ -236,21 +236,26 @@ struct Placed {
     fs: f64,
 }
 
-/// The energy of `component` (from `onset_s`) in the span under a Hann window.
+/// The height of `component`'s peak (from `onset_s`) in the span's spectrum: the power of its
+/// samples alone, under the Hann window, at the frequency it is heard at. The taller of a unit's
+/// components is the one whose peak its spectrum shows.
 fn in_span(component: &Component, onset_s: f64, placed: Placed) -> f64 {
     let (first, end) = placed.window;
     let width = (end - first) as f64;
-    (first..end)
-        .map(|n| {
-            let hann = 0.5 - 0.5 * (TAU * (n - first) as f64 / width).cos();
-            let tau = n as f64 / placed.fs - onset_s;
-            if tau < 0.0 {
-                0.0
-            } else {
-                (hann * component.value(tau)).powi(2)
-            }
-        })
-        .sum()
+    let (mut re, mut im) = (0.0, 0.0);
+    // Every stride-th sample, as the fit read them: enough samples a period of the components.
+    for n in (first..end).step_by(placed.stride) {
+        let tau = n as f64 / placed.fs - onset_s;
+        if tau < 0.0 {
+            continue;
+        }
+        let hann = 0.5 - 0.5 * (TAU * (n - first) as f64 / width).cos();
+        let value = hann * component.value(tau);
+        let (sine, cosine) = (TAU * component.heard_hz * tau).sin_cos();
+        re += value * cosine;
+        im -= value * sine;
+    }
+    re * re + im * im
 }
 
 /// Why a detected unit was not used.
@@ -489,16 +494,20 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
 /// The unit `span` holds: eq. 1 if it describes it, else a phased fit from its own peaks, else
 /// the same in the first part of the span; or why none does, with the best fit rejected.
 fn fit_unit(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<UnitFit, Failed> {
-    let peaks = own_peaks(&span.samples, span.fs);
-    if peaks.is_empty() {
-        return Err(Box::new((Rejection::NoResonance, None)));
-    }
-    // The stronger component must lie at the strongest peak of the samples it was fitted to.
+    // The stronger component must lie at the strongest peak of the samples it was fitted to, read
+    // as the fit read them (every stride-th: a spectrum up to 8 samples a period of 1.3 times the
+    // highest start); a peak beyond that folds elsewhere and fails the check, and the fits from
+    // the unit's own peaks (found in every sample) then read at strides set by those peaks.
     let at_peak = |unit: UnitFit| -> Result<UnitFit, Failed> {
-        let fitted = &span.samples[..unit.window.1 - span.first];
-        let peak_hz = own_peaks(fitted, span.fs).first().map_or(f64::NAN, |p| p.0);
+        let read: Vec<f64> = span.samples[..unit.window.1 - span.first]
+            .iter()
+            .step_by(unit.stride)
+            .copied()
+            .collect();
+        let rate = span.fs / unit.stride as f64;
+        let peak_hz = own_peaks(&read, rate).first().map_or(f64::NAN, |p| p.0);
         let component_hz = unit.stronger().map_or(f64::NAN, |c| c.heard_hz);
-        let tolerance = (AT_PEAK_SHARE * peak_hz).max(span.fs / fitted.len() as f64);
+        let tolerance = (AT_PEAK_SHARE * peak_hz).max(rate / read.len() as f64);
         if (component_hz - peak_hz).abs() <= tolerance {
             Ok(unit)
         } else {
@@ -517,6 +526,10 @@ fn fit_unit(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<UnitFit
     let Err(first_reason) = paper else {
         return paper;
     };
+    let peaks = own_peaks(&span.samples, span.fs);
+    if peaks.is_empty() {
+        return Err(Box::new((Rejection::NoResonance, None)));
+    }
     let own_hz: Vec<f64> = peaks.iter().map(|p| p.0).collect();
     let highest = own_hz.iter().copied().fold(0.0, f64::max);
     let own_strides = Strides::for_highest(highest, span.fs);
