@@ -110,13 +110,22 @@ pub fn report_markdown(fit: &SessionFit) -> String {
             );
         }
         if let Some(law) = liquid.amplitude_law {
+            // Its zero is V0's estimate: a number only where V0 has one.
+            let silent_key = sake_glug_engine::Constant::SilentBelow.quantity().scene_key;
+            let zero = liquid
+                .estimates
+                .iter()
+                .find(|e| e.key == silent_key && e.has_value())
+                .map_or_else(
+                    || "no zero worth a number (see `amplitude.silent_below_ml`)".to_owned(),
+                    |e| format!("zero at {} ml", sig(e.value)),
+                );
             let _ = writeln!(
                 out,
-                "\nAmplitude law (fig. 7): Asum = {} · V + {} (R² = {:.3}), zero at {} ml.",
+                "\nAmplitude law (fig. 7): Asum = {} · V + {} (R² = {:.3}), {zero}.",
                 sig(law.slope),
                 sig(law.intercept),
                 law.r_squared,
-                sig(-law.intercept / law.slope)
             );
         }
         if !liquid.kept_default.is_empty() {
