@@ -84,7 +84,8 @@ fn pearson(pairs: &[(f64, f64)]) -> f64 {
 /// `sample_rate`, the bottle kept full (it glugs all along); the renderer's message if it
 /// refuses.
 pub fn render_model(model_toml: &str, sample_rate: u32) -> Result<Vec<f32>, String> {
-    let mut table: toml::Table = toml::from_str(model_toml).map_err(|error| error.to_string())?;
+    let mut table: toml::Table =
+        toml::from_str(model_toml).map_err(|error| keys::syntax_message(&error, model_toml))?;
     keys::insert(
         &mut table,
         "sample_rate",

@@ -16,7 +16,7 @@ pub enum FitError {
     #[error(transparent)]
     SessionRead(ReadError),
     /// Not valid TOML, an unknown key or a value of the wrong type.
-    #[error("invalid session {}: {}", shown(path), printable(message))]
+    #[error("invalid session {}: {message}", shown(path))]
     SessionSyntax {
         /// The session file.
         path: PathBuf,

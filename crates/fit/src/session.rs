@@ -1,6 +1,7 @@
 //! A fit session (MODEL.md §13): the bottle's capacity and its recordings, each a WAV file at one
 //! tilt, with its start volume or a weight log, and the liquid it holds.
 
+use sake_glug_io::keys;
 use sake_glug_io::read::{self, InputKind};
 use std::path::{Path, PathBuf};
 
@@ -106,7 +107,7 @@ impl FitSession {
     pub fn parse(text: &str, path: &Path) -> Result<Self, FitError> {
         let file: SessionFile = toml::from_str(text).map_err(|error| FitError::SessionSyntax {
             path: path.to_owned(),
-            message: error.to_string().trim_end().to_owned(),
+            message: keys::syntax_message(&error, text),
         })?;
         let value_error = |key: String, value: f64, why| FitError::SessionValue {
             path: path.to_owned(),
