@@ -4,6 +4,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod actuator;
 mod cli;
 mod clip_rules;
 mod clips_rendered;

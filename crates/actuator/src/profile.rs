@@ -44,6 +44,14 @@ pub enum ProfileError {
     /// names the key.
     #[error("invalid actuator profile: {0}")]
     Syntax(String),
+    /// A profile file refused for the reason given: the file named.
+    #[error("{file}: {error}")]
+    InFile {
+        /// The file, printable.
+        file: String,
+        /// Why it was refused.
+        error: Box<ProfileError>,
+    },
     /// A key every profile gives is missing.
     #[error("invalid actuator profile: `{0}` is missing")]
     Missing(&'static str),
@@ -89,7 +97,10 @@ impl ActuatorProfile {
     /// Reads the profile file at `path`.
     pub fn load(path: &Path) -> Result<Self, ProfileError> {
         let text = read::read_text(path, InputKind::ACTUATOR)?;
-        Self::parse(&text)
+        Self::parse(&text).map_err(|error| ProfileError::InFile {
+            file: quoted(&path.display().to_string()),
+            error: Box::new(error),
+        })
     }
 
     /// Parses and checks a profile's `text`.
