@@ -83,6 +83,9 @@ struct Unit {
     viscosity: f64,
     frequency_hz: [f64; 2],
     decay_per_s: [f64; 2],
+    /// A1 and A2 as driven (compensated).
+    driven: [f64; 2],
+    /// A1 + A2, 0 for a unit not heard.
     amplitude: f64,
 }
 
@@ -112,6 +115,7 @@ fn units_of(path: &Path) -> Vec<Unit> {
                 viscosity: value(1),
                 frequency_hz: [value(2), value(3)],
                 decay_per_s: [value(4), value(5)],
+                driven: [value(6), value(7)],
                 amplitude: (value(6) + value(7)) * value(8),
             }
         })
@@ -264,6 +268,13 @@ fn through_the_device_the_compensated_render_keeps_each_units_ratio() {
         let with = ratio_errors_db(directory.path(), profile, &["--actuator", argument]);
         let without = ratio_errors_db(directory.path(), profile, &[]);
         let worst = |errors: &[f64]| errors.iter().fold(0.0f64, |worst, e| worst.max(e.abs()));
+        let least = |errors: &[f64]| errors.iter().fold(f64::MAX, |least, e| least.min(e.abs()));
+        eprintln!(
+            "{argument}: compensated within {:.2e} dB, uncompensated off by {:.2} to {:.2} dB",
+            worst(&with),
+            least(&without),
+            worst(&without)
+        );
         assert!(worst(&with) < 0.5, "{argument}, compensated: {with:.3?}");
         assert!(
             without.iter().all(|error| error.abs() > 0.5),
@@ -378,4 +389,80 @@ fn bad_profiles_are_refused_with_the_file_and_the_key_named() {
         message.contains("no-such-device") && message.contains("haptuator-mark2"),
         "{message}"
     );
+}
+
+/// The fidelity report's delivered-c columns for the `wav` row, as `(mean, worst)` pairs:
+/// uncompensated, compensated.
+fn delivered_columns(report: &str) -> [(f64, f64); 2] {
+    let row = report
+        .lines()
+        .find(|line| line.starts_with("| `wav` |"))
+        .unwrap_or_else(|| panic!("no wav row in {report}"));
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    let pair = |cell: &str| {
+        let (mean, worst) = cell.split_once(" / ").unwrap_or_else(|| panic!("{row}"));
+        (mean.parse().unwrap(), worst.parse().unwrap())
+    };
+    [pair(cells[cells.len() - 3]), pair(cells[cells.len() - 2])]
+}
+
+#[test]
+fn the_fidelity_report_gives_the_c_the_device_delivers() {
+    let directory = tempfile::tempdir().unwrap();
+    let path = directory.path().join("sloped.toml");
+    std::fs::write(&path, SLOPED).unwrap();
+    let output = sake_glug(
+        directory.path(),
+        &[
+            "render",
+            "--fidelity",
+            "-o",
+            "f.wav",
+            "--units",
+            "f.units.csv",
+            "--actuator",
+            path.to_str().unwrap(),
+        ],
+    );
+    assert!(output.status.success());
+    let report = String::from_utf8_lossy(&output.stdout);
+    // Each audible unit's delivered c, worked out here from the units table and the points.
+    let points = points_of(SLOPED);
+    let shift = |drive: &dyn Fn(&Unit) -> [f64; 2], units: &[Unit]| {
+        let shifts: Vec<f64> = units
+            .iter()
+            .filter(|unit| unit.amplitude > 0.0)
+            .map(|unit| {
+                let [a1, a2] = drive(unit);
+                let [r1, r2] = unit.frequency_hz.map(|hz| response_at(&points, hz));
+                a1 * r1 / (a1 * r1 + a2 * r2) - unit.viscosity
+            })
+            .collect();
+        let mean = shifts.iter().sum::<f64>() / shifts.len() as f64;
+        (
+            mean,
+            shifts.iter().fold(0.0f64, |worst, s| worst.max(s.abs())),
+        )
+    };
+    let units = units_of(&directory.path().join("f.units.csv"));
+    let model = |unit: &Unit| [unit.viscosity, 1.0 - unit.viscosity];
+    let compensated = |unit: &Unit| unit.driven;
+    let [without, with] = delivered_columns(&report);
+    let expected = [shift(&model, &units), shift(&compensated, &units)];
+    for ((printed, expected), name) in [without, with]
+        .into_iter()
+        .zip(expected)
+        .zip(["uncompensated", "compensated"])
+    {
+        assert!(
+            (printed.0 - expected.0).abs() <= 0.0006 && (printed.1 - expected.1).abs() <= 0.0006,
+            "{name}: printed {printed:?}, worked out {expected:?}\n{report}"
+        );
+    }
+    assert!(
+        without.0 < -0.1,
+        "the sloped device thins the liquid: {without:?}"
+    );
+    // A platform that plays c itself says so.
+    assert!(report.contains("as carried"), "{report}");
 }
