@@ -104,6 +104,10 @@ enum SakeGlugStatus
    * The handle failed in an earlier call: it renders silence; destroy it and create another.
    */
   SAKE_GLUG_STATUS_FAILED = 9,
+  /**
+   * The actuator profile's text was refused: `sake_glug_last_error` says why.
+   */
+  SAKE_GLUG_STATUS_INVALID_PROFILE = 10,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -333,7 +337,8 @@ SakeGlugStatus sake_glug_control_range(int32_t control, SakeGlugRange *range);
 SakeGlug *sake_glug_create(double sample_rate, const char *model_text, uint64_t seed);
 
 /**
- * Why the last `sake_glug_create` on this thread returned NULL ("" after one that succeeded):
+ * Why the last `sake_glug_create` on this thread returned NULL, or the last
+ * `sake_glug_set_actuator` refused its profile ("" after one that succeeded):
  * copied into `buffer` as NUL-terminated UTF-8, cut at a character to fit `capacity` bytes.
  * Returns the message's full length in bytes (without the NUL), as snprintf does; `buffer` may
  * be NULL when `capacity` is 0, to ask the length.
@@ -390,6 +395,18 @@ SakeGlugStatus sake_glug_refill(SakeGlug *glug);
  * `glug` is NULL or a live handle.
  */
 SakeGlugStatus sake_glug_reset(SakeGlug *glug);
+
+/**
+ * Compensates the units that start from the first sample of the next process call on for the
+ * actuator whose profile is `profile_text` (an actuator profile file's text, MODEL.md §18), as
+ * `sake-glug render --actuator` does; NULL plays the model's drive as it is. A refused profile
+ * answers `SAKE_GLUG_STATUS_INVALID_PROFILE` and changes nothing; `sake_glug_last_error` says
+ * why. Parses the text, so it allocates: not on the audio thread.
+ *
+ * # Safety
+ * `glug` is NULL or a live handle; `profile_text` is NULL or a NUL-terminated string.
+ */
+SakeGlugStatus sake_glug_set_actuator(SakeGlug *glug, const char *profile_text);
 
 /**
  * Renders `frames` mono samples into `out`, after taking the control calls queued since the

@@ -296,3 +296,45 @@ fn a_ramps_every_value_is_its_two_point_lanes() {
         }
     }
 }
+
+#[test]
+fn an_actuator_profile_plays_as_the_renderers_actuator() {
+    let text = std::fs::read_to_string("actuators/haptuator-mark2.toml").unwrap();
+    let profile = sake_glug_actuator::ActuatorProfile::parse(&text).unwrap();
+    let scene = Scene {
+        actuator: Some(profile.response()),
+        ..Scene::default()
+    };
+    let (expected, expected_units) = offline(&scene);
+    let live = Live::paper(48_000.0);
+    let text = std::ffi::CString::new(text).unwrap();
+    assert_eq!(
+        unsafe { sake_glug::sake_glug_set_actuator(live.raw(), text.as_ptr()) },
+        SakeGlugStatus::Ok
+    );
+    let (samples, units) = builtin_pour(&live, 48_000, 333);
+    assert_same_samples(&samples, &expected, "haptuator-mark2");
+    assert_same_units(&units, &expected_units, "haptuator-mark2");
+    // The compensation changed the samples; NULL takes it off again (from the next call on).
+    assert_ne!(samples, offline(&Scene::default()).0);
+    let bad = std::ffi::CString::new(
+        "name = \"x\"\nresponse = [[2.0, 0.0]]\nband_hz = [2.0, 3.0]\nmax_amplitude = 1.0\n\
+         sample_rate_hz = 48000\n",
+    )
+    .unwrap();
+    assert_eq!(
+        unsafe { sake_glug::sake_glug_set_actuator(live.raw(), bad.as_ptr()) },
+        SakeGlugStatus::InvalidProfile
+    );
+    let message = super::last_error();
+    assert!(message.contains("`response`"), "{message}");
+    let plain = Live::paper(48_000.0);
+    assert_eq!(
+        unsafe { sake_glug::sake_glug_set_actuator(plain.raw(), std::ptr::null()) },
+        SakeGlugStatus::Ok
+    );
+    assert_eq!(
+        builtin_pour(&plain, 48_000, 4096).0,
+        offline(&Scene::default()).0
+    );
+}

@@ -15,3 +15,6 @@ mod shipped;
 pub use profile::{ActuatorProfile, ProfileError, ProfileText};
 pub use sake_glug_engine::{ActuatorResponse, Equalise};
 pub use shipped::{shipped_names, SHIPPED};
+
+/// The most a profile's text may hold (bytes): a file's limit, and the C library's for a text.
+pub const MAX_PROFILE_BYTES: u64 = sake_glug_io::read::InputKind::ACTUATOR.max_bytes;

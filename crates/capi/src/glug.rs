@@ -7,8 +7,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use crossbeam_queue::ArrayQueue;
 use sake_glug_engine::config::SAMPLE_RATE_HZ;
 use sake_glug_engine::{
-    sample_time_s, Control, ControlValues, Controls, Engine, Lane, LinearSegment, PerControl,
-    UnitOnset, Voicing,
+    sample_time_s, ActuatorResponse, Control, ControlValues, Controls, Engine, Lane, LinearSegment,
+    PerControl, UnitOnset, Voicing,
 };
 use sake_glug_model_file::{ModelFile, MAX_MODEL_BYTES};
 
@@ -32,6 +32,8 @@ pub enum Command {
     Refill,
     /// MODEL.md §8 reset; every control holds the value it had reached.
     Reset,
+    /// The actuator profile waiting in its slot (MODEL.md §18) takes effect.
+    Actuator,
 }
 
 /// A control on its way to a target: the two-point lane of a scene from `(p0/fs, from)` to
@@ -78,6 +80,9 @@ struct Audio {
 /// One live glug: the C interface's opaque handle.
 pub struct SakeGlug {
     commands: ArrayQueue<Command>,
+    /// The latest actuator profile set and not yet taken (`None`: no profile): one slot, so
+    /// that the queue's calls stay small; a later call replaces a profile not yet taken.
+    actuator: ArrayQueue<Option<ActuatorResponse>>,
     failed: AtomicBool,
     #[cfg(feature = "fault-injection")]
     fault: AtomicBool,
@@ -130,6 +135,7 @@ impl SakeGlug {
         });
         Ok(Self {
             commands: ArrayQueue::new(SAKE_GLUG_MAX_QUEUED_CONTROLS),
+            actuator: ArrayQueue::new(1),
             failed: AtomicBool::new(false),
             #[cfg(feature = "fault-injection")]
             fault: AtomicBool::new(false),
@@ -155,6 +161,16 @@ impl SakeGlug {
         self.commands
             .push(command)
             .map_err(|_| SakeGlugStatus::QueueFull)
+    }
+
+    /// Compensates the units that start from the next process call on for `actuator` (`None`:
+    /// none), as `sake-glug render --actuator` does; any thread.
+    pub fn set_actuator(&self, actuator: Option<ActuatorResponse>) -> Result<(), SakeGlugStatus> {
+        if self.has_failed() {
+            return Err(SakeGlugStatus::Failed);
+        }
+        self.actuator.force_push(actuator);
+        self.queue(Command::Actuator)
     }
 
     /// Whether an earlier call failed (the handle renders silence from then on).
@@ -189,7 +205,7 @@ impl SakeGlug {
     pub unsafe fn process(&self, out: &mut [f32]) {
         self.check_fault();
         let audio = unsafe { self.audio() };
-        audio.start_call(&self.commands);
+        audio.start_call(&self.commands, &self.actuator);
         let first = audio.engine.position();
         for span in out.chunks_mut(SPAN) {
             audio.render_span(span, first);
@@ -204,7 +220,7 @@ impl SakeGlug {
     pub unsafe fn process_interleaved(&self, out: &mut [f32], channels: usize) {
         self.check_fault();
         let audio = unsafe { self.audio() };
-        audio.start_call(&self.commands);
+        audio.start_call(&self.commands, &self.actuator);
         let first = audio.engine.position();
         for frames in out.chunks_mut(SPAN * channels) {
             let len = frames.len() / channels;
@@ -244,8 +260,19 @@ impl SakeGlug {
 
 impl Audio {
     /// Takes every queued control call, in order, at the first sample of the call.
-    fn start_call(&mut self, commands: &ArrayQueue<Command>) {
+    fn start_call(
+        &mut self,
+        commands: &ArrayQueue<Command>,
+        actuator: &ArrayQueue<Option<ActuatorResponse>>,
+    ) {
         while let Some(command) = commands.pop() {
+            if command == Command::Actuator {
+                // Every profile set by now is in the slot: a later marker finds it empty.
+                if let Some(response) = actuator.pop() {
+                    self.engine.set_actuator(response);
+                }
+                continue;
+            }
             self.apply(command);
         }
         self.kept = 0;
@@ -275,6 +302,7 @@ impl Audio {
                 self.held[control] = target;
             }
             Command::Refill => self.engine.refill(),
+            Command::Actuator => {}
             Command::Reset => {
                 for &control in Control::ALL {
                     self.held[control] = self.value_at(control, position);

@@ -26,7 +26,7 @@ fn guarded<T>(on_panic: T, body: impl FnOnce() -> T) -> T {
 }
 
 thread_local! {
-    /// Why the last `sake_glug_create` on this thread failed.
+    /// Why the last `sake_glug_create` on this thread failed, or `sake_glug_set_actuator`.
     static LAST_ERROR: RefCell<String> = const { RefCell::new(String::new()) };
 }
 
@@ -71,6 +71,7 @@ pub extern "C" fn sake_glug_status_text(status: i32) -> *const c_char {
         7 => c"too many control calls wait for the next process call",
         8 => c"the library failed inside this call; the handle renders silence from now on",
         9 => c"the handle failed earlier; destroy it and create another",
+        10 => c"the actuator profile was refused (sake_glug_last_error says why)",
         _ => c"not a status of SakeGlugStatus",
     };
     text.as_ptr()
@@ -152,7 +153,8 @@ pub unsafe extern "C" fn sake_glug_create(
     }
 }
 
-/// Why the last `sake_glug_create` on this thread returned NULL ("" after one that succeeded):
+/// Why the last `sake_glug_create` on this thread returned NULL, or the last
+/// `sake_glug_set_actuator` refused its profile ("" after one that succeeded):
 /// copied into `buffer` as NUL-terminated UTF-8, cut at a character to fit `capacity` bytes.
 /// Returns the message's full length in bytes (without the NUL), as snprintf does; `buffer` may
 /// be NULL when `capacity` is 0, to ask the length.
@@ -289,6 +291,53 @@ pub unsafe extern "C" fn sake_glug_refill(glug: *mut SakeGlug) -> SakeGlugStatus
 #[no_mangle]
 pub unsafe extern "C" fn sake_glug_reset(glug: *mut SakeGlug) -> SakeGlugStatus {
     unsafe { queue(glug, || Ok(Command::Reset)) }
+}
+
+/// Compensates the units that start from the first sample of the next process call on for the
+/// actuator whose profile is `profile_text` (an actuator profile file's text, MODEL.md §18), as
+/// `sake-glug render --actuator` does; NULL plays the model's drive as it is. A refused profile
+/// answers `SAKE_GLUG_STATUS_INVALID_PROFILE` and changes nothing; `sake_glug_last_error` says
+/// why. Parses the text, so it allocates: not on the audio thread.
+///
+/// # Safety
+/// `glug` is NULL or a live handle; `profile_text` is NULL or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn sake_glug_set_actuator(
+    glug: *mut SakeGlug,
+    profile_text: *const c_char,
+) -> SakeGlugStatus {
+    guarded(SakeGlugStatus::Panicked, || {
+        let glug = match unsafe { handle(glug) } {
+            Ok(glug) => glug,
+            Err(status) => return status,
+        };
+        let response = if profile_text.is_null() {
+            None
+        } else {
+            let bytes = unsafe { CStr::from_ptr(profile_text) }.to_bytes();
+            let text = if bytes.len() as u64 > sake_glug_actuator::MAX_PROFILE_BYTES {
+                Err(format!(
+                    "{} bytes, over the limit of {} bytes",
+                    bytes.len(),
+                    sake_glug_actuator::MAX_PROFILE_BYTES
+                ))
+            } else {
+                std::str::from_utf8(bytes).map_err(|_| "not UTF-8 text".to_owned())
+            };
+            let parsed = text.and_then(|text| {
+                sake_glug_actuator::ActuatorProfile::parse(text).map_err(|error| error.to_string())
+            });
+            match parsed {
+                Ok(profile) => Some(profile.response()),
+                Err(error) => {
+                    set_last_error(&format!("actuator profile: {error}"));
+                    return SakeGlugStatus::InvalidProfile;
+                }
+            }
+        };
+        set_last_error("");
+        status(glug.set_actuator(response))
+    })
 }
 
 /// A frame count within [`SAKE_GLUG_MAX_FRAMES`] (a negative count cast to size_t is far above

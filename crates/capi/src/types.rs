@@ -46,6 +46,8 @@ pub enum SakeGlugStatus {
     Panicked = 8,
     /// The handle failed in an earlier call: it renders silence; destroy it and create another.
     Failed = 9,
+    /// The actuator profile's text was refused: `sake_glug_last_error` says why.
+    InvalidProfile = 10,
 }
 
 /// The controls (MODEL.md §1, §6), in the order of the engine's table of controls. Their ranges
