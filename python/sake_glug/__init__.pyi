@@ -76,10 +76,12 @@ def render_tables(
     stops it. Raises SakeGlugError for what it refuses."""
 
 def fit(session: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
-    """Fits a model to the recordings of a session file (`sake-glug fit`, MODEL.md §13):
-    {"liquids": {name: {"estimates": {key: {"value", "low", "high", "in_model"}}, "units",
-    "kept_default", "model"}}, "warnings": [...]}. Writes nothing. Ctrl-C returns at once
-    (the fit, which cannot be stopped, runs on in the background and its result is dropped)."""
+    """Fits a model to the recordings of a session file (`sake-glug fit`, MODEL.md §13) and
+    returns what `sake-glug fit --json` prints: {"units": {"detected", "used"}, "explained":
+    {recording: share}, "estimates": {key: {"value", "low", "high", "n", "in_model", "note"}},
+    "liquids": {name: {"estimates", "units", "detected", "kept_default", "model"}},
+    "warnings": [...]}. Writes nothing. Ctrl-C returns at once (the fit, which cannot be
+    stopped, runs on in the background and its result is dropped)."""
 
 def analyze_paired(logs: List[Union[str, "os.PathLike[str]"]]) -> Dict[str, Any]:
     """The paired-comparison analysis of trial logs, as `sake-glug analyze paired --json`.

@@ -23,7 +23,7 @@ use sake_glug_analysis::{
     MAX_RESAMPLES,
 };
 use sake_glug_engine::{Preset, UnitOnset, Voicing, PRESETS};
-use sake_glug_fit::{fit_session, FitSession};
+use sake_glug_fit::{fit_json, fit_session, FitSession};
 use sake_glug_render::{
     render_scene, render_tables_until, Column, RenderError, RenderObserver, Scene, SceneError,
     StateRate, StateRow, TablesError, UnitRow, MAX_SCENE_BYTES,
@@ -357,51 +357,18 @@ fn columns<'py, R>(
 }
 
 /// Fits a model to the recordings of a session file (`sake-glug fit`, MODEL.md §13) and returns
-/// what the fit found: {"liquids": {name: {"estimates": {key: {"value", "low", "high",
-/// "in_model"}}, "units", "kept_default": {key: why}, "model": the model file's TOML}},
-/// "warnings": [...]}. Nothing is written. Raises SakeGlugError with the command line's message.
-/// Ctrl-C returns at once; the fit, which cannot be stopped, runs on in the background and its
-/// result is dropped.
+/// what `sake-glug fit --json` prints (`sake_glug_fit::fit_json`, the same numbers): {"units":
+/// {"detected", "used"}, "explained": {recording: share}, "estimates": {key: {"value", "low",
+/// "high", "n", "in_model", "note"}}, "liquids": {name: {...}}, "warnings": [...]}. Nothing is
+/// written. Raises SakeGlugError with the command line's message. Ctrl-C returns at once; the
+/// fit, which cannot be stopped, runs on in the background and its result is dropped.
 #[pyfunction]
 fn fit(py: Python<'_>, session: PathBuf) -> PyResult<Bound<'_, PyAny>> {
     let fitted = interruptible(py, move || {
         FitSession::load(&session).and_then(|session| fit_session(&session))
     })?
     .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
-    let liquids: serde_json::Map<String, serde_json::Value> = fitted
-        .liquids
-        .iter()
-        .map(|liquid| {
-            let estimates: serde_json::Map<String, serde_json::Value> = liquid
-                .estimates
-                .iter()
-                .map(|estimate| {
-                    let (low, high) = estimate.interval.unzip();
-                    let value = serde_json::json!({
-                        "value": estimate.value,
-                        "low": low,
-                        "high": high,
-                        "in_model": estimate.in_model,
-                    });
-                    (estimate.key.clone(), value)
-                })
-                .collect();
-            let kept: serde_json::Map<String, serde_json::Value> = liquid
-                .kept_default
-                .iter()
-                .map(|(key, why)| (key.clone(), why.clone().into()))
-                .collect();
-            let value = serde_json::json!({
-                "estimates": estimates,
-                "units": liquid.units,
-                "kept_default": kept,
-                "model": liquid.model_toml,
-            });
-            (liquid.liquid.clone(), value)
-        })
-        .collect();
-    let result = serde_json::json!({ "liquids": liquids, "warnings": fitted.warnings });
-    Ok(pythonize::pythonize(py, &result)?)
+    Ok(pythonize::pythonize(py, &fit_json(&fitted))?)
 }
 
 /// The paired-comparison analysis of trial logs (`sake-glug analyze paired --json`): the

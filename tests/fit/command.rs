@@ -202,3 +202,109 @@ fn a_fit_whose_last_file_cannot_be_written_leaves_no_file_and_keeps_the_old_ones
         "# the old model\n"
     );
 }
+
+/// A clip is enough: `fit CLIP.wav` without a session writes the model, the units table, the
+/// JSON on stdout and the comparison picture; the model plays at the clip's glug rate.
+#[test]
+fn a_clip_alone_is_fitted_with_every_output() {
+    let folder = tempfile::tempdir().unwrap();
+    let dir = folder.path();
+    let rendered = render("sample_rate = 25000\ntilt_deg = 135.0\nduration_s = 3.0\n");
+    let mut samples = rendered.samples.clone();
+    let sigma = glug_rms(&samples) * 0.01;
+    add_noise(&mut samples, sigma, 9);
+    write_wav(&dir.join("clip.wav"), &samples, 25_000);
+    let output = sake_glug(
+        dir,
+        &[
+            "fit",
+            "clip.wav",
+            "-o",
+            "model.toml",
+            "--units",
+            "units.csv",
+            "--compare",
+            "compare.png",
+            "--plot",
+            "fit.png",
+            "--report",
+            "fit.md",
+            "--json",
+        ],
+    );
+    assert_refused(&output, 0, &["clip.wav", "units used", "explaining"]);
+    let units = std::fs::read_to_string(dir.join("units.csv")).unwrap();
+    let mut lines = units.lines();
+    assert_eq!(
+        lines.next(),
+        Some("recording,onset_s,f1_hz,f2_hz,b1_per_s,b2_per_s,a1,a2,used,reason")
+    );
+    let rows: Vec<&str> = lines.collect();
+    assert!(rows.len() >= 20, "{units}");
+    assert!(
+        rows.iter().all(|row| row.starts_with("clip.wav,")),
+        "{units}"
+    );
+    assert!(
+        rows.iter().any(|row| row.ends_with(",1,")),
+        "no used unit has an empty reason: {units}"
+    );
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).expect("one JSON object");
+    let (detected, used) = (
+        json["units"]["detected"].as_u64().unwrap(),
+        json["units"]["used"].as_u64().unwrap(),
+    );
+    assert_eq!(detected as usize, rows.len());
+    assert!(used * 10 >= detected * 9, "{used} of {detected}");
+    assert!(
+        json["explained"]["clip.wav"].as_f64().unwrap() > 0.9,
+        "{json}"
+    );
+    let f1 = &json["estimates"]["glug.f1_hz"];
+    assert!(
+        (f1["value"].as_f64().unwrap() / 80.0 - 1.0).abs() < 0.03,
+        "{f1}"
+    );
+    assert!(
+        f1["low"].as_f64().unwrap() <= f1["value"].as_f64().unwrap(),
+        "{f1}"
+    );
+    assert_eq!(f1["n"].as_u64(), Some(used));
+    // No weight log: the pocket keeps its default, with no number and no interval of its own.
+    assert!(json["estimates"]["bottle.pocket_ml"].is_null(), "{json}");
+    for png in ["compare.png", "fit.png"] {
+        assert!(std::fs::read(dir.join(png))
+            .unwrap()
+            .starts_with(b"\x89PNG"));
+    }
+    let model = std::fs::read_to_string(dir.join("model.toml")).unwrap();
+    assert!(model.contains("pour_time_s"), "{model}");
+    let report = std::fs::read_to_string(dir.join("fit.md")).unwrap();
+    assert!(report.contains("| clip.wav |"), "{report}");
+}
+
+/// Clips and a session do not mix; the clips' bottle is not a session's.
+#[test]
+fn clip_options_with_a_session_and_mixed_inputs_exit_2() {
+    let folder = tempfile::tempdir().unwrap();
+    let dir = folder.path();
+    good_session(dir);
+    let before = files_in(dir);
+    for args in [
+        &[
+            "fit",
+            "session.toml",
+            "--capacity-ml",
+            "500",
+            "-o",
+            "m.toml",
+        ][..],
+        &["fit", "session.toml", "a.wav", "-o", "m.toml"][..],
+    ] {
+        let output = sake_glug(dir, args);
+        assert_eq!(output.status.code(), Some(2), "{args:?}");
+    }
+    assert_eq!(files_in(dir), before);
+    let output = sake_glug(dir, &["fit", "a.wav", "--tilt-deg", "200", "-o", "m.toml"]);
+    assert_refused(&output, 1, &["--tilt-deg 200"]);
+}

@@ -3,8 +3,11 @@
 //! refused or warned about.
 
 mod bad_input;
+mod bubbles;
 mod command;
+mod real;
 mod round_trip;
+mod simulated;
 
 use std::path::{Path, PathBuf};
 

@@ -75,6 +75,30 @@ fn every_repository_path_named_exists() {
     );
 }
 
+/// A fixture git ignores passes every local run and is missing from every clone (the real
+/// recordings were, behind `*.wav`): nothing under tests/fixtures may be ignored and untracked.
+#[test]
+fn every_fixture_is_in_the_repository() {
+    let output = std::process::Command::new("git")
+        .args([
+            "ls-files",
+            "--others",
+            "--ignored",
+            "--exclude-standard",
+            "--",
+            "tests/fixtures",
+        ])
+        .current_dir(ROOT)
+        .output()
+        .expect("git runs (the test reads what the repository holds)");
+    assert!(output.status.success(), "git ls-files failed: {output:?}");
+    let ignored = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        ignored.trim().is_empty(),
+        "fixtures git ignores, so a clone lacks them (see .gitignore):\n{ignored}"
+    );
+}
+
 #[test]
 fn every_cargo_target_named_exists() {
     // The root manifest and every crate's: a `--bin` may be the plugin crate's app.

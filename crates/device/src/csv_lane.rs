@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 use super::axis::{tilt_from_gravity, Axis};
-use sake_glug_io::text::{printable, quoted};
+use sake_glug_io::text::{cut_short, printable};
 
 /// The column of times, in seconds from the start of the take.
 pub const TIME_COLUMN: &str = "time_s";
@@ -213,8 +213,8 @@ pub fn read_csv_lane(
             let name = &header[index];
             match field.parse::<f64>() {
                 Ok(value) if value.is_finite() => Ok(value),
-                Ok(_) => Err(fail(line, &[name], CsvFault::NotFinite(quoted(field)))),
-                Err(_) => Err(fail(line, &[name], CsvFault::NotANumber(quoted(field)))),
+                Ok(_) => Err(fail(line, &[name], CsvFault::NotFinite(cut_short(field)))),
+                Err(_) => Err(fail(line, &[name], CsvFault::NotANumber(cut_short(field)))),
             }
         };
 

@@ -367,6 +367,14 @@ impl<'a> Controls<'a> {
         Control::pour().all(|control| self[control].is_constant_over(len))
     }
 
+    /// Whether every lane, the output gain's too, is a [`Lane::Constant`]: then the block is the
+    /// same from any of its samples on.
+    pub fn is_constant(&self) -> bool {
+        Control::ALL
+            .iter()
+            .all(|&control| self[control].is_constant())
+    }
+
     /// A block of the same controls starting `offset` samples later.
     pub fn offset(&self, offset: usize) -> Self {
         self.map(|_, lane| match lane {

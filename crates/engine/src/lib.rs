@@ -264,10 +264,19 @@ impl<S: Synthesis> Engine<S> {
             return;
         }
         let mut done = 0;
+        // Constant lanes need no slicing for each period.
+        let constant = controls.is_constant();
         while done < out.len() {
             let period_end = (self.sample / GRID as u64 + 1) * GRID as u64;
             let span = (out.len() - done).min((period_end - self.sample) as usize);
-            self.process_span(&controls.offset(done), &mut out[done..done + span], on_unit);
+            let sliced;
+            let span_controls = if constant {
+                controls
+            } else {
+                sliced = controls.offset(done);
+                &sliced
+            };
+            self.process_span(span_controls, &mut out[done..done + span], on_unit);
             done += span;
         }
     }

@@ -3,8 +3,10 @@
 //! straight ramp of [`OUTPUT_RAMP_S`], sample by sample, so that moving them does not click and
 //! the same automation gives the same samples however time is cut into blocks.
 
+use multiversion::multiversion;
+
 use super::amplitude::db_to_gain;
-use super::config::OUTPUT_RAMP_S;
+use super::config::{CEILING, OUTPUT_RAMP_S};
 use super::controls::{Control, Lane};
 
 /// A value that goes to each new target in a straight line of `len` samples.
@@ -198,7 +200,16 @@ impl OutputStage {
             return;
         }
         self.begin(gain_db.at(0), ceiling);
-        if gain_db.is_constant() && self.gain.is_settled() {
+        let constant_gain = gain_db.is_constant() && self.gain.is_settled();
+        if constant_gain && self.ceiling.is_settled() {
+            // The usual span, in one pass; the limiter's own pass only when it has work to do.
+            let ceiling = self.ceiling.value as f32;
+            if gain_and_flush(out, self.gain.value, ceiling) {
+                self.limit(out, ceiling);
+            }
+            return;
+        }
+        if constant_gain {
             let gain = self.gain.value;
             for y in out.iter_mut() {
                 *y = (*y as f64 * gain) as f32;
@@ -246,9 +257,124 @@ impl OutputStage {
     }
 }
 
+/// The output gain, then the limiter's flush of denormals to 0, in one pass: returns whether any
+/// sample is NaN, infinite or past `ceiling`, the only samples on which the limiter does more
+/// (then [`OutputStage::limit`] runs over the result and gives the very bits and counts it gives
+/// without the flush: a flushed sample was finite and below 2^−126, under any ceiling, which is
+/// at least [`CEILING`]'s minimum, so it counts for nothing, and the limiter makes it 0 too).
+/// Compiled like the synthesis for AVX2 and AVX-512 (the same IEEE operations in each lane, so
+/// the same bits as the baseline).
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
+fn gain_and_flush(out: &mut [f32], gain: f64, ceiling: f32) -> bool {
+    const { assert!(CEILING.min as f32 >= f32::MIN_POSITIVE) };
+    // The bits of |y| order as the magnitudes do, and NaN's lie above infinity's: the largest
+    // is past the ceiling's exactly when some sample is NaN, infinite or past the ceiling (an
+    // integer maximum, where the comparisons themselves would each need a reduction).
+    let magnitude = |y: f32| y.to_bits() & !(1 << 31);
+    let mut largest = 0;
+    for y in out.iter_mut() {
+        let value = (*y as f64 * gain) as f32;
+        largest = largest.max(magnitude(value));
+        *y = if magnitude(value) < f32::MIN_POSITIVE.to_bits() {
+            0.0
+        } else {
+            value
+        };
+    }
+    largest > ceiling.to_bits()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The gain, then the limiter's pass, as the stage applied them before the one-pass span.
+    fn gain_then_limiter(out: &mut [f32], gain: f64, ceiling: f32) -> LimiterCounts {
+        let mut stage = OutputStage::new(48_000.0);
+        for y in out.iter_mut() {
+            *y = (*y as f64 * gain) as f32;
+        }
+        stage.limit(out, ceiling);
+        stage.limiter
+    }
+
+    #[test]
+    fn the_one_pass_span_gives_the_bits_and_counts_of_gain_then_limiter() {
+        let specials = [
+            0.0,
+            -0.0,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            f32::MIN_POSITIVE / 2.0,
+            -1e-45,
+            1e-30,
+            0.999,
+            1.0,
+            -1.5,
+            f32::MAX,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -f32::NAN,
+        ];
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        // Gains that make denormals of ordinary samples and infinities of large ones.
+        let gains = [1.0, 0.5011872336272722, 3.98, 1e-36, 1e30];
+        let ceilings = [CEILING.min as f32, 0.5, 1.0];
+        let mut flushed = 0;
+        for round in 0..3000 {
+            let len = 1 + round % LONGEST_SPAN;
+            // Ordinary samples, with a special one now and then.
+            let input: Vec<f32> = (0..len)
+                .map(|_| {
+                    let bits = next();
+                    if bits % 7 == 0 {
+                        specials[(bits >> 8) as usize % specials.len()]
+                    } else {
+                        ((bits >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) as f32
+                    }
+                })
+                .collect();
+            for &gain in &gains {
+                for &ceiling in &ceilings {
+                    let mut expected = input.clone();
+                    let counts = gain_then_limiter(&mut expected, gain, ceiling);
+                    let mut stage = OutputStage::new(48_000.0);
+                    let mut got = input.clone();
+                    if gain_and_flush(&mut got, gain, ceiling) {
+                        stage.limit(&mut got, ceiling);
+                    }
+                    let bits = |samples: &[f32]| samples.iter().map(|y| y.to_bits()).collect();
+                    let (got_bits, expected_bits): (Vec<u32>, Vec<u32>) =
+                        (bits(&got), bits(&expected));
+                    assert_eq!(got_bits, expected_bits, "gain {gain}, ceiling {ceiling}");
+                    assert_eq!(
+                        (stage.limiter.events, stage.limiter.non_finite),
+                        (counts.events, counts.non_finite),
+                        "gain {gain}, ceiling {ceiling}: {input:?}"
+                    );
+                    flushed += input
+                        .iter()
+                        .filter(|&&y| {
+                            let gained = (y as f64 * gain) as f32;
+                            gained != 0.0 && gained.abs() < f32::MIN_POSITIVE
+                        })
+                        .count();
+                }
+            }
+        }
+        // The denormals were there to flush.
+        assert!(flushed > 100, "{flushed}");
+    }
+
+    /// Spans up to a grid period long, and a little longer (the stage takes any length).
+    const LONGEST_SPAN: usize = 70;
 
     #[test]
     fn a_ramp_reaches_its_target_in_len_samples_in_a_straight_line() {

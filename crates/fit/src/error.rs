@@ -3,8 +3,11 @@
 
 use std::path::{Path, PathBuf};
 
-use sake_glug_io::text::printable;
+use sake_glug_io::text::{cut_short, printable};
 use sake_glug_io::ReadError;
+use sake_glug_render::human_bytes;
+
+use super::audio::SampleFault;
 
 /// Why `sake-glug fit` could not fit a model.
 #[derive(Debug, thiserror::Error)]
@@ -13,7 +16,7 @@ pub enum FitError {
     #[error(transparent)]
     SessionRead(ReadError),
     /// Not valid TOML, an unknown key or a value of the wrong type.
-    #[error("invalid session {}: {}", shown(path), printable(message))]
+    #[error("invalid session {}: {message}", shown(path))]
     SessionSyntax {
         /// The session file.
         path: PathBuf,
@@ -71,6 +74,35 @@ pub enum FitError {
         /// The lowest rate accepted (Hz).
         min: u32,
     },
+    /// A recording too long to fit in the memory there is (refused before it is read).
+    #[error(
+        "`{key}`: {} holds {samples} samples, whose fit needs {} of memory; {} are available",
+        shown(path),
+        human_bytes(*needed),
+        human_bytes(*available)
+    )]
+    TooLarge {
+        /// The key naming it.
+        key: String,
+        /// The file.
+        path: PathBuf,
+        /// Its samples (one channel).
+        samples: u64,
+        /// The memory its fit needs (bytes).
+        needed: u64,
+        /// The memory available (bytes).
+        available: u64,
+    },
+    /// A recording whose samples are corrupt: not finite, or an isolated spike.
+    #[error("`{key}`: {}: {fault}", shown(path))]
+    Samples {
+        /// The key naming it.
+        key: String,
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with them.
+        fault: SampleFault,
+    },
     /// A recording with nothing in it.
     #[error(
         "`{key}`: {} is silent (peak {peak:e} after its offset is removed)",
@@ -85,7 +117,7 @@ pub enum FitError {
         peak: f64,
     },
     /// A weight log that cannot be read: the file, line and column.
-    #[error("`{key}`: {}, line {line}{}: {what}", shown(path), column.as_ref().map(|c| format!(", column {:?}", printable(c))).unwrap_or_default())]
+    #[error("`{key}`: {}, line {line}{}: {what}", shown(path), column.as_ref().map(|c| format!(", column {:?}", cut_short(c))).unwrap_or_default())]
     WeightLog {
         /// The key naming it (`recording[0].weight.csv`).
         key: String,
@@ -111,6 +143,19 @@ pub enum FitError {
     NoGlugs {
         /// The recording or liquid.
         what: String,
+    },
+    /// Units were found, but eq. 1 describes none of them: the model cannot be fitted.
+    #[error(
+        "{what}: {detected} unit(s) detected, but the paper's model describes none of them \
+         ({reasons}): no model is written"
+    )]
+    NoUnitDescribed {
+        /// The liquid.
+        what: String,
+        /// Units detected.
+        detected: usize,
+        /// The reasons they were rejected, each with its count.
+        reasons: String,
     },
     /// An output file could not be written (nothing was: every file is written all or none).
     #[error("cannot write {}: {message}", shown(path))]

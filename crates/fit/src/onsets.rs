@@ -18,23 +18,17 @@ const MIN_SEPARATION_S: f64 = 0.010;
 
 /// The samples near which units start in `samples` (DC removed) at `sample_rate`, given the
 /// lowest component's frequency `low_hz` (its period sets the window before), in order.
-pub fn detect_onsets(samples: &[f64], sample_rate: f64, low_hz: f64) -> Vec<usize> {
+pub fn detect_onsets(samples: &[f32], sample_rate: f64, low_hz: f64) -> Vec<usize> {
     let after = ((AFTER_S * sample_rate).round() as usize).max(2);
     let before = ((BEFORE_MIN_S.max(1.0 / low_hz.max(1.0)) * sample_rate).round() as usize).max(2);
     if samples.len() < after + before + 1 {
         return Vec::new();
     }
-    let mut energy = Vec::with_capacity(samples.len() + 1);
-    energy.push(0.0);
-    let mut sum = 0.0;
-    for &sample in samples {
-        sum += sample * sample;
-        energy.push(sum);
-    }
-    let mean = |from: usize, len: usize| (energy[from + len] - energy[from]) / len as f64;
+    let square = |n: usize| f64::from(samples[n]).powi(2);
+    let sum = |from: usize, len: usize| (from..from + len).map(square).sum::<f64>();
     // The noise: the quietest tenth of the windows; the loudest window.
     let mut windows: Vec<f64> = (0..samples.len() / after)
-        .map(|i| mean(i * after, after))
+        .map(|i| sum(i * after, after) / after as f64)
         .collect();
     windows.sort_by(f64::total_cmp);
     let noise = windows[windows.len() / 10];
@@ -45,12 +39,22 @@ pub fn detect_onsets(samples: &[f64], sample_rate: f64, low_hz: f64) -> Vec<usiz
 
     let separation = ((MIN_SEPARATION_S * sample_rate) as usize).max(1);
     let mut onsets: Vec<(usize, f64)> = Vec::new();
+    // Both windows' sums slide a sample at a time (no array as long as the recording), summed
+    // afresh every RESUM samples so that rounding cannot build up.
+    const RESUM: usize = 1 << 16;
+    let (mut behind, mut ahead) = (0.0, 0.0);
     for n in before..samples.len() - after {
-        let ahead = mean(n, after);
-        if ahead < gate {
+        if (n - before).is_multiple_of(RESUM) {
+            (behind, ahead) = (sum(n - before, before), sum(n, after));
+        } else {
+            behind += square(n - 1) - square(n - 1 - before);
+            ahead += square(n + after - 1) - square(n - 1);
+        }
+        let ahead_mean = ahead.max(0.0) / after as f64;
+        if ahead_mean < gate {
             continue;
         }
-        let ratio = ahead / (mean(n - before, before) + floor);
+        let ratio = ahead_mean / (behind.max(0.0) / before as f64 + floor);
         if ratio < RISE {
             continue;
         }

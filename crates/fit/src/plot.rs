@@ -1,12 +1,13 @@
 //! The fit plot: (a) the first units of the first recording with their fits, (b) its spectrum
 //! with f1 and f2, (c) Asum against V with the amplitude law (fig. 7), (d) V(t) per recording
-//! with its drain line (fig. 6).
+//! with its drain line (fig. 6). A panel with nothing to draw (no unit with a volume, no weight
+//! log nor drain line: a clip) says so in words instead of showing empty axes.
 
 use sake_glug_io::PendingFile;
 use sake_glug_plot::plotters::prelude::*;
 use sake_glug_plot::{Canvas, Plot, PlotError};
 
-use super::estimate::SessionFit;
+use super::session_fit::SessionFit;
 
 /// The plot: its name in messages and its size.
 const FIT_PLOT: Plot = Plot::new("fit plot", (1600, 1100));
@@ -28,14 +29,16 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
 
     // (a) The recording and the fitted units over its first glugs.
     if let Some(recording) = fit.recordings.iter().find(|r| !r.units.is_empty()) {
-        let fs = recording.audio.sample_rate as f64;
-        let from_s = (recording.units[0].fit.onset_s - 0.01).max(0.0);
+        let fs = recording.sample_rate as f64;
+        let samples = &recording.excerpt;
+        let excerpt_s = samples.len() as f64 / fs;
+        let from_s = (recording.units[0].fit.onset_s - 0.01).clamp(0.0, excerpt_s);
         let to_s = from_s + UNITS_SPAN_S;
-        let samples = &recording.audio.samples;
-        let range = (from_s * fs) as usize..((to_s * fs) as usize).min(samples.len());
+        let range =
+            ((from_s * fs) as usize).min(samples.len())..((to_s * fs) as usize).min(samples.len());
         let peak = samples[range.clone()]
             .iter()
-            .fold(1e-9f64, |p, y| p.max(y.abs()))
+            .fold(1e-9f64, |p, &y| p.max(f64::from(y).abs()))
             * 1.1;
         let mut chart = ChartBuilder::on(&panels[0])
             .margin(12)
@@ -54,7 +57,9 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
             .map_err(|x| e(&x))?;
         chart
             .draw_series(LineSeries::new(
-                range.clone().map(|n| (n as f64 / fs, samples[n])),
+                range
+                    .clone()
+                    .map(|n| (n as f64 / fs, f64::from(samples[n]))),
                 BLUE.mix(0.6),
             ))
             .map_err(|x| e(&x))?;
@@ -105,7 +110,12 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
             .map_err(|x| e(&x))?;
         if let Some(liquid) = fit.liquids.first() {
             for key in ["glug.f1_hz", "glug.f2_hz"] {
-                if let Some(estimate) = liquid.estimates.iter().find(|x| x.key == key) {
+                // An estimate without a value (a mode no unit rings) draws no line.
+                if let Some(estimate) = liquid
+                    .estimates
+                    .iter()
+                    .find(|x| x.key == key && x.has_value())
+                {
                     let f = estimate.value;
                     chart
                         .draw_series(std::iter::once(PathElement::new(
@@ -120,51 +130,78 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
 
     // (c) Asum against V, each liquid with its line.
     let capacity = fit.session.capacity_ml;
-    let top = fit
+    let with_volume = fit
         .recordings
         .iter()
-        .flat_map(|r| r.units.iter().map(|u| u.fit.amplitude_sum()))
-        .fold(1e-9, f64::max)
-        * 1.1;
-    let mut chart = ChartBuilder::on(&panels[2])
-        .margin(12)
-        .caption("(c) Asum against V (fig. 7)", ("sans-serif", 22))
-        .x_label_area_size(35)
-        .y_label_area_size(70)
-        .build_cartesian_2d(0.0..capacity, 0.0..top)
+        .flat_map(|r| r.units.iter())
+        .any(|u| u.volume_ml.is_finite());
+    if !with_volume {
+        say(
+            &panels[2],
+            "(c) Asum against V (fig. 7)",
+            "No unit has a volume: give start_ml and enough units, or a weight log.",
+        )
         .map_err(|x| e(&x))?;
-    chart
-        .configure_mesh()
-        .x_desc("volume V (ml)")
-        .y_desc("Asum")
-        .draw()
-        .map_err(|x| e(&x))?;
-    for (index, liquid) in fit.liquids.iter().enumerate() {
-        let colour = colours[index % colours.len()];
-        let points = fit
+    } else {
+        let top = fit
             .recordings
             .iter()
-            .filter(|r| r.spec.liquid == liquid.liquid)
-            .flat_map(|r| r.units.iter())
-            .filter(|u| u.volume_ml.is_finite())
-            .map(|u| Circle::new((u.volume_ml, u.fit.amplitude_sum()), 2, colour.filled()));
-        chart.draw_series(points).map_err(|x| e(&x))?;
-        if let Some(line) = liquid.amplitude_law {
-            let zero = (-line.intercept / line.slope).clamp(0.0, capacity);
-            chart
-                .draw_series(LineSeries::new(
-                    [(zero, line.at(zero)), (capacity, line.at(capacity))],
-                    colour.stroke_width(2),
-                ))
-                .map_err(|x| e(&x))?;
+            .flat_map(|r| r.units.iter().map(|u| u.fit.amplitude_sum()))
+            .fold(1e-9, f64::max)
+            * 1.1;
+        let mut chart = ChartBuilder::on(&panels[2])
+            .margin(12)
+            .caption("(c) Asum against V (fig. 7)", ("sans-serif", 22))
+            .x_label_area_size(35)
+            .y_label_area_size(70)
+            .build_cartesian_2d(0.0..capacity, 0.0..top)
+            .map_err(|x| e(&x))?;
+        chart
+            .configure_mesh()
+            .x_desc("volume V (ml)")
+            .y_desc("Asum")
+            .draw()
+            .map_err(|x| e(&x))?;
+        for (index, liquid) in fit.liquids.iter().enumerate() {
+            let colour = colours[index % colours.len()];
+            let points = fit
+                .recordings
+                .iter()
+                .filter(|r| r.spec.liquid == liquid.liquid)
+                .flat_map(|r| r.units.iter())
+                .filter(|u| u.volume_ml.is_finite())
+                .map(|u| Circle::new((u.volume_ml, u.fit.amplitude_sum()), 2, colour.filled()));
+            chart.draw_series(points).map_err(|x| e(&x))?;
+            if let Some(line) = liquid.amplitude_law {
+                let zero = (-line.intercept / line.slope).clamp(0.0, capacity);
+                chart
+                    .draw_series(LineSeries::new(
+                        [(zero, line.at(zero)), (capacity, line.at(capacity))],
+                        colour.stroke_width(2),
+                    ))
+                    .map_err(|x| e(&x))?;
+            }
         }
     }
 
     // (d) V(t) per recording with its drain line.
+    let drawn = fit
+        .recordings
+        .iter()
+        .any(|r| r.weight.is_some() || r.drain.is_some());
+    if !drawn {
+        say(
+            &panels[3],
+            "(d) V(t) per recording and its line (fig. 6)",
+            "No weight log and no drain line: the volumes over time are unknown.",
+        )
+        .map_err(|x| e(&x))?;
+        return root.present().map_err(|x| e(&x));
+    }
     let end_s = fit
         .recordings
         .iter()
-        .map(|r| r.audio.duration_s())
+        .map(|r| r.duration_s)
         .fold(0.1, f64::max);
     let mut chart = ChartBuilder::on(&panels[3])
         .margin(12)
@@ -205,11 +242,33 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
         }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|x| e(&x))?;
+    if fit.recordings.iter().any(|r| r.drain.is_some()) {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|x| e(&x))?;
+    }
     root.present().map_err(|x| e(&x))
+}
+
+/// A panel's caption and, in its middle, why it shows nothing.
+fn say<DB: DrawingBackend>(
+    panel: &DrawingArea<DB, sake_glug_plot::plotters::coord::Shift>,
+    caption: &str,
+    why: &str,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let (_, height) = panel.dim_in_pixel();
+    panel.draw_text(
+        caption,
+        &("sans-serif", 22).into_font().color(&BLACK),
+        (12, 12),
+    )?;
+    panel.draw_text(
+        why,
+        &("sans-serif", 20).into_font().color(&BLACK.mix(0.7)),
+        (40, height as i32 / 2),
+    )?;
+    Ok(())
 }

@@ -1,16 +1,31 @@
-//! The fit's report (markdown): the recordings, each liquid's estimates with their 95 %
-//! intervals, what was kept at its default, and every warning.
+//! The fit's report (markdown): the recordings (units detected and used, the share of each
+//! recording's energy they explain), each liquid's estimates with their 95 % intervals (or why
+//! there is none), what was kept at its default, and every warning. Every name from outside (a
+//! file, a liquid) is shown escaped and without a character that breaks the table.
 
 use std::fmt::Write;
 
-use super::estimate::SessionFit;
+use super::recording::LOW_EXPLAINED;
+use super::session_fit::SessionFit;
 use super::stats::BOOTSTRAP_RESAMPLES;
+use sake_glug_io::text::printable;
+
+/// `text` for a Markdown table cell: control characters escaped, `|` as `\|`.
+fn cell(text: &str) -> String {
+    printable(text).replace('|', "\\|")
+}
 
 /// The report of `fit`.
 pub fn report_markdown(fit: &SessionFit) -> String {
     let mut out = String::new();
     let session = &fit.session;
-    let _ = writeln!(out, "# Fit of {}\n", session.path.display());
+    let origin = if session.from_clips {
+        let names: Vec<String> = fit.recordings.iter().map(|r| cell(&r.name())).collect();
+        names.join(", ")
+    } else {
+        cell(&session.path.to_string_lossy())
+    };
+    let _ = writeln!(out, "# Fit of {origin}\n");
     let _ = writeln!(
         out,
         "The method of MODEL.md §13 on {} recording(s) of a {} ml bottle. Intervals are 95 %: a \
@@ -22,9 +37,9 @@ pub fn report_markdown(fit: &SessionFit) -> String {
     let _ = writeln!(out, "## Recordings\n");
     let _ = writeln!(
         out,
-        "| recording | file | liquid | tilt (°) | rate (Hz) | length (s) | units used | rejected | outflow (ml/s) | from | rest (ml) |"
+        "| recording | file | liquid | tilt (°) | rate (Hz) | length (s) | units detected | used | energy explained | outflow (ml/s) | from | rest (ml) |"
     );
-    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for recording in &fit.recordings {
         let spec = &recording.spec;
         let (rate, from) = match recording.drain {
@@ -40,15 +55,21 @@ pub fn report_markdown(fit: &SessionFit) -> String {
         };
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {} |",
-            spec.key,
-            spec.audio.display(),
-            spec.liquid,
+            "| {} | {} | {} | {} | {} | {:.2} | {} | {} | {:.0} %{} | {} | {} | {} |",
+            cell(&spec.key),
+            cell(&recording.name()),
+            cell(&spec.liquid),
             spec.tilt_deg,
-            recording.audio.sample_rate,
-            recording.audio.duration_s(),
+            recording.sample_rate,
+            recording.duration_s,
+            recording.detected.len(),
             recording.units.len(),
-            recording.rejected,
+            100.0 * recording.explained.max(0.0),
+            if recording.explained < LOW_EXPLAINED {
+                " (low)"
+            } else {
+                ""
+            },
             rate,
             from,
             recording
@@ -59,41 +80,58 @@ pub fn report_markdown(fit: &SessionFit) -> String {
     for liquid in &fit.liquids {
         let _ = writeln!(
             out,
-            "\n## Liquid `{}` ({} units)\n",
-            liquid.liquid, liquid.units
+            "\n## Liquid `{}` ({} of {} detected units used)\n",
+            cell(&liquid.liquid),
+            liquid.units,
+            liquid.detected
         );
-        let _ = writeln!(out, "| estimate | value | 95 % interval | in the model |");
-        let _ = writeln!(out, "|---|---|---|---|");
+        let _ = writeln!(
+            out,
+            "| estimate | value | 95 % interval | units | in the model |"
+        );
+        let _ = writeln!(out, "|---|---|---|---|---|");
         for estimate in &liquid.estimates {
-            let interval = estimate
-                .interval
-                .filter(|(low, high)| low.is_finite() && high.is_finite())
-                .map_or("—".into(), |(low, high)| {
-                    format!("{} … {}", sig(low), sig(high))
-                });
+            let interval = match estimate.interval {
+                Some((low, high)) => format!("{} … {}", sig(low), sig(high)),
+                None => estimate.note.as_deref().map_or("—".into(), cell),
+            };
             let _ = writeln!(
                 out,
-                "| `{}` | {} | {} | {} |",
+                "| `{}` | {} | {} | {} | {} |",
                 estimate.key,
-                sig(estimate.value),
+                if estimate.has_value() {
+                    sig(estimate.value)
+                } else {
+                    "—".into()
+                },
                 interval,
+                estimate.units.map_or("—".into(), |n| n.to_string()),
                 if estimate.in_model { "yes" } else { "no" }
             );
         }
         if let Some(law) = liquid.amplitude_law {
+            // Its zero is V0's estimate: a number only where V0 has one.
+            let silent_key = sake_glug_engine::Constant::SilentBelow.quantity().scene_key;
+            let zero = liquid
+                .estimates
+                .iter()
+                .find(|e| e.key == silent_key && e.has_value())
+                .map_or_else(
+                    || "no zero worth a number (see `amplitude.silent_below_ml`)".to_owned(),
+                    |e| format!("zero at {} ml", sig(e.value)),
+                );
             let _ = writeln!(
                 out,
-                "\nAmplitude law (fig. 7): Asum = {} · V + {} (R² = {:.3}), zero at {} ml.",
+                "\nAmplitude law (fig. 7): Asum = {} · V + {} (R² = {:.3}), {zero}.",
                 sig(law.slope),
                 sig(law.intercept),
                 law.r_squared,
-                sig(-law.intercept / law.slope)
             );
         }
         if !liquid.kept_default.is_empty() {
             let _ = writeln!(out, "\nKept at the default:\n");
             for (key, why) in &liquid.kept_default {
-                let _ = writeln!(out, "- `{key}`: {why}");
+                let _ = writeln!(out, "- `{key}`: {}", printable(why));
             }
         }
     }
@@ -113,7 +151,7 @@ pub fn report_markdown(fit: &SessionFit) -> String {
         let _ = writeln!(out, "None.");
     }
     for warning in &fit.warnings {
-        let _ = writeln!(out, "- {warning}");
+        let _ = writeln!(out, "- {}", printable(warning));
     }
     out
 }

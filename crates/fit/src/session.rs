@@ -1,13 +1,14 @@
 //! A fit session (MODEL.md §13): the bottle's capacity and its recordings, each a WAV file at one
 //! tilt, with its start volume or a weight log, and the liquid it holds.
 
+use sake_glug_io::keys;
 use sake_glug_io::read::{self, InputKind};
-use sake_glug_io::text::quoted;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
 use super::error::FitError;
+use sake_glug_engine::curves::REFERENCE_TILT_DEG;
 use sake_glug_engine::{Constant, Control};
 
 /// The liquid of a recording that names none.
@@ -16,8 +17,10 @@ pub const DEFAULT_LIQUID: &str = "liquid";
 /// A validated session, its paths resolved against the session file's folder.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitSession {
-    /// The session file (for messages).
+    /// The session file (for messages), or the first clip of a fit of clips.
     pub path: PathBuf,
+    /// Whether it is a fit of clips named on the command line (no session file).
+    pub from_clips: bool,
     /// The bottle's capacity C (ml).
     pub capacity_ml: f64,
     /// Every recording, in the file's order.
@@ -27,8 +30,10 @@ pub struct FitSession {
 /// One `[[recording]]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordingSpec {
-    /// Its place in messages: `recording[0]`.
+    /// Its place in messages: `recording[0]` (a clip: its file).
     pub key: String,
+    /// Its audio's place in messages: `recording[0].audio` (a clip: its file).
+    pub audio_key: String,
     /// The WAV file.
     pub audio: PathBuf,
     /// The tilt the bottle was held at (degrees).
@@ -102,7 +107,7 @@ impl FitSession {
     pub fn parse(text: &str, path: &Path) -> Result<Self, FitError> {
         let file: SessionFile = toml::from_str(text).map_err(|error| FitError::SessionSyntax {
             path: path.to_owned(),
-            message: error.to_string().trim_end().to_owned(),
+            message: keys::syntax_message(&error, text),
         })?;
         let value_error = |key: String, value: f64, why| FitError::SessionValue {
             path: path.to_owned(),
@@ -175,12 +180,13 @@ impl FitSession {
                         "`{key}.liquid` = \"{}\" ({} characters): a liquid names its model \
                          file, so it is 1 to {MAX_LIQUID_CHARS} characters, each a letter, a \
                          digit, `-` or `_`",
-                        quoted(&liquid),
+                        sake_glug_io::text::quoted(&liquid),
                         liquid.chars().count()
                     ),
                 });
             }
             recordings.push(RecordingSpec {
+                audio_key: format!("{key}.audio"),
                 key,
                 audio: folder.join(recording.audio),
                 tilt_deg: recording.tilt_deg,
@@ -191,6 +197,60 @@ impl FitSession {
         }
         Ok(FitSession {
             path: path.to_owned(),
+            from_clips: false,
+            capacity_ml,
+            recordings,
+        })
+    }
+
+    /// A session of clips without a session file: a bottle of `capacity_ml` (default: the
+    /// model's) held at `tilt_deg` (default 135°), full at each clip's first sample, one liquid.
+    pub fn of_clips(
+        clips: &[PathBuf],
+        capacity_ml: Option<f64>,
+        tilt_deg: Option<f64>,
+    ) -> Result<Self, FitError> {
+        let first = clips.first().ok_or_else(|| {
+            FitError::Outputs("no recording: name a session file or WAV clips".into())
+        })?;
+        let argument_error = |name: &str, value: f64, why: &str| {
+            FitError::Outputs(format!("--{name} {value}: {why}"))
+        };
+        let capacity = Constant::Capacity.quantity();
+        let capacity_ml = capacity_ml.unwrap_or(capacity.range.default);
+        if !capacity.range.contains(capacity_ml) {
+            return Err(argument_error(
+                "capacity-ml",
+                capacity_ml,
+                "outside the capacity's range (see `sake-glug parameters`)",
+            ));
+        }
+        let tilt_deg = tilt_deg.unwrap_or(REFERENCE_TILT_DEG);
+        if !Control::Tilt.range().contains(tilt_deg) {
+            return Err(argument_error(
+                "tilt-deg",
+                tilt_deg,
+                "a tilt lies within 0 to 180 degrees",
+            ));
+        }
+        let recordings = clips
+            .iter()
+            .map(|clip| {
+                let shown = sake_glug_io::text::printable(&clip.to_string_lossy()).into_owned();
+                RecordingSpec {
+                    key: shown.clone(),
+                    audio_key: shown,
+                    audio: clip.clone(),
+                    tilt_deg,
+                    start_ml: Some(capacity_ml),
+                    weight: None,
+                    liquid: DEFAULT_LIQUID.to_owned(),
+                }
+            })
+            .collect();
+        Ok(FitSession {
+            path: first.clone(),
+            from_clips: true,
             capacity_ml,
             recordings,
         })
@@ -208,46 +268,14 @@ impl FitSession {
     }
 }
 
+/// Whether `name` can name a file `<name>.toml` in any folder, on any system.
 /// The longest liquid name: it names a file `<name>.toml`, whose name must fit every system.
 const MAX_LIQUID_CHARS: usize = 64;
 
-/// Whether `name` can name a file `<name>.toml` in any folder, on any system.
 fn is_file_name(name: &str) -> bool {
     !name.is_empty()
         && name.len() <= MAX_LIQUID_CHARS
         && name
             .chars()
             .all(|ch| ch.is_ascii_alphanumeric() || ch == '-' || ch == '_')
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A 300-character liquid was refused as "letters, digits, `-` and `_` only"; the rule is
-    /// also a length, which the message now says, with the name cut short.
-    #[test]
-    fn a_long_liquid_name_is_refused_with_the_real_rule() {
-        let session = |liquid: &str| {
-            format!(
-                "capacity_ml = 300.0\n[[recording]]\naudio = \"a.wav\"\ntilt_deg = 90.0\n\
-                 start_ml = 300.0\nliquid = \"{liquid}\"\n"
-            )
-        };
-        let path = Path::new("session.toml");
-        let long = "a".repeat(300);
-        let message = FitSession::parse(&session(&long), path)
-            .unwrap_err()
-            .to_string();
-        assert!(
-            message.contains("(300 characters)") && message.contains("1 to 64 characters"),
-            "{message}"
-        );
-        assert!(message.len() < 300, "{message}");
-        FitSession::parse(&session(&"a".repeat(64)), path).unwrap();
-        let message = FitSession::parse(&session("rosé"), path)
-            .unwrap_err()
-            .to_string();
-        assert!(message.contains("a letter, a digit"), "{message}");
-    }
 }

@@ -1,5 +1,6 @@
 //! The recording's power spectrum (Welch's method, rustfft) and its two strongest peaks: the
-//! starting guess of f1 and f2 for every unit, and panel (b) of the plot.
+//! starting guess of f1 and f2 for eq. 1, and panel (b) of the plot; and a unit's own spectrum
+//! and its peaks, where a unit that eq. 1 does not describe is started.
 
 use rustfft::num_complex::Complex;
 use rustfft::FftPlanner;
@@ -15,7 +16,28 @@ const LOWEST_PEAK_HZ: f64 = 20.0;
 const WEAKEST_PEAK: f64 = 1e-3;
 
 /// Two peaks closer than this ratio of frequencies are one component.
-const PEAK_SEPARATION: f64 = 1.4;
+pub(crate) const PEAK_SEPARATION: f64 = 1.4;
+
+/// A unit's second peak counts as a component if within this fraction of its strongest (in
+/// power): 20 dB.
+const WEAKEST_OWN_PEAK: f64 = 1e-2;
+
+/// A unit's spectrum is zero-padded to at least this many times its length, and to a bin of at
+/// most [`OWN_BIN_HZ`]: with a parabola through the peak's bins, fine enough to place a peak
+/// within a few hertz.
+const OWN_PADDING: usize = 2;
+const OWN_BIN_HZ: f64 = 4.0;
+
+thread_local! {
+    /// rustfft's planner keeps the plans it made: a fit asks for the same few lengths again and
+    /// again.
+    static PLANNER: std::cell::RefCell<FftPlanner<f64>> = std::cell::RefCell::new(FftPlanner::new());
+}
+
+/// The forward FFT of `len` points, planned once per length and thread.
+fn forward(len: usize) -> std::sync::Arc<dyn rustfft::Fft<f64>> {
+    PLANNER.with(|planner| planner.borrow_mut().plan_fft_forward(len))
+}
 
 /// The averaged power spectrum of a recording.
 #[derive(Debug, Clone, PartialEq)]
@@ -29,11 +51,11 @@ pub struct Spectrum {
 impl Spectrum {
     /// Welch's estimate of the power spectrum of `samples` at `sample_rate` (Hann windows, half
     /// overlapping, a power of two long).
-    pub fn of(samples: &[f64], sample_rate: f64) -> Self {
+    pub fn of(samples: &[f32], sample_rate: f64) -> Self {
         let len = ((SEGMENT_S * sample_rate) as usize)
             .next_power_of_two()
             .min(samples.len().next_power_of_two().max(16));
-        let fft = FftPlanner::new().plan_fft_forward(len);
+        let fft = forward(len);
         let window: Vec<f64> = (0..len)
             .map(|n| 0.5 - 0.5 * (std::f64::consts::TAU * n as f64 / len as f64).cos())
             .collect();
@@ -42,7 +64,7 @@ impl Spectrum {
         let mut start = 0;
         loop {
             for (n, slot) in buffer.iter_mut().enumerate() {
-                let sample = samples.get(start + n).copied().unwrap_or(0.0);
+                let sample = samples.get(start + n).map_or(0.0, |&y| f64::from(y));
                 *slot = Complex::new(sample * window[n], 0.0);
             }
             fft.process(&mut buffer);
@@ -64,6 +86,18 @@ impl Spectrum {
     /// [`PEAK_SEPARATION`] apart, a peak's frequency refined by a parabola through its bin and
     /// its neighbours' log powers.
     pub fn peaks(&self) -> Vec<f64> {
+        let mut peaks: Vec<f64> = self
+            .peaks_within(WEAKEST_PEAK)
+            .into_iter()
+            .map(|(hz, _)| hz)
+            .collect();
+        peaks.sort_by(f64::total_cmp);
+        peaks
+    }
+
+    /// The one or two strongest peaks `(Hz, power)`, strongest first, the second at least
+    /// [`PEAK_SEPARATION`] from the first and within `weakest` of its power.
+    fn peaks_within(&self, weakest: f64) -> Vec<(f64, f64)> {
         let first_bin = ((LOWEST_PEAK_HZ / self.bin_hz).ceil() as usize).max(1);
         let mut maxima: Vec<(f64, f64)> = (first_bin..self.power.len().saturating_sub(1))
             .filter(|&bin| {
@@ -76,15 +110,48 @@ impl Spectrum {
             return Vec::new();
         };
         let second = maxima.iter().find(|&&(hz, power)| {
-            power >= WEAKEST_PEAK * strongest
+            power >= weakest * strongest
                 && (hz / strongest_hz).max(strongest_hz / hz) >= PEAK_SEPARATION
         });
-        let mut peaks = vec![strongest_hz];
-        peaks.extend(second.map(|&(hz, _)| hz));
-        peaks.sort_by(f64::total_cmp);
+        let mut peaks = vec![(strongest_hz, strongest)];
+        peaks.extend(second.copied());
         peaks
     }
 
+    /// The spectrum of one stretch of samples: a Hann window, zero-padded.
+    pub fn of_span(samples: &[f64], sample_rate: f64) -> Self {
+        let len = (OWN_PADDING * samples.len())
+            .max((sample_rate / OWN_BIN_HZ) as usize)
+            .next_power_of_two();
+        let fft = forward(len);
+        let width = samples.len() as f64;
+        let mut buffer: Vec<Complex<f64>> = (0..len)
+            .map(|n| {
+                let sample = samples.get(n).copied().unwrap_or(0.0);
+                let hann = 0.5 - 0.5 * (std::f64::consts::TAU * n as f64 / width).cos();
+                Complex::new(sample * hann, 0.0)
+            })
+            .collect();
+        fft.process(&mut buffer);
+        Self {
+            bin_hz: sample_rate / len as f64,
+            power: buffer[..=len / 2].iter().map(|z| z.norm_sqr()).collect(),
+        }
+    }
+
+    /// The frequency (Hz) at which a bin lies.
+    pub fn hz(&self, bin: usize) -> f64 {
+        bin as f64 * self.bin_hz
+    }
+}
+
+/// The peaks of a unit's own span `(Hz, power)`, strongest first: its strongest, and a second
+/// [`PEAK_SEPARATION`] from it within 20 dB if there is one.
+pub fn own_peaks(samples: &[f64], sample_rate: f64) -> Vec<(f64, f64)> {
+    Spectrum::of_span(samples, sample_rate).peaks_within(WEAKEST_OWN_PEAK)
+}
+
+impl Spectrum {
     fn refined_hz(&self, bin: usize) -> f64 {
         let log = |bin: usize| self.power[bin].max(1e-300).ln();
         let (left, centre, right) = (log(bin - 1), log(bin), log(bin + 1));

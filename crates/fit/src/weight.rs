@@ -1,10 +1,17 @@
 //! A recording's weight log: a CSV with a header, a time column and a weight column (g), read with
 //! the `csv` crate as the CSV lanes are (fields trimmed, rows as long as the header), turned into
-//! the residual volume V(t) in ml. A log that rises is refused: a pour only loses liquid.
+//! the residual volume V(t) in ml. A log that rises is refused: a pour only loses liquid; so is
+//! one whose volumes do not fit in the bottle (a scale not zeroed for it, or a wrong density or
+//! unit), with the figures. A message quotes at most the start of a field.
 
 use super::error::FitError;
 use super::session::WeightSpec;
 use sake_glug_io::read::{self, InputKind};
+use sake_glug_io::text::cut_short;
+
+/// Volumes beyond the bottle by more than this share of its capacity are refused: a scale's
+/// noise and a liquid's density known to a few per cent stay within it.
+const VOLUME_SLACK: f64 = 0.05;
 
 /// The residual volume over time read from a weight log.
 #[derive(Debug, Clone, PartialEq)]
@@ -16,8 +23,14 @@ pub struct WeightLog {
 impl WeightLog {
     /// Reads the log `spec` names (for the recording `key`); `start_ml`, if given, is the volume
     /// at its first row (the scale may weigh the bottle too: only the loss counts then), else a
-    /// row's volume is its weight over the density.
-    pub fn read(spec: &WeightSpec, key: &str, start_ml: Option<f64>) -> Result<Self, FitError> {
+    /// row's volume is its weight over the density. Volumes outside 0 … `capacity_ml` (by more
+    /// than [`VOLUME_SLACK`] of it) are refused.
+    pub fn read(
+        spec: &WeightSpec,
+        key: &str,
+        start_ml: Option<f64>,
+        capacity_ml: f64,
+    ) -> Result<Self, FitError> {
         let key = format!("{key}.weight.csv");
         let fail = |line: u64, column: Option<&str>, what: String| FitError::WeightLog {
             key: key.clone(),
@@ -57,7 +70,7 @@ impl WeightLog {
                     _ => Err(fail(
                         line,
                         Some(name),
-                        format!("{field:?} is not a finite number"),
+                        format!("{:?} is not a finite number", cut_short(field)),
                     )),
                 }
             };
@@ -95,7 +108,35 @@ impl WeightLog {
                 };
                 (time_s, volume_ml)
             })
-            .collect();
+            .collect::<Vec<(f64, f64)>>();
+        let (lowest, highest) = points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), p| {
+                (low.min(p.1), high.max(p.1))
+            });
+        let slack = VOLUME_SLACK * capacity_ml;
+        if highest > capacity_ml + slack || lowest < -slack {
+            let hint = match start_ml {
+                None => format!(
+                    "a volume is the weight over the density ({density} g/ml) unless start_ml is \
+                     given: was the scale zeroed with the empty bottle on it, and are the weights \
+                     in grams? (give start_ml to count only the liquid poured)"
+                ),
+                Some(start_ml) => format!(
+                    "the log loses {:.1} ml from start_ml = {start_ml} ml: are the weights in \
+                     grams, and the density ({density} g/ml) right?",
+                    (first_grams - rows[rows.len() - 1].2) / density
+                ),
+            };
+            return Err(fail(
+                0,
+                Some(&spec.column),
+                format!(
+                    "its volumes run from {lowest:.1} to {highest:.1} ml, which a bottle of \
+                     {capacity_ml} ml cannot hold; {hint}"
+                ),
+            ));
+        }
         Ok(Self { points })
     }
 

@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use super::error::FitError;
-use super::estimate::SessionFit;
+use super::session_fit::SessionFit;
 use sake_glug_io::PendingFile;
 
 /// The files a fit writes.
@@ -19,6 +19,10 @@ pub struct FitOutputs {
     pub report: Option<PathBuf>,
     /// The PNG plot.
     pub plot: Option<PathBuf>,
+    /// The units table (CSV).
+    pub units: Option<PathBuf>,
+    /// The comparison picture (PNG): the recording beside the model's render.
+    pub compare: Option<PathBuf>,
 }
 
 /// Writes every file `outputs` asks for from `fit`; returns each file and its size. A session of
@@ -58,6 +62,9 @@ pub fn write_fit(fit: &SessionFit, outputs: &FitOutputs) -> Result<Vec<(PathBuf,
     if let Some(path) = &outputs.report {
         texts.push((path.clone(), super::report_markdown(fit)));
     }
+    if let Some(path) = &outputs.units {
+        texts.push((path.clone(), super::units_csv(fit)));
+    }
     let mut files = Vec::new();
     for (path, text) in texts {
         let file = pending(&path, "")?;
@@ -74,8 +81,14 @@ pub fn write_fit(fit: &SessionFit, outputs: &FitOutputs) -> Result<Vec<(PathBuf,
         super::draw_fit_plot(fit, &file)?;
         files.push(file);
     }
+    #[cfg(feature = "plot")]
+    if let Some(path) = &outputs.compare {
+        let file = pending(path, ".png")?;
+        super::draw_compare_plot(fit, &file)?;
+        files.push(file);
+    }
     #[cfg(not(feature = "plot"))]
-    if outputs.plot.is_some() {
+    if outputs.plot.is_some() || outputs.compare.is_some() {
         return Err(FitError::Outputs(
             "this build draws no plots (feature `plot`)".into(),
         ));

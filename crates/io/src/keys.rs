@@ -3,7 +3,7 @@
 //! and a TOML syntax error made printable. Scenes, model files, study specs and the fit's model
 //! all use them (feature `toml`).
 
-use crate::text::printable;
+use crate::text::{cut_quotes, printable, quoted};
 
 /// The section and the name of a dotted key (`None` for a top-level key).
 pub fn split(key: &str) -> (Option<&str>, &str) {
@@ -78,15 +78,18 @@ pub fn insert_if_absent(table: &mut toml::Table, key: &str, value: &toml::Value)
     }
 }
 
-/// toml's message for a syntax error, every line printable: it shows the line at fault over
-/// several lines, whose layout is kept.
-pub fn syntax_message(error: &toml::de::Error) -> String {
-    error
-        .to_string()
-        .split('\n')
-        .map(|line| printable(line).into_owned())
-        .collect::<Vec<_>>()
-        .join("\n")
+/// toml's message for an error in `text`, on one line: where (`line L, column C`) and what,
+/// each span it quotes of the file cut short and printable ([`cut_quotes`]). toml's own layout
+/// shows the line at fault whole, which may be a file's worth of text.
+pub fn syntax_message(error: &toml::de::Error, text: &str) -> String {
+    let what = cut_quotes(error.message().trim_end());
+    let Some(start) = error.span().map(|span| span.start) else {
+        return what;
+    };
+    let before = text.get(..start).unwrap_or(text);
+    let line = 1 + before.matches('\n').count();
+    let column = 1 + before.rsplit('\n').next().unwrap_or("").chars().count();
+    format!("line {line}, column {column}: {what}")
 }
 
 /// A file's TOML from which each key is taken as it is read; whatever is left at the end is
@@ -100,7 +103,7 @@ pub struct KeyedTable {
 impl KeyedTable {
     /// Parses `text`; a syntax error gives [`syntax_message`].
     pub fn parse(text: &str) -> Result<Self, String> {
-        let table = toml::from_str(text).map_err(|error| syntax_message(&error))?;
+        let table = toml::from_str(text).map_err(|error| syntax_message(&error, text))?;
         Ok(Self::new(table))
     }
 
@@ -142,7 +145,7 @@ impl KeyedTable {
                 .map(Some)
                 .map_err(|error: toml::de::Error| {
                     // toml ends a message without a place in the file with a line break.
-                    printable(&format!("`{key}`: {}", error.to_string().trim_end())).into_owned()
+                    format!("`{key}`: {}", cut_quotes(error.to_string().trim_end()))
                 }),
         }
     }
@@ -167,11 +170,11 @@ impl KeyedTable {
         };
         let unknown = |name: &str, place: String, known: Vec<&str>| {
             let known: Vec<String> = known.iter().map(|name| format!("`{name}`")).collect();
-            printable(&format!(
-                "unknown field `{name}`{place}, expected one of {}",
-                known.join(", ")
-            ))
-            .into_owned()
+            format!(
+                "unknown field `{}`{place}, expected one of {}",
+                quoted(name),
+                printable(&known.join(", "))
+            )
         };
         for (name, value) in &self.table {
             let inside = names_in(Some(name));
@@ -180,7 +183,7 @@ impl KeyedTable {
                     return Err(unknown(name, String::new(), names_in(None)));
                 }
             } else if let Some(key) = value.as_table().and_then(|table| table.keys().next()) {
-                return Err(unknown(key, format!(" in [{name}]"), inside));
+                return Err(unknown(key, format!(" in [{}]", quoted(name)), inside));
             }
         }
         Ok(())
@@ -219,10 +222,34 @@ mod tests {
             keys.refuse_unknown().unwrap_err(),
             "unknown field `c` in [s], expected one of `b`"
         );
+        let long = "k".repeat(100_000);
+        let message = KeyedTable::parse(&format!("{long} = 1"))
+            .unwrap()
+            .refuse_unknown()
+            .unwrap_err();
+        assert!(message.len() < 200, "{message}");
         let mut keys = KeyedTable::parse("s = 1").unwrap();
         assert!(keys
             .take::<i64>("s.b")
             .unwrap_err()
             .contains("expected a table"));
+    }
+
+    /// A scene, model or spec that quotes a whole line or field of itself in a message can fill
+    /// a terminal with a file: toml's own layout shows the line at fault whole.
+    #[test]
+    fn messages_quote_a_file_cut_short_with_its_place() {
+        let line = format!("a = \"{}\" x", "v".repeat(100_000));
+        let message = KeyedTable::parse(&format!("# c\n{line}")).err().unwrap();
+        assert!(message.starts_with("line 2, column "), "{message}");
+        assert!(message.len() < 200, "{}", &message[..200]);
+        let mut keys =
+            KeyedTable::parse(&format!("b = \"{}\"", "\\u001b".repeat(100_000))).unwrap();
+        let message = keys.take::<f64>("b").unwrap_err();
+        assert!(message.starts_with("`b`: "), "{message}");
+        assert!(
+            message.len() < 300 && !message.contains('\u{1b}'),
+            "{message}"
+        );
     }
 }

@@ -26,13 +26,20 @@ pub fn printable(text: &str) -> Cow<'_, str> {
 /// whole line of a file.
 pub const QUOTED_CHARS: usize = 32;
 
-/// The start of `field` for a message to quote: its first [`QUOTED_CHARS`] characters, then `…`
-/// if it is longer; printable.
-pub fn quoted(field: &str) -> String {
+/// The start of `field`: at most [`QUOTED_CHARS`] characters, then `…` if it was cut, not yet
+/// escaped (for a message that escapes it, as `{:?}` does). A field of another file quoted in a
+/// message never carries that file whole (a 50 MB field, or the next line of a file that is no
+/// CSV).
+pub fn cut_short(field: &str) -> String {
     match field.char_indices().nth(QUOTED_CHARS) {
-        Some((end, _)) => format!("{}…", printable(&field[..end])),
-        None => printable(field).into_owned(),
+        Some((end, _)) => format!("{}…", &field[..end]),
+        None => field.to_owned(),
     }
+}
+
+/// The start of `field` for a message to quote: [`cut_short`], printable.
+pub fn quoted(field: &str) -> String {
+    printable(&cut_short(field)).into_owned()
 }
 
 /// A message from a library (a TOML or CSV error) whose spans between backquotes or double

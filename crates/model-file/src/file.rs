@@ -61,7 +61,7 @@ impl ModelFile {
     /// Parses and validates the model `text`, called `name`.
     pub fn parse(name: &str, text: &str) -> Result<Self, ModelFileError> {
         let table: toml::Table = toml::from_str(text)
-            .map_err(|error| ModelFileError::Syntax(keys::syntax_message(&error)))?;
+            .map_err(|error| ModelFileError::Syntax(keys::syntax_message(&error, text)))?;
         let keys = flatten(&table);
         let mut config = ModelConfig::default();
         let mut controls = PerControl::from_fn(|_| None);

@@ -191,7 +191,7 @@ impl Spec {
             message,
         };
         let table: toml::Table =
-            toml::from_str(text).map_err(|error| bad(toml_message(&error, text)))?;
+            toml::from_str(text).map_err(|error| bad(keys::syntax_message(&error, text)))?;
         let mut file = KeyedTable::new(table);
         let mut take = |key: &str| -> Result<Option<toml::Value>, StudyError> {
             file.take(key).map_err(|message| bad(cut_quotes(&message)))
@@ -407,19 +407,6 @@ fn required<T: serde::de::DeserializeOwned>(
     optional(value, key)?.ok_or_else(|| format!("missing field `{key}`"))
 }
 
-/// A TOML error as a message: where it is (line and column) and what, its quotes of the file cut
-/// short; never the line itself, which toml's own message shows and which may be any file's.
-fn toml_message(error: &toml::de::Error, text: &str) -> String {
-    let what = cut_quotes(error.message().trim_end());
-    let Some(start) = error.span().map(|span| span.start) else {
-        return what;
-    };
-    let before = text.get(..start).unwrap_or(text);
-    let line = 1 + before.matches('\n').count();
-    let column = 1 + before.rsplit('\n').next().unwrap_or("").chars().count();
-    format!("line {line}, column {column}: {what}")
-}
-
 /// The scene keys a constant design may vary: every control's and every constant's, from their
 /// tables.
 pub fn level_keys() -> impl Iterator<Item = &'static str> {
@@ -533,7 +520,7 @@ fn build_stimulus(
                 bad(format!(
                     "`{key}` = \"{}\": not TOML: {}",
                     quoted(&file),
-                    toml_message(&error, &text)
+                    keys::syntax_message(&error, &text)
                 ))
             })?;
             let scene_folder = path.parent().unwrap_or(Path::new("")).to_owned();

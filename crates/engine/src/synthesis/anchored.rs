@@ -31,6 +31,8 @@ pub struct AnchoredComponent {
     powers_im: [f32; GRID],
     /// State at `anchor_sample`, the first sample of the period being rendered.
     anchor: [f32; 2],
+    /// The same in f64, as it was worked out: what the level is read from.
+    anchor_f64: [f64; 2],
     anchor_sample: u64,
     /// State at the first sample of the next period.
     next_anchor: [f64; 2],
@@ -40,9 +42,6 @@ pub struct AnchoredComponent {
     /// The sample from which the component is silent (see [`Component::silent_from`]).
     silent_from: u64,
     periods_since_direct: u32,
-    /// |anchor|², for choosing which component to give up when the bank is full (squared: only
-    /// the order matters, and it saves a hypot per component per period).
-    level: f32,
 }
 
 impl BankComponent for AnchoredComponent {
@@ -53,6 +52,7 @@ impl BankComponent for AnchoredComponent {
             powers_re: [0.0; GRID],
             powers_im: [0.0; GRID],
             anchor: [0.0; 2],
+            anchor_f64: [0.0; 2],
             anchor_sample: first_sample,
             next_anchor: [0.0; 2],
             period_step: complex_exp(
@@ -62,7 +62,6 @@ impl BankComponent for AnchoredComponent {
             component,
             silent_from: component.silent_from(),
             periods_since_direct: 0,
-            level: 0.0,
         };
         anchored.set_anchor(component.state_at(first_sample));
         let next_period = (first_sample / GRID as u64 + 1) * GRID as u64;
@@ -71,8 +70,11 @@ impl BankComponent for AnchoredComponent {
         anchored
     }
 
+    /// |anchor|² rounded to f32 (squared: only the order matters, and it saves a hypot), worked
+    /// out only when the bank is full and a component is to be given up, not every period.
     fn level(&self) -> f64 {
-        self.level as f64
+        let [re, im] = self.anchor_f64;
+        (re * re + im * im) as f32 as f64
     }
 
     fn advance(&mut self, period_start: u64) -> bool {
@@ -139,7 +141,7 @@ impl AnchoredComponent {
 
     fn set_anchor(&mut self, state: [f64; 2]) {
         self.anchor = [state[0] as f32, state[1] as f32];
-        self.level = (state[0] * state[0] + state[1] * state[1]) as f32;
+        self.anchor_f64 = state;
     }
 
     fn fill_powers(&mut self) {

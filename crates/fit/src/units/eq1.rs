@@ -1,232 +1,58 @@
-//! Each unit's eq. 1 (MODEL.md §5, §13): two exponentially decaying sinusoids from a common onset,
-//! q(τ) = A1·e^(−B1τ)·sin(2πf1τ) + A2·e^(−B2τ)·sin(2πf2τ), fitted to the recording in the window
-//! from just before its onset to just before the next unit's. The start: the two poles of a
-//! matrix pencil (nalgebra's SVD and eigenvalues) nearest the recording's spectral peaks, the
-//! onset from a grid and the amplitudes by linear least squares; then all seven numbers refined
-//! together by Levenberg-Marquardt (the `levenberg-marquardt` crate), given the problem compressed
-//! to eight rows. The grid and the refinement read every k-th sample of the window, as many as
-//! eq. 1 needs (MODEL.md §13). Units are fitted in order,
-//! each fitted unit subtracted from the recording before the next is fitted, so that a unit
-//! starting while the last one rings is fitted alone.
+//! The paper's eq. 1 as it stands (MODEL.md §5, §13): two exponentially decaying sinusoids from a
+//! common onset, each starting at phase 0, q(τ) = A1·e^(−B1τ)·sin(2πf1τ) + A2·e^(−B2τ)·sin(2πf2τ),
+//! fitted in the window from just before its onset to just before the next unit's. The start:
+//! the two poles of a matrix pencil (nalgebra's SVD and eigenvalues) nearest the starting
+//! frequencies, the onset from a grid and the amplitudes by linear least squares; then all seven
+//! numbers refined together by Levenberg-Marquardt (the `levenberg-marquardt` crate), given the
+//! problem compressed to eight rows. The grid and the refinement read every k-th sample of the
+//! window, as many as eq. 1 needs (MODEL.md §13).
 
 use std::f64::consts::TAU;
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{DMatrix, DVector, Owned, SMatrix, SVector, U7, U8};
+use num_complex::Complex;
+
+use super::window::{Span, Window};
+use super::{
+    Component, Fitted, Placed, Rejection, Strides, UnitFit, UnitMethod, MAX_DECAY_PER_S,
+    MIN_EXPLAINED,
+};
 
 type Vector7 = SVector<f64, 7>;
 type Matrix7 = SMatrix<f64, 7, 7>;
-use num_complex::Complex;
 
-use super::onsets::detect_onsets;
-use super::spectrum::Spectrum;
-
-/// The fitted window starts this long before the detected onset (s): the silence before a unit
-/// pins its onset.
-const BEFORE_ONSET_S: f64 = 0.004;
-/// …and ends this long before the next detected onset (s), which may lie late by as much.
-const BEFORE_NEXT_S: f64 = 0.004;
-/// The longest window (s): the components are 50 dB down by then at 40 /s.
-const LONGEST_WINDOW_S: f64 = 0.15;
-/// The shortest window (s) a unit is fitted in: less than a period of the low component says
-/// little about it.
-const SHORTEST_WINDOW_S: f64 = 0.012;
 /// The onset grid of the starting guess: this range around the detected onset (s), in steps.
 const ONSET_GRID_S: (f64, f64, f64) = (-0.004, 0.002, 0.00025);
 /// The pencil sees at most this much of a unit (s): its loud start.
 const PENCIL_S: f64 = 0.04;
-/// Samples per period of the highest component the pencil keeps (it decimates to this).
-const PENCIL_SAMPLES_PER_PERIOD: f64 = 8.0;
 /// The pencil's Hankel matrix has at most this many columns: a model of order 4 needs few, and
 /// the SVD's cost grows with their square.
 const PENCIL_MAX_COLUMNS: usize = 16;
-/// Samples per period of the highest component the least-squares fit keeps: it fits every k-th
-/// sample of its window, k as large as keeps this many. Eq. 1 has seven numbers; a 25 kHz window
-/// holds 83 samples a period of 300 Hz, and the fit's cost falls with k while its noise grows
-/// only as √k (MODEL.md §13).
-const FIT_SAMPLES_PER_PERIOD: f64 = 16.0;
-/// A pencil pole within this frequency ratio of a spectral peak is taken for that component.
-const POLE_MATCH_RATIO: f64 = 1.3;
+/// A pencil pole within this frequency ratio of a starting frequency is taken for that component.
+pub(super) const POLE_MATCH_RATIO: f64 = 1.3;
 /// The decay assumed where the pencil finds none (1/s): the model's default B2.
-const DECAY_GUESS_PER_S: f64 = 40.0;
-/// A unit whose fit explains less than this share of its window's energy is rejected.
-const MIN_R_SQUARED: f64 = 0.5;
+pub(super) const DECAY_GUESS_PER_S: f64 = 40.0;
 /// A fitted onset further than this from the detected one is rejected (s).
 const MAX_ONSET_SHIFT_S: f64 = 0.006;
-/// The highest decay rate kept (1/s).
-const MAX_DECAY_PER_S: f64 = 5_000.0;
-/// A fitted unit is subtracted until it has decayed by this factor (−80 dB).
-const SUBTRACT_UNTIL: f64 = 1e-4;
 /// Levenberg-Marquardt gives up after patience × 8 evaluations.
 const LM_PATIENCE: usize = 25;
 
-/// One unit's eq. 1, as fitted.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct UnitFit {
-    /// The onset t_i (s from the recording's first sample).
-    pub onset_s: f64,
-    /// A1, A2 (the recording's units).
-    pub amplitude: [f64; 2],
-    /// f1, f2 (Hz), f1 the lower.
-    pub frequency_hz: [f64; 2],
-    /// B1, B2 (1/s).
-    pub decay_per_s: [f64; 2],
-    /// The share of its window's energy the fit explains.
-    pub r_squared: f64,
-    /// The window fitted, `[first, end)`…
-    pub window: (usize, usize),
-    /// …of which every `stride`-th sample from `first` on was read (MODEL.md §13).
-    pub stride: usize,
-    /// Where Levenberg-Marquardt started, `[onset (s), A1, A2, f1, f2, B1, B2]` (the pencil's
-    /// poles, the onset grid and its amplitudes): another solver started here is compared fairly
-    /// (benches/render.rs).
-    pub start: [f64; 7],
-}
-
-impl UnitFit {
-    /// Asum = A1 + A2.
-    pub fn amplitude_sum(&self) -> f64 {
-        self.amplitude[0] + self.amplitude[1]
-    }
-
-    /// c = A1/(A1 + A2) (paper eq. 2).
-    pub fn viscosity(&self) -> f64 {
-        self.amplitude[0] / self.amplitude_sum()
-    }
-
-    /// q(t) at `time_s`.
-    pub fn value_at(&self, time_s: f64) -> f64 {
-        let tau = time_s - self.onset_s;
-        if tau < 0.0 {
-            return 0.0;
-        }
-        (0..2)
-            .map(|k| {
-                self.amplitude[k]
-                    * (-self.decay_per_s[k] * tau).exp()
-                    * (TAU * self.frequency_hz[k] * tau).sin()
-            })
-            .sum()
-    }
-}
-
-/// Every unit of one recording.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RecordingUnits {
-    /// The units kept, in time order.
-    pub units: Vec<UnitFit>,
-    /// Onsets detected whose fit was rejected (too short a window, a poor or implausible fit).
-    pub rejected: usize,
-    /// The spectrum's peaks that started every unit's frequencies (Hz; f1 < f2).
-    pub start_hz: [f64; 2],
-    /// Whether the spectrum showed only one peak (the other start was guessed).
-    pub one_peak: bool,
-    /// The recording's spectrum.
-    pub spectrum: Spectrum,
-}
-
-/// Finds and fits every unit of `samples` (DC removed) at `sample_rate`.
-pub fn fit_units(samples: &[f64], sample_rate: u32) -> RecordingUnits {
-    let fs = sample_rate as f64;
-    let spectrum = Spectrum::of(samples, fs);
-    let peaks = spectrum.peaks();
-    // The paper's ratio of f2 to f1 guesses the other component when only one shows.
-    const RATIO: f64 = 300.0 / 80.0;
-    let (start_hz, one_peak) = match peaks.as_slice() {
-        [low, high] => ([*low, *high], false),
-        [only] if *only < 160.0 => ([*only, only * RATIO], true),
-        [only] => ([only / RATIO, *only], true),
-        _ => ([80.0, 300.0], true),
-    };
-    let onsets = detect_onsets(samples, fs, start_hz[0]);
-    let mut residual = samples.to_vec();
-    let mut units = Vec::with_capacity(onsets.len());
-    let mut rejected = 0;
-    // Both keep a margin for a component found above its start.
-    let highest_hz = start_hz[1] * POLE_MATCH_RATIO;
-    let strides = Strides {
-        pencil: ((fs / (PENCIL_SAMPLES_PER_PERIOD * highest_hz)) as usize).max(1),
-        fit: ((fs / (FIT_SAMPLES_PER_PERIOD * highest_hz)) as usize).max(1),
-    };
-    for (index, &onset) in onsets.iter().enumerate() {
-        let first = onset.saturating_sub((BEFORE_ONSET_S * fs) as usize);
-        let next = onsets.get(index + 1).copied().unwrap_or(samples.len());
-        let end = next
-            .saturating_sub((BEFORE_NEXT_S * fs) as usize)
-            .min(onset + (LONGEST_WINDOW_S * fs) as usize)
-            .min(samples.len());
-        if end < first + ((SHORTEST_WINDOW_S + BEFORE_ONSET_S) * fs) as usize {
-            rejected += 1;
-            continue;
-        }
-        match fit_unit(&residual, first, end, onset, fs, start_hz, strides) {
-            Some(unit) => {
-                subtract(&mut residual, &unit, fs);
-                units.push(unit);
-            }
-            None => rejected += 1,
-        }
-    }
-    RecordingUnits {
-        units,
-        rejected,
-        start_hz,
-        one_peak,
-        spectrum,
-    }
-}
-
-/// Every how many samples the pencil and the least-squares fit read a window.
-#[derive(Debug, Clone, Copy)]
-struct Strides {
-    pencil: usize,
-    fit: usize,
-}
-
-/// Fits the unit detected at `onset` in `signal[first..end]`; `None` if the fit is implausible.
-fn fit_unit(
-    signal: &[f64],
-    first: usize,
-    end: usize,
-    onset: usize,
-    fs: f64,
-    start_hz: [f64; 2],
-    strides: Strides,
-) -> Option<UnitFit> {
-    let pencil_end = end.min(onset + (PENCIL_S * fs) as usize);
-    let poles = pencil_poles(&signal[onset..pencil_end], strides.pencil, fs);
+/// Eq. 1 fitted to the unit `span` holds, its frequencies started at `start_hz` (each replaced by
+/// the nearest pencil pole); why not if the fit is implausible or explains too little.
+pub(super) fn fit(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<UnitFit, Rejection> {
+    let fs = span.fs;
+    let poles = pencil_poles(span.after_onset(PENCIL_S), strides.pencil, fs);
     let mut frequency_hz = start_hz;
     let mut decay_per_s = [DECAY_GUESS_PER_S; 2];
     for k in 0..2 {
-        let near = poles
-            .iter()
-            .filter(|(hz, decay)| {
-                (hz / start_hz[k]).max(start_hz[k] / hz) < POLE_MATCH_RATIO
-                    && *decay > 0.5
-                    && *decay < MAX_DECAY_PER_S
-            })
-            .min_by(|a, b| {
-                (a.0 / start_hz[k])
-                    .ln()
-                    .abs()
-                    .total_cmp(&(b.0 / start_hz[k]).ln().abs())
-            });
-        if let Some(&(hz, decay)) = near {
+        if let Some((hz, decay)) = nearest_pole(&poles, start_hz[k]) {
             frequency_hz[k] = hz;
             decay_per_s[k] = decay;
         }
     }
-    let window = Window {
-        data: signal[first..end]
-            .iter()
-            .step_by(strides.fit)
-            .copied()
-            .collect(),
-        first,
-        stride: strides.fit,
-        fs,
-    };
-    let detected_s = onset as f64 / fs;
+    let window = span.window(strides.fit);
+    let detected_s = span.onset_s();
     let (start_s, amplitude) = onset_grid(&window, detected_s, frequency_hz, decay_per_s);
     let start = [
         start_s,
@@ -254,47 +80,70 @@ fn fit_unit(
         .with_patience(LM_PATIENCE)
         .minimize(problem);
     let p = problem.params;
-    let mut unit = UnitFit {
-        onset_s: problem.reference_s + p[0] / 1000.0,
-        amplitude: [p[1], p[2]],
-        frequency_hz: [p[3], p[4]],
-        decay_per_s: [p[5], p[6]],
-        r_squared: 0.0,
-        window: (first, end),
-        stride: strides.fit,
-        start,
-    };
-    if unit.frequency_hz[0] > unit.frequency_hz[1] {
-        unit.amplitude.swap(0, 1);
-        unit.frequency_hz.swap(0, 1);
-        unit.decay_per_s.swap(0, 1);
+    let onset_s = problem.reference_s + p[0] / 1000.0;
+    if !p.iter().all(|value| value.is_finite()) {
+        return Err(Rejection::NotFinite);
     }
-    let energy: f64 = window.data.iter().map(|y| y * y).sum();
-    let residual: f64 = problem.residuals()?.norm_squared();
-    unit.r_squared = 1.0 - residual / energy.max(1e-300);
-    let total = unit.amplitude_sum();
-    let plausible = p.iter().all(|value| value.is_finite())
-        && total > 0.0
-        && unit.amplitude.iter().all(|&a| a >= -0.02 * total)
-        && unit
-            .frequency_hz
-            .iter()
-            .all(|&hz| hz > 0.0 && hz < fs / 2.0)
-        && unit
-            .decay_per_s
-            .iter()
-            .all(|&b| b > 0.0 && b < MAX_DECAY_PER_S)
-        && unit.r_squared >= MIN_R_SQUARED
-        && (unit.onset_s - detected_s).abs() <= MAX_ONSET_SHIFT_S;
-    for amplitude in &mut unit.amplitude {
-        *amplitude = amplitude.max(0.0);
+    let residual = problem
+        .residuals()
+        .ok_or(Rejection::NotFinite)?
+        .norm_squared();
+    let explained = 1.0 - residual / window.energy().max(1e-300);
+    let total = p[1] + p[2];
+    if !(total > 0.0 && p[1] >= -0.02 * total && p[2] >= -0.02 * total) {
+        return Err(Rejection::OutOfPhase);
     }
-    plausible.then_some(unit)
+    let components = [0, 1].map(|k| Component {
+        frequency_hz: p[3 + k],
+        glide_hz_per_s: 0.0,
+        heard_hz: p[3 + k],
+        in_span: 0.0,
+        decay_per_s: p[5 + k],
+        amplitude: p[1 + k].max(0.0),
+        phase: 0.0,
+    });
+    for component in &components {
+        component.check(fs)?;
+    }
+    if explained < MIN_EXPLAINED {
+        return Err(Rejection::Unexplained { share: explained });
+    }
+    let shift_s = onset_s - detected_s;
+    if shift_s.abs() > MAX_ONSET_SHIFT_S {
+        return Err(Rejection::OnsetMoved { shift_s });
+    }
+    Ok(UnitFit::new(
+        Fitted {
+            onset_s,
+            components: &components,
+            explained,
+        },
+        Placed {
+            window: (span.first, span.end),
+            stride: strides.fit,
+            fs,
+        },
+        Some(start),
+        UnitMethod::Eq1,
+    ))
+}
+
+/// The pencil pole nearest `hz` in frequency, within [`POLE_MATCH_RATIO`] and decaying plausibly.
+pub(super) fn nearest_pole(poles: &[(f64, f64)], hz: f64) -> Option<(f64, f64)> {
+    poles
+        .iter()
+        .filter(|(pole_hz, decay)| {
+            (pole_hz / hz).max(hz / pole_hz) < POLE_MATCH_RATIO
+                && *decay > 0.5
+                && *decay < MAX_DECAY_PER_S
+        })
+        .min_by(|a, b| (a.0 / hz).ln().abs().total_cmp(&(b.0 / hz).ln().abs()))
+        .copied()
 }
 
 /// The damped poles `(f Hz, B 1/s)`, f > 0, of a matrix pencil of order 4 (two real damped
 /// sinusoids) through `segment` taken every `step` samples.
-fn pencil_poles(segment: &[f64], step: usize, fs: f64) -> Vec<(f64, f64)> {
+pub(super) fn pencil_poles(segment: &[f64], step: usize, fs: f64) -> Vec<(f64, f64)> {
     const ORDER: usize = 4;
     let decimated: Vec<f64> = segment.iter().step_by(step).copied().collect();
     let len = decimated.len();
@@ -429,71 +278,6 @@ impl GridSums {
             (c[0] * ye0).im,
             (c[1] * ye1).im,
         ]
-    }
-}
-
-/// The samples a unit is fitted to: every `stride`-th sample of the recording from `first` on.
-struct Window {
-    data: Vec<f64>,
-    first: usize,
-    stride: usize,
-    fs: f64,
-}
-
-impl Window {
-    /// The recording's sample index of `data[n]`.
-    fn index(&self, n: usize) -> usize {
-        self.first + n * self.stride
-    }
-
-    /// The first n whose sample lies at or after `onset_s`, at most `data.len()`.
-    fn first_after(&self, onset_s: f64) -> usize {
-        let onset = (onset_s * self.fs).ceil().max(self.first as f64) - self.first as f64;
-        ((onset / self.stride as f64).ceil() as usize).min(self.data.len())
-    }
-
-    /// For each n from the onset on, `each(n, z, τ)` with z = e^((−B + i2πf)τ) and τ the time of
-    /// sample n after `onset_s`: one complex rotation per sample.
-    fn rotate(
-        &self,
-        onset_s: f64,
-        frequency_hz: f64,
-        decay_per_s: f64,
-        mut each: impl FnMut(usize, Complex<f64>, f64),
-    ) {
-        let rate = Complex::new(-decay_per_s, TAU * frequency_hz);
-        let period = self.stride as f64 / self.fs;
-        let step = (rate * period).exp();
-        let start = self.first_after(onset_s);
-        let tau0 = self.index(start) as f64 / self.fs - onset_s;
-        let mut z = (rate * tau0).exp();
-        for n in start..self.data.len() {
-            each(n, z, tau0 + (n - start) as f64 * period);
-            z *= step;
-        }
-    }
-}
-
-/// Subtracts `unit` from `signal` until it has decayed by [`SUBTRACT_UNTIL`].
-fn subtract(signal: &mut [f64], unit: &UnitFit, fs: f64) {
-    let slowest = unit.decay_per_s[0].min(unit.decay_per_s[1]).max(1.0);
-    let first = ((unit.onset_s * fs).ceil().max(0.0) as usize).min(signal.len());
-    let end = (first + (-SUBTRACT_UNTIL.ln() / slowest * fs) as usize).min(signal.len());
-    // The unit's span at full rate, as a window of its own.
-    let span = Window {
-        data: vec![0.0; end - first],
-        first,
-        stride: 1,
-        fs,
-    };
-    for k in 0..2 {
-        let amplitude = unit.amplitude[k];
-        span.rotate(
-            unit.onset_s,
-            unit.frequency_hz[k],
-            unit.decay_per_s[k],
-            |n, z, _| signal[first + n] -= amplitude * z.im,
-        );
     }
 }
 

@@ -1,0 +1,435 @@
+//! One liquid's model (MODEL.md §13): its glug constants and amplitude law from the units of its
+//! recordings, its pocket and timing from their intervals, its pour time from the rate at 135°,
+//! each estimate checked by the honesty rules of [`Estimate`].
+
+use super::curves::FittedCurves;
+use super::estimate::Estimate;
+use super::estimate::MIN_UNITS_FOR_MODEL;
+use super::model_toml::model_toml;
+use super::pour::{intervals, pockets, rate_error};
+use super::recording::{FittedUnit, RecordingFit, LOW_EXPLAINED};
+use super::stats::{bootstrap, iqr, median, Line, NORMAL_IQR};
+use super::units::Modes;
+use sake_glug_engine::curves::REFERENCE_TILT_DEG;
+use sake_glug_engine::{Constant, Control, Curve, Range};
+
+/// The z of a two-sided 95 % normal interval (a line's rate).
+const Z_95: f64 = 1.959_963_984_540_054;
+/// A fitted V0 further below the lowest unit's volume than this share of the volumes' span lies
+/// outside the data.
+const V0_BEYOND_DATA: f64 = 0.25;
+/// A mode's spread is estimated from at least this many units of it.
+const MIN_UNITS_FOR_SPREAD: usize = 3;
+
+/// One liquid's model.
+#[derive(Debug, Clone)]
+pub struct LiquidFit {
+    /// Its name.
+    pub liquid: String,
+    /// Every estimate, model keys first.
+    pub estimates: Vec<Estimate>,
+    /// The model's keys left at their defaults, and why.
+    pub kept_default: Vec<(String, String)>,
+    /// Units used.
+    pub units: usize,
+    /// Units detected.
+    pub detected: usize,
+    /// How its units' components were put in the bottle's two modes.
+    pub modes: Modes,
+    /// The amplitude law Asum = slope·V + intercept, if fitted.
+    pub amplitude_law: Option<Line>,
+    /// The model: a scene file.
+    pub model_toml: String,
+}
+
+/// What one liquid's model is made of.
+pub(crate) struct LiquidInputs<'a> {
+    /// Its name.
+    pub liquid: &'a str,
+    /// Its recordings.
+    pub recordings: Vec<&'a RecordingFit>,
+    /// The bottle's capacity (ml).
+    pub capacity_ml: f64,
+    /// The bottle's curves.
+    pub curves: &'a FittedCurves,
+    /// Its outflow rate at 135°, if known (ml/s).
+    pub rate_at_135: Option<f64>,
+    /// Its outflow rate at each tilt measured (°, ml/s).
+    pub rates: &'a [(f64, f64)],
+    /// How its units' components were put in modes.
+    pub modes: Modes,
+}
+
+/// The unit estimates, in this order: each one's model key (or name), and whether it is one.
+fn unit_keys() -> [(String, bool); 11] {
+    let key = |constant: Constant| (constant.quantity().scene_key.to_owned(), true);
+    [
+        key(Constant::F1),
+        key(Constant::F2),
+        key(Constant::FreqJitter),
+        key(Constant::B1),
+        key(Constant::B2),
+        key(Constant::DecaySigma),
+        (Control::Viscosity.quantity().scene_key.to_owned(), true),
+        key(Constant::SilentBelow),
+        key(Constant::AmplitudeSpread),
+        (Control::Gain.quantity().scene_key.to_owned(), true),
+        ("R² of Asum against V".to_owned(), false),
+    ]
+}
+
+/// The units each of [`unit_keys`]' estimates comes from.
+fn unit_counts(units: &[FittedUnit]) -> [usize; 11] {
+    let in_mode = |mode: usize| {
+        units
+            .iter()
+            .filter(|u| u.fit.frequency_hz[mode].is_finite())
+            .count()
+    };
+    let (low, high) = (in_mode(0), in_mode(1));
+    let spread = [low, high]
+        .into_iter()
+        .filter(|&n| n >= MIN_UNITS_FOR_SPREAD)
+        .max()
+        .unwrap_or(low.max(high));
+    let with_volume = units.iter().filter(|u| u.volume_ml.is_finite()).count();
+    [
+        low,
+        high,
+        spread,
+        low,
+        high,
+        spread,
+        units.len(),
+        with_volume,
+        with_volume,
+        units.len(),
+        with_volume,
+    ]
+}
+
+/// The unit-based estimates of a liquid, in [`unit_keys`] order (NaN where unknown).
+fn unit_estimates(units: &[FittedUnit], capacity_ml: f64) -> Vec<f64> {
+    let of = |get: &dyn Fn(&FittedUnit) -> f64| {
+        units
+            .iter()
+            .map(get)
+            .filter(|v| v.is_finite())
+            .collect::<Vec<_>>()
+    };
+    let f = [0, 1].map(|k| of(&|u| u.fit.frequency_hz[k]));
+    let b = [0, 1].map(|k| of(&|u| u.fit.decay_per_s[k]));
+    // A spread over the modes with enough units to show one.
+    let mean_over_modes = |values: &[Vec<f64>; 2], spread: &dyn Fn(&[f64]) -> f64| {
+        let spreads: Vec<f64> = values
+            .iter()
+            .filter(|v| v.len() >= MIN_UNITS_FOR_SPREAD)
+            .map(|v| spread(v))
+            .collect();
+        spreads.iter().sum::<f64>() / spreads.len() as f64
+    };
+    let relative = |values: &[f64]| iqr(values) / median(values);
+    let log_sigma =
+        |values: &[f64]| iqr(&values.iter().map(|v| v.ln()).collect::<Vec<_>>()) / NORMAL_IQR;
+    let law = amplitude_law(units);
+    let (silent_below, amplitude_spread, r_squared) = match law {
+        Some(line) if line.slope > 0.0 => {
+            let residuals: Vec<f64> = units
+                .iter()
+                .filter(|u| u.volume_ml.is_finite() && line.at(u.volume_ml) > 0.0)
+                .map(|u| (u.fit.amplitude_sum() / line.at(u.volume_ml)).ln())
+                .collect();
+            (
+                -line.intercept / line.slope,
+                iqr(&residuals) / NORMAL_IQR,
+                line.r_squared,
+            )
+        }
+        _ => (f64::NAN, f64::NAN, f64::NAN),
+    };
+    // The full bottle's Asum: the law at C where Asum falls with V, else the units' median (a
+    // recording near full, whose law has no slope).
+    let full = match law {
+        Some(line) if line.slope > 0.0 => line.at(capacity_ml),
+        _ => median(&of(&|u| u.fit.amplitude_sum())),
+    };
+    vec![
+        median(&f[0]),
+        median(&f[1]),
+        // j_f: f(1 + j·u), u uniform in [−1, 1], has its quartiles at f(1 ± j/2).
+        mean_over_modes(&f, &relative),
+        median(&b[0]),
+        median(&b[1]),
+        mean_over_modes(&b, &log_sigma),
+        median(&of(&|u| u.fit.viscosity())),
+        silent_below,
+        amplitude_spread,
+        20.0 * full.log10(),
+        r_squared,
+    ]
+}
+
+/// The line Asum = α·V + β through the units whose volume is known.
+fn amplitude_law(units: &[FittedUnit]) -> Option<Line> {
+    let points: Vec<(f64, f64)> = units
+        .iter()
+        .filter(|u| u.volume_ml.is_finite())
+        .map(|u| (u.volume_ml, u.fit.amplitude_sum()))
+        .collect();
+    Line::through(&points)
+}
+
+/// Fits the model of one liquid.
+pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> LiquidFit {
+    let LiquidInputs {
+        liquid,
+        capacity_ml,
+        ..
+    } = *inputs;
+    let recordings = &inputs.recordings;
+    let units: Vec<FittedUnit> = recordings
+        .iter()
+        .flat_map(|r| r.units.iter().copied())
+        .collect();
+    let detected = recordings.iter().map(|r| r.detected.len()).sum();
+    let values = unit_estimates(&units, capacity_ml);
+    let intervals = bootstrap(&units, |sample| unit_estimates(sample, capacity_ml));
+    let mut estimates: Vec<Estimate> = unit_keys()
+        .into_iter()
+        .zip(values.iter().zip(intervals).zip(unit_counts(&units)))
+        .map(|((key, in_model), ((&value, interval), n))| {
+            Estimate::from_units(key, value, interval, n, in_model)
+        })
+        .collect();
+    if units.len() < MIN_UNITS_FOR_MODEL {
+        warnings.push(format!(
+            "liquid `{liquid}`: the paper's model describes {} of its {detected} detected \
+             unit(s): too few for a model of its glugs, whose constants keep their defaults",
+            units.len()
+        ));
+    }
+    if inputs.modes == Modes::One && !units.is_empty() {
+        let f2 = Constant::F2.quantity().scene_key;
+        if let Some(estimate) = estimates.iter_mut().find(|e| e.key == f2) {
+            estimate.note = Some(
+                "every unit rings one mode (f1), so c = 1 and f2 is not heard: kept at its \
+                 default"
+                    .to_owned(),
+            );
+        }
+    }
+    check_silent_below(&mut estimates, &units, capacity_ml);
+    estimates.extend(timing_estimates(inputs));
+    estimates.push(Estimate::measured(
+        Constant::Capacity.quantity().scene_key,
+        capacity_ml,
+        None,
+        true,
+    ));
+    for estimate in estimates.iter_mut().filter(|e| e.in_model) {
+        if let Some(range) = range_of(&estimate.key).filter(|r| !r.contains(estimate.value)) {
+            warnings.push(format!(
+                "liquid `{liquid}`: `{}` = {} lies outside {}…{}: brought into range",
+                estimate.key, estimate.value, range.min, range.max
+            ));
+            estimate.value = range.sanitize(estimate.value);
+        }
+    }
+    let kept_default = kept_at_default(&estimates, inputs.curves);
+    let law = amplitude_law(&units);
+    // Where the model describes a recording poorly, its file says so before anything else.
+    let cautions: Vec<String> = recordings
+        .iter()
+        .filter(|r| r.explained < LOW_EXPLAINED)
+        .map(|r| {
+            format!(
+                "the units fitted explain only {:.0} % of {}: the paper's model describes it \
+                 poorly, and this model may not sound like it",
+                100.0 * r.explained.max(0.0),
+                r.name()
+            )
+        })
+        .chain((units.len() < MIN_UNITS_FOR_MODEL).then(|| {
+            format!(
+                "only {} unit(s) are described by the paper's model: the glug's constants keep \
+                 their defaults",
+                units.len()
+            )
+        }))
+        .collect();
+    let model_toml = model_toml(liquid, &estimates, inputs.curves, &kept_default, &cautions);
+    LiquidFit {
+        liquid: liquid.to_owned(),
+        units: units.len(),
+        detected,
+        modes: inputs.modes,
+        estimates,
+        kept_default,
+        model_toml,
+        amplitude_law: law,
+    }
+}
+
+/// V0 is not written where the law has no measurable slope, where it lies at or above the
+/// capacity, or where it lies outside the units' volumes: reported as such, without a number.
+fn check_silent_below(estimates: &mut [Estimate], units: &[FittedUnit], capacity_ml: f64) {
+    let silent_key = Constant::SilentBelow.quantity().scene_key;
+    let Some(estimate) = estimates.iter_mut().find(|e| e.key == silent_key) else {
+        return;
+    };
+    let law = amplitude_law(units);
+    let volumes: Vec<f64> = units
+        .iter()
+        .map(|u| u.volume_ml)
+        .filter(|v| v.is_finite())
+        .collect();
+    let (lowest, highest) = volumes
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
+    // A line whose slope its own error cannot tell from 0 has no zero worth a number.
+    if let Some(line) = law.filter(|line| line.slope <= Z_95 * line.slope_error) {
+        estimate.fail(format!(
+            "Asum does not fall measurably with V (slope {:.3e} ± {:.3e} per ml)",
+            line.slope,
+            Z_95 * line.slope_error
+        ));
+    } else if estimate.has_value() && estimate.value >= capacity_ml {
+        estimate.fail("the fitted zero lies above the capacity".to_owned());
+    } else if estimate.has_value() && estimate.value < lowest - V0_BEYOND_DATA * (highest - lowest)
+    {
+        estimate.fail(format!(
+            "outside the data: the line reaches 0 at {:.1} ml, far below the units' volumes \
+             ({lowest:.1} … {highest:.1} ml)",
+            estimate.value
+        ));
+    }
+}
+
+/// The pocket, the timing spread, the pour time and each tilt's rate.
+fn timing_estimates(inputs: &LiquidInputs) -> Vec<Estimate> {
+    let mut estimates = Vec::new();
+    let recordings = &inputs.recordings;
+    let pockets = pockets(recordings);
+    if !pockets.is_empty() {
+        let interval = bootstrap(&pockets, |s| vec![median(s)])[0];
+        estimates.push(Estimate::from_units(
+            Constant::Pocket.quantity().scene_key,
+            median(&pockets),
+            interval,
+            pockets.len(),
+            true,
+        ));
+    }
+    let relative_intervals: Vec<f64> = recordings
+        .iter()
+        .flat_map(|r| {
+            let all = intervals(r);
+            let typical = median(&all);
+            all.into_iter().map(move |dt| dt / typical)
+        })
+        .collect();
+    if !relative_intervals.is_empty() {
+        // j_t: b(1 + j·u) has its quartiles at b(1 ± j/2).
+        let interval = bootstrap(&relative_intervals, |s| vec![iqr(s) / median(s)])[0];
+        estimates.push(Estimate::from_units(
+            Constant::TimingJitter.quantity().scene_key,
+            iqr(&relative_intervals) / median(&relative_intervals),
+            interval,
+            relative_intervals.len(),
+            true,
+        ));
+    }
+    if let Some(rate) = inputs.rate_at_135 {
+        let interval = rate_error(recordings, REFERENCE_TILT_DEG)
+            .map(|e| (rate - Z_95 * e, rate + Z_95 * e))
+            .filter(|(low, _)| *low > 0.0);
+        estimates.push(Estimate::measured(
+            Control::PourTime.quantity().scene_key,
+            inputs.capacity_ml / rate,
+            interval.map(|(low, high)| (inputs.capacity_ml / high, inputs.capacity_ml / low)),
+            true,
+        ));
+    }
+    for &(tilt, rate) in inputs.rates {
+        let interval = rate_error(recordings, tilt).map(|e| (rate - Z_95 * e, rate + Z_95 * e));
+        estimates.push(Estimate::measured(
+            format!("outflow rate at {tilt}° (ml/s)"),
+            rate,
+            interval,
+            false,
+        ));
+    }
+    estimates
+}
+
+/// Every model key left at its default, and why.
+fn kept_at_default(estimates: &[Estimate], curves: &FittedCurves) -> Vec<(String, String)> {
+    let model_keys: Vec<String> = unit_keys()
+        .into_iter()
+        .filter(|(_, in_model)| *in_model)
+        .map(|(key, _)| key)
+        .collect();
+    let mut kept: Vec<(String, String)> = estimates
+        .iter()
+        .filter(|e| !e.in_model && model_keys.contains(&e.key))
+        .map(|e| {
+            (
+                e.key.clone(),
+                e.note.clone().unwrap_or_else(|| "not estimated".into()),
+            )
+        })
+        .collect();
+    for (key, why) in [
+        (
+            Constant::Pocket.quantity().scene_key,
+            "no weight log gave the outflow",
+        ),
+        (
+            Constant::TimingJitter.quantity().scene_key,
+            "too few intervals between units",
+        ),
+        (
+            Control::PourTime.quantity().scene_key,
+            "no drain rate was measured",
+        ),
+    ] {
+        match estimates.iter().find(|e| e.key == key) {
+            None => kept.push((key.to_owned(), why.to_owned())),
+            Some(e) if !e.in_model => kept.push((
+                key.to_owned(),
+                e.note.clone().unwrap_or_else(|| why.to_owned()),
+            )),
+            Some(_) => {}
+        }
+    }
+    for curve in Curve::ALL {
+        let fitted = match curve {
+            Curve::Drain => curves.drain.is_some(),
+            Curve::Rest => curves.rest.is_some(),
+            Curve::Submerged => false,
+        };
+        if !fitted {
+            let why = match curve {
+                Curve::Submerged => {
+                    "the last glug shows where the mouth surfaces only above the silent volume; \
+                     not estimated"
+                }
+                _ => "needs several tilts",
+            };
+            kept.push((curve.scene_key().to_owned(), why.to_owned()));
+        }
+    }
+    kept
+}
+
+/// The range of the constant or control whose scene key is `key`.
+fn range_of(key: &str) -> Option<Range> {
+    Constant::ALL
+        .iter()
+        .map(|c| c.quantity())
+        .chain(Control::ALL.iter().map(|c| c.quantity()))
+        .find(|q| q.scene_key == key)
+        .map(|q| q.range)
+}

@@ -1,0 +1,654 @@
+//! Every unit of a recording (MODEL.md §5, §13): where each starts, and its resonances.
+//!
+//! Each detected unit is first fitted with the paper's eq. 1 as it stands ([`eq1`]: two
+//! components from phase 0 at a common onset). A real glug is not always that: one mode may
+//! dominate, a component may start at another phase, the pitch may glide. So a unit eq. 1 does
+//! not describe, or describes with its stronger component away from the unit's own spectral
+//! peak, is fitted again ([`phased`]) with one or two components started at the peaks of its own
+//! spectrum, each with a phase of its own, and, if that explains too little of it, in the
+//! first part of its span only (where a gliding pitch has not moved far). A unit is kept if its
+//! fit explains at least half of the samples fitted and its stronger component lies at its own
+//! spectral peak; otherwise it is rejected with the reason. Units are fitted in time order, each
+//! kept unit subtracted from the recording before the next is fitted, so that a unit starting
+//! while the last one rings is fitted alone.
+
+mod eq1;
+mod modes;
+mod phased;
+mod window;
+
+use std::f64::consts::TAU;
+
+use super::onsets::detect_onsets;
+use super::spectrum::{own_peaks, Spectrum};
+pub use modes::Modes;
+use window::{Span, Window};
+
+/// The fitted span starts this long before the detected onset (s): the silence before a unit
+/// pins its onset.
+const BEFORE_ONSET_S: f64 = 0.004;
+/// …and ends this long before the next detected onset (s), which may lie late by as much.
+const BEFORE_NEXT_S: f64 = 0.004;
+/// The longest span (s): the components are 50 dB down by then at 40 /s.
+const LONGEST_WINDOW_S: f64 = 0.15;
+/// The shortest span (s) a unit is fitted in: a period of 125 Hz, several of a bubble's.
+const SHORTEST_WINDOW_S: f64 = 0.008;
+/// Samples per period of the highest component the pencil keeps (it decimates to this).
+const PENCIL_SAMPLES_PER_PERIOD: f64 = 8.0;
+/// Samples per period of the highest component the least-squares fit keeps: it fits every k-th
+/// sample of its window, k as large as keeps this many. Eq. 1 has seven numbers; a 25 kHz window
+/// holds 83 samples a period of 300 Hz, and the fit's cost falls with k while its noise grows
+/// only as √k (MODEL.md §13).
+const FIT_SAMPLES_PER_PERIOD: f64 = 16.0;
+/// A unit is kept only if its fit explains at least this share of the samples fitted.
+pub const MIN_EXPLAINED: f64 = 0.5;
+/// The highest decay rate of a resonance (1/s): a faster one is a click.
+pub(crate) const MAX_DECAY_PER_S: f64 = 5_000.0;
+/// The lowest frequency of a resonance (Hz): below it lie drift and handling noise.
+pub(crate) const LOWEST_HZ: f64 = 20.0;
+/// The stronger component lies at the unit's own spectral peak (the strongest peak of the samples
+/// fitted) when within this share of the peak's frequency, or within one bin of a spectrum as
+/// long as those samples (1/their length), if wider.
+pub const AT_PEAK_SHARE: f64 = 0.1;
+/// A fitted unit is subtracted until it has decayed by this factor (−80 dB).
+const SUBTRACT_UNTIL: f64 = 1e-4;
+/// A gliding unit is fitted again in the first this share of its span…
+const GLIDE_SHARE: f64 = 0.4;
+/// …but never fewer than this many periods of its lowest start.
+const GLIDE_PERIODS: f64 = 4.0;
+
+/// One resonance of a unit: A·e^(−Bτ)·sin(2π(fτ + gτ²/2) + φ), τ the time since the unit's
+/// onset (g = 0 and φ = 0 in the paper's eq. 1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Component {
+    /// f at the onset (Hz).
+    pub frequency_hz: f64,
+    /// g, how fast its frequency rises (Hz/s; 0 but for a gliding unit).
+    pub glide_hz_per_s: f64,
+    /// The frequency it is heard at (Hz): f, or for a glide f at the centre of its energy in the
+    /// span fitted. Eq. 1's view of the unit, and its mode, take this one.
+    pub heard_hz: f64,
+    /// B (1/s).
+    pub decay_per_s: f64,
+    /// A (the recording's units), ≥ 0.
+    pub amplitude: f64,
+    /// φ (radians): 0 in the paper's eq. 1.
+    pub phase: f64,
+    /// The height of its peak in the spectrum of the span fitted (its samples alone, under the
+    /// Hann window, at the frequency it is heard at, from the samples the fit read): which tells a
+    /// unit's stronger component.
+    pub in_span: f64,
+}
+
+impl Component {
+    /// Its value τ seconds after the onset.
+    pub fn value(&self, tau: f64) -> f64 {
+        let cycles = (self.frequency_hz + 0.5 * self.glide_hz_per_s * tau) * tau;
+        self.amplitude * (-self.decay_per_s * tau).exp() * (TAU * cycles + self.phase).sin()
+    }
+
+    /// Why it is no resonance of a recording at `fs`, if it is not one.
+    fn check(&self, fs: f64) -> Result<(), Rejection> {
+        let Component {
+            heard_hz: hz,
+            decay_per_s: decay,
+            ..
+        } = *self;
+        if !(hz.is_finite() && decay.is_finite() && self.amplitude.is_finite()) {
+            Err(Rejection::NotFinite)
+        } else if !(LOWEST_HZ..fs / 2.0).contains(&hz) {
+            Err(Rejection::Frequency { hz })
+        } else if decay <= 0.0 {
+            Err(Rejection::NoDecay)
+        } else if decay >= MAX_DECAY_PER_S {
+            Err(Rejection::Click { decay })
+        } else {
+            Ok(())
+        }
+    }
+}
+
+/// Which fit gave a unit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum UnitMethod {
+    /// The paper's eq. 1 as it stands.
+    Eq1,
+    /// One or two components, each with its phase, from the unit's own spectral peaks.
+    Phased,
+    /// As [`UnitMethod::Phased`] with a glide of each frequency, in the first part of the span
+    /// (a bubble's pitch rises as it rises).
+    Glide,
+}
+
+/// One unit, as fitted: its components, and eq. 1's view of it (the bottle's two modes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UnitFit {
+    /// The onset t_i (s from the recording's first sample).
+    pub onset_s: f64,
+    /// Its components as fitted (one or two), the lower first.
+    pub components: [Option<Component>; 2],
+    /// A1, A2: its amplitude in the bottle's low and high mode (0 where it does not ring one).
+    pub amplitude: [f64; 2],
+    /// f1, f2 (Hz; NaN where it does not ring that mode).
+    pub frequency_hz: [f64; 2],
+    /// B1, B2 (1/s; NaN where it does not ring that mode).
+    pub decay_per_s: [f64; 2],
+    /// The share of the samples fitted that the fit explains.
+    pub r_squared: f64,
+    /// The span fitted, `[first, end)`…
+    pub window: (usize, usize),
+    /// …of which every `stride`-th sample from `first` on was read (MODEL.md §13).
+    pub stride: usize,
+    /// Where eq. 1's Levenberg-Marquardt started, `[onset (s), A1, A2, f1, f2, B1, B2]` (the
+    /// pencil's poles, the onset grid and its amplitudes): another solver started here is
+    /// compared fairly (benches/render/fit.rs). NaN for a unit another fit gave.
+    pub start: [f64; 7],
+    /// Which fit gave it.
+    pub method: UnitMethod,
+}
+
+impl UnitFit {
+    fn new(fitted: Fitted, placed: Placed, start: Option<[f64; 7]>, method: UnitMethod) -> Self {
+        let mut sorted = fitted.components.to_vec();
+        sorted.sort_by(|a, b| a.heard_hz.total_cmp(&b.heard_hz));
+        for component in &mut sorted {
+            component.in_span = in_span(component, fitted.onset_s, placed);
+        }
+        let mut unit = Self {
+            onset_s: fitted.onset_s,
+            components: [sorted.first().copied(), sorted.get(1).copied()],
+            amplitude: [0.0; 2],
+            frequency_hz: [f64::NAN; 2],
+            decay_per_s: [f64::NAN; 2],
+            r_squared: fitted.explained,
+            window: placed.window,
+            stride: placed.stride,
+            start: start.unwrap_or([f64::NAN; 7]),
+            method,
+        };
+        unit.assign(&Modes::by_order());
+        unit
+    }
+
+    /// Its components, as fitted.
+    pub fn fitted(&self) -> impl Iterator<Item = &Component> {
+        self.components.iter().flatten()
+    }
+
+    /// Puts each component in the mode `modes` gives it (the stronger, where two fall in one).
+    pub fn assign(&mut self, modes: &Modes) {
+        let mut best: [Option<Component>; 2] = [None, None];
+        let count = self.fitted().count();
+        for (index, component) in self.fitted().enumerate() {
+            let mode = modes.mode_of(component.heard_hz, index, count);
+            if best[mode].is_none_or(|b| b.in_span < component.in_span) {
+                best[mode] = Some(*component);
+            }
+        }
+        for (mode, component) in best.into_iter().enumerate() {
+            self.amplitude[mode] = component.map_or(0.0, |c| c.amplitude);
+            self.frequency_hz[mode] = component.map_or(f64::NAN, |c| c.heard_hz);
+            self.decay_per_s[mode] = component.map_or(f64::NAN, |c| c.decay_per_s);
+        }
+    }
+
+    /// Asum = A1 + A2.
+    pub fn amplitude_sum(&self) -> f64 {
+        self.amplitude[0] + self.amplitude[1]
+    }
+
+    /// c = A1/(A1 + A2) (paper eq. 2).
+    pub fn viscosity(&self) -> f64 {
+        self.amplitude[0] / self.amplitude_sum()
+    }
+
+    /// Its stronger component: the one whose peak in the spectrum of the span fitted is taller.
+    pub fn stronger(&self) -> Option<&Component> {
+        self.fitted().max_by(|a, b| a.in_span.total_cmp(&b.in_span))
+    }
+
+    /// Its samples at `time_s`: every component fitted.
+    pub fn value_at(&self, time_s: f64) -> f64 {
+        let tau = time_s - self.onset_s;
+        if tau < 0.0 {
+            return 0.0;
+        }
+        self.fitted().map(|c| c.value(tau)).sum()
+    }
+}
+
+/// A fit not kept: why, and the fit if one was made (boxed: a unit is large).
+type Failed = Box<(Rejection, Option<UnitFit>)>;
+
+/// A fit's result: its onset (s), components and the share of the samples it explains.
+struct Fitted<'a> {
+    onset_s: f64,
+    components: &'a [Component],
+    explained: f64,
+}
+
+/// Where a fit lies: its span `[first, end)` of the recording, read every `stride`-th sample, at
+/// the rate `fs`.
+#[derive(Debug, Clone, Copy)]
+struct Placed {
+    window: (usize, usize),
+    stride: usize,
+    fs: f64,
+}
+
+/// The height of `component`'s peak (from `onset_s`) in the span's spectrum: the power of its
+/// samples alone, under the Hann window, at the frequency it is heard at. The taller of a unit's
+/// components is the one whose peak its spectrum shows.
+fn in_span(component: &Component, onset_s: f64, placed: Placed) -> f64 {
+    let (first, end) = placed.window;
+    let width = (end - first) as f64;
+    let (mut re, mut im) = (0.0, 0.0);
+    // Every stride-th sample, as the fit read them: enough samples a period of the components.
+    for n in (first..end).step_by(placed.stride) {
+        let tau = n as f64 / placed.fs - onset_s;
+        if tau < 0.0 {
+            continue;
+        }
+        let hann = 0.5 - 0.5 * (TAU * (n - first) as f64 / width).cos();
+        let value = hann * component.value(tau);
+        let (sine, cosine) = (TAU * component.heard_hz * tau).sin_cos();
+        re += value * cosine;
+        im -= value * sine;
+    }
+    re * re + im * im
+}
+
+/// Why a detected unit was not used.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Rejection {
+    /// The next unit starts too soon after it.
+    TooShort {
+        /// The span there is (s).
+        span_s: f64,
+    },
+    /// Its span's spectrum has no peak.
+    NoResonance,
+    /// A number of the fit is not finite.
+    NotFinite,
+    /// Eq. 1 needs a component of negative amplitude (it starts out of phase).
+    OutOfPhase,
+    /// A component outside 20 Hz … fs/2.
+    Frequency {
+        /// Its frequency (Hz).
+        hz: f64,
+    },
+    /// A component that does not decay.
+    NoDecay,
+    /// A component decaying faster than a resonance does.
+    Click {
+        /// Its decay rate (1/s).
+        decay: f64,
+    },
+    /// The fit explains too little of it.
+    Unexplained {
+        /// The share it explains.
+        share: f64,
+    },
+    /// Its stronger component is not at its own spectral peak.
+    OffPeak {
+        /// The stronger component's frequency (Hz).
+        component_hz: f64,
+        /// The peak's (Hz).
+        peak_hz: f64,
+    },
+    /// The onset moved too far from where it was detected.
+    OnsetMoved {
+        /// By how much (s).
+        shift_s: f64,
+    },
+}
+
+impl Rejection {
+    /// The reason without its figures, so that like reasons count together.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Rejection::TooShort { .. } => "the next unit starts too soon",
+            Rejection::NoResonance => "no resonance",
+            Rejection::NotFinite => "the fit did not converge",
+            Rejection::OutOfPhase => "a negative amplitude",
+            Rejection::Frequency { .. } => "a frequency out of range",
+            Rejection::NoDecay => "no decay",
+            Rejection::Click { .. } => "a click",
+            Rejection::Unexplained { .. } => "the fit explains too little",
+            Rejection::OffPeak { .. } => "not at its spectral peak",
+            Rejection::OnsetMoved { .. } => "the onset moved",
+        }
+    }
+}
+
+impl std::fmt::Display for Rejection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Rejection::TooShort { span_s } => write!(
+                f,
+                "the next unit starts {:.1} ms after it (a fit needs {:.0} ms)",
+                1e3 * span_s,
+                1e3 * SHORTEST_WINDOW_S
+            ),
+            Rejection::NoResonance => write!(f, "its spectrum shows no resonance"),
+            Rejection::NotFinite => write!(f, "the fit did not converge"),
+            Rejection::OutOfPhase => write!(f, "eq. 1 fits it only with a negative amplitude"),
+            Rejection::Frequency { hz } => write!(
+                f,
+                "a component at {hz:.1} Hz, outside {LOWEST_HZ} Hz … half the sample rate"
+            ),
+            Rejection::NoDecay => write!(f, "a component does not decay"),
+            Rejection::Click { decay } => write!(
+                f,
+                "a component decays at {decay:.0} /s: a click, not a resonance"
+            ),
+            Rejection::Unexplained { share } => write!(
+                f,
+                "the fit explains {:.0} % of it (a unit needs {:.0} %)",
+                100.0 * share,
+                100.0 * MIN_EXPLAINED
+            ),
+            Rejection::OffPeak {
+                component_hz,
+                peak_hz,
+            } => write!(
+                f,
+                "its stronger component ({component_hz:.1} Hz) is not at its spectral peak \
+                 ({peak_hz:.1} Hz)"
+            ),
+            Rejection::OnsetMoved { shift_s } => write!(
+                f,
+                "the fitted onset lies {:.1} ms from the detected one",
+                1e3 * shift_s
+            ),
+        }
+    }
+}
+
+/// A detected unit: its fit, and whether it was used.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DetectedUnit {
+    /// Where it was detected (s).
+    pub onset_s: f64,
+    /// The fit: the one used, or the best rejected one (if any fit was made).
+    pub fit: Option<UnitFit>,
+    /// Why it was not used (`None`: used).
+    pub rejection: Option<Rejection>,
+}
+
+/// Every unit of one recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordingUnits {
+    /// The units kept, in time order.
+    pub units: Vec<UnitFit>,
+    /// Every unit detected, in time order, used or not.
+    pub detected: Vec<DetectedUnit>,
+    /// The spectrum's peaks that started eq. 1's frequencies (Hz; f1 < f2).
+    pub start_hz: [f64; 2],
+    /// Whether the spectrum showed only one peak (the other start was guessed).
+    pub one_peak: bool,
+    /// The recording's spectrum.
+    pub spectrum: Spectrum,
+    /// The share of the recording's energy the units kept explain.
+    pub explained: f64,
+}
+
+impl RecordingUnits {
+    /// The units detected but not used.
+    pub fn rejected(&self) -> usize {
+        self.detected
+            .iter()
+            .filter(|d| d.rejection.is_some())
+            .count()
+    }
+}
+
+/// Every how many samples the pencil and the least-squares fit read a span.
+#[derive(Debug, Clone, Copy)]
+struct Strides {
+    pencil: usize,
+    fit: usize,
+}
+
+impl Strides {
+    /// The strides that keep enough samples a period of `highest_hz` (with a margin for a
+    /// component found above its start).
+    fn for_highest(highest_hz: f64, fs: f64) -> Self {
+        let highest_hz = highest_hz * eq1::POLE_MATCH_RATIO;
+        Self {
+            pencil: ((fs / (PENCIL_SAMPLES_PER_PERIOD * highest_hz)) as usize).max(1),
+            fit: ((fs / (FIT_SAMPLES_PER_PERIOD * highest_hz)) as usize).max(1),
+        }
+    }
+}
+
+/// Finds and fits every unit of `samples` (DC removed) at `sample_rate`.
+pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
+    let fs = sample_rate as f64;
+    let spectrum = Spectrum::of(samples, fs);
+    let peaks = spectrum.peaks();
+    // The paper's ratio of f2 to f1 guesses the other component when only one shows.
+    const RATIO: f64 = 300.0 / 80.0;
+    let (start_hz, one_peak) = match peaks.as_slice() {
+        [low, high] => ([*low, *high], false),
+        [only] if *only < 160.0 => ([*only, only * RATIO], true),
+        [only] => ([only / RATIO, *only], true),
+        _ => ([80.0, 300.0], true),
+    };
+    let onsets = detect_onsets(samples, fs, start_hz[0]);
+    let mut residual = samples.to_vec();
+    let mut units = Vec::with_capacity(onsets.len());
+    let mut detected = Vec::with_capacity(onsets.len());
+    let strides = Strides::for_highest(start_hz[1], fs);
+    for (index, &onset) in onsets.iter().enumerate() {
+        let first = onset.saturating_sub((BEFORE_ONSET_S * fs) as usize);
+        let next = onsets.get(index + 1).copied().unwrap_or(samples.len());
+        let end = next
+            .saturating_sub((BEFORE_NEXT_S * fs) as usize)
+            .min(onset + (LONGEST_WINDOW_S * fs) as usize)
+            .min(samples.len());
+        let onset_s = onset as f64 / fs;
+        if end < first + ((SHORTEST_WINDOW_S + BEFORE_ONSET_S) * fs) as usize {
+            detected.push(DetectedUnit {
+                onset_s,
+                fit: None,
+                rejection: Some(Rejection::TooShort {
+                    span_s: end.saturating_sub(onset) as f64 / fs,
+                }),
+            });
+            continue;
+        }
+        let span = Span::of(&residual, first, end, onset, fs);
+        match fit_unit(&span, start_hz, strides) {
+            Ok(unit) => {
+                subtract(&mut residual, &unit, fs);
+                units.push(unit);
+                detected.push(DetectedUnit {
+                    onset_s,
+                    fit: Some(unit),
+                    rejection: None,
+                });
+            }
+            Err(failure) => {
+                let (rejection, fit) = *failure;
+                detected.push(DetectedUnit {
+                    onset_s,
+                    fit,
+                    rejection: Some(rejection),
+                });
+            }
+        }
+    }
+    let energy = |signal: &[f32]| signal.iter().map(|&y| f64::from(y).powi(2)).sum::<f64>();
+    let explained = 1.0 - energy(&residual) / energy(samples).max(1e-300);
+    RecordingUnits {
+        units,
+        detected,
+        start_hz,
+        one_peak,
+        spectrum,
+        explained,
+    }
+}
+
+/// The unit `span` holds: eq. 1 if it describes it, else a phased fit from its own peaks, else
+/// the same in the first part of the span; or why none does, with the best fit rejected.
+fn fit_unit(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<UnitFit, Failed> {
+    // The stronger component must lie at the strongest peak of the samples it was fitted to, read
+    // as the fit read them (every stride-th: a spectrum up to 8 samples a period of 1.3 times the
+    // highest start); a peak beyond that folds elsewhere and fails the check, and the fits from
+    // the unit's own peaks (found in every sample) then read at strides set by those peaks.
+    let at_peak = |unit: UnitFit| -> Result<UnitFit, Failed> {
+        let read: Vec<f64> = span.samples[..unit.window.1 - span.first]
+            .iter()
+            .step_by(unit.stride)
+            .copied()
+            .collect();
+        let rate = span.fs / unit.stride as f64;
+        let peak_hz = own_peaks(&read, rate).first().map_or(f64::NAN, |p| p.0);
+        let component_hz = unit.stronger().map_or(f64::NAN, |c| c.heard_hz);
+        let tolerance = (AT_PEAK_SHARE * peak_hz).max(rate / read.len() as f64);
+        if (component_hz - peak_hz).abs() <= tolerance {
+            Ok(unit)
+        } else {
+            Err(Box::new((
+                Rejection::OffPeak {
+                    component_hz,
+                    peak_hz,
+                },
+                Some(unit),
+            )))
+        }
+    };
+    let paper = eq1::fit(span, start_hz, strides)
+        .map_err(|rejection| Box::new((rejection, None)))
+        .and_then(at_peak);
+    let Err(first_reason) = paper else {
+        return paper;
+    };
+    let peaks = own_peaks(&span.samples, span.fs);
+    if peaks.is_empty() {
+        return Err(Box::new((Rejection::NoResonance, None)));
+    }
+    let own_hz: Vec<f64> = peaks.iter().map(|p| p.0).collect();
+    let highest = own_hz.iter().copied().fold(0.0, f64::max);
+    let own_strides = Strides::for_highest(highest, span.fs);
+    let poles = eq1::pencil_poles(span.after_onset(0.04), own_strides.pencil, span.fs);
+    let starts: Vec<(f64, f64)> = own_hz
+        .iter()
+        .map(|&hz| eq1::nearest_pole(&poles, hz).unwrap_or((hz, eq1::DECAY_GUESS_PER_S)))
+        .collect();
+    let mut best = first_reason;
+    let lowest = own_hz.iter().copied().fold(f64::INFINITY, f64::min);
+    let glide_end = span.onset
+        + ((GLIDE_SHARE * (span.end - span.onset) as f64)
+            .max(GLIDE_PERIODS / lowest * span.fs)
+            .max(SHORTEST_WINDOW_S * span.fs)) as usize;
+    // Phases of their own, then a glide too, then a glide in the first part of the span only;
+    // each with the unit's peaks, then with its strongest alone (one mode may dominate).
+    let attempts = [
+        (UnitMethod::Phased, span.end),
+        (UnitMethod::Glide, span.end),
+        (UnitMethod::Glide, glide_end.min(span.end)),
+    ];
+    let counts: &[usize] = if starts.len() > 1 { &[2, 1] } else { &[1] };
+    for (&count, (method, end)) in counts
+        .iter()
+        .flat_map(|count| attempts.iter().map(move |attempt| (count, *attempt)))
+    {
+        let window = span.window_until(own_strides.fit, end);
+        let attempt = phased::fit(
+            &window,
+            span.onset_s(),
+            &starts[..count],
+            method == UnitMethod::Glide,
+        )
+        .map_err(|rejection| Box::new((rejection, None)))
+        .map(|fitted| {
+            UnitFit::new(
+                Fitted {
+                    onset_s: fitted.onset_s,
+                    components: &fitted.components,
+                    explained: fitted.explained,
+                },
+                Placed {
+                    window: (span.first, end),
+                    stride: own_strides.fit,
+                    fs: span.fs,
+                },
+                None,
+                method,
+            )
+        })
+        .and_then(|unit| check(unit, span.fs))
+        .and_then(at_peak);
+        match attempt {
+            Ok(unit) => return Ok(unit),
+            Err(reason) => best = better(best, reason),
+        }
+    }
+    Err(best)
+}
+
+/// A phased fit checked: finite, resonant and explaining enough.
+fn check(unit: UnitFit, fs: f64) -> Result<UnitFit, Failed> {
+    for component in unit.fitted() {
+        component.check(fs).map_err(|r| Box::new((r, Some(unit))))?;
+    }
+    if unit.r_squared < MIN_EXPLAINED {
+        return Err(Box::new((
+            Rejection::Unexplained {
+                share: unit.r_squared,
+            },
+            Some(unit),
+        )));
+    }
+    Ok(unit)
+}
+
+/// Of two rejections, the one whose fit explains more (a fit over none).
+fn better(a: Failed, b: Failed) -> Failed {
+    let share = |r: &Failed| r.1.map_or(f64::NEG_INFINITY, |u| u.r_squared);
+    if share(&b) > share(&a) {
+        b
+    } else {
+        a
+    }
+}
+
+/// Subtracts `unit` from `signal` until it has decayed by [`SUBTRACT_UNTIL`].
+fn subtract(signal: &mut [f32], unit: &UnitFit, fs: f64) {
+    let slowest = unit
+        .fitted()
+        .map(|c| c.decay_per_s)
+        .fold(f64::INFINITY, f64::min)
+        .max(1.0);
+    let first = ((unit.onset_s * fs).ceil().max(0.0) as usize).min(signal.len());
+    let end = (first + (-SUBTRACT_UNTIL.ln() / slowest * fs) as usize).min(signal.len());
+    // The unit's span at full rate, as a window of its own.
+    let span = Window {
+        data: vec![0.0; end - first],
+        first,
+        stride: 1,
+        fs,
+    };
+    for component in unit.fitted() {
+        if component.glide_hz_per_s != 0.0 {
+            for (n, sample) in signal[first..end].iter_mut().enumerate() {
+                let tau = (first + n) as f64 / fs - unit.onset_s;
+                *sample -= component.value(tau) as f32;
+            }
+            continue;
+        }
+        let (sine, cosine) = (
+            component.amplitude * component.phase.cos(),
+            component.amplitude * component.phase.sin(),
+        );
+        span.rotate(
+            unit.onset_s,
+            component.frequency_hz,
+            component.decay_per_s,
+            |n, z, _| signal[first + n] -= (sine * z.im + cosine * z.re) as f32,
+        );
+    }
+}

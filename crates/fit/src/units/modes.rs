@@ -1,0 +1,110 @@
+//! The bottle's two modes (MODEL.md §13): which of a unit's components is f1's and which f2's.
+//! A unit of eq. 1 has both; a real unit may ring one, and units may ring different ones. So the
+//! components of every unit of a liquid are split in two groups by their log frequency
+//! (two-means); the groups are two modes if their centres lie at least [`SEPARATE_MODES`] apart
+//! and the groups are well apart for their spreads (Ashman's D = √2·|m1 − m2|/√(s1² + s2²) at
+//! least [`MIN_ASHMAN_D`]: a spread of frequencies, such as gliding bubbles give, splits at any
+//! place but has no gap), else every component rings the one mode there is, which is then f1
+//! (and c = 1).
+
+/// Two groups whose centres lie closer than this ratio of frequencies are one mode: the
+/// spectrum's peaks are told apart at the same ratio.
+pub const SEPARATE_MODES: f64 = super::super::spectrum::PEAK_SEPARATION;
+
+/// The least Ashman's D of two modes: a uniform spread has 3.5, two peaks each narrower than a
+/// tenth of their distance more than 14.
+pub const MIN_ASHMAN_D: f64 = 4.0;
+
+/// How components are put in modes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Modes {
+    /// A unit's lower component is f1's, its higher f2's (eq. 1 as fitted, before the units of a
+    /// liquid are seen together).
+    ByOrder,
+    /// Below this frequency f1's, above it f2's (Hz).
+    Split(f64),
+    /// One mode only: every component is f1's.
+    One,
+}
+
+impl Modes {
+    /// The modes before the units are seen together.
+    pub fn by_order() -> Self {
+        Modes::ByOrder
+    }
+
+    /// The modes of components at `frequencies` (Hz).
+    pub fn of(frequencies: &[f64]) -> Self {
+        let mut logs: Vec<f64> = frequencies
+            .iter()
+            .filter(|f| f.is_finite() && **f > 0.0)
+            .map(|f| f.ln())
+            .collect();
+        if logs.len() < 2 {
+            return Modes::One;
+        }
+        logs.sort_by(f64::total_cmp);
+        // Two-means in one dimension: the best split of the sorted values, tried at every place.
+        let total: f64 = logs.iter().sum();
+        let total_squares: f64 = logs.iter().map(|x| x * x).sum();
+        let (mut best, mut best_cost) = (None, f64::INFINITY);
+        let (mut sum, mut squares) = (0.0, 0.0);
+        for split in 1..logs.len() {
+            sum += logs[split - 1];
+            squares += logs[split - 1] * logs[split - 1];
+            let (n_low, n_high) = (split as f64, (logs.len() - split) as f64);
+            let cost = (squares - sum * sum / n_low)
+                + (total_squares - squares - (total - sum).powi(2) / n_high);
+            if cost < best_cost {
+                best_cost = cost;
+                let (mean_low, mean_high) = (sum / n_low, (total - sum) / n_high);
+                let variance_low = (squares / n_low - mean_low * mean_low).max(0.0);
+                let variance_high =
+                    ((total_squares - squares) / n_high - mean_high * mean_high).max(0.0);
+                let ashman = std::f64::consts::SQRT_2 * (mean_high - mean_low)
+                    / (variance_low + variance_high).sqrt().max(1e-12);
+                best = Some((mean_low, mean_high, ashman));
+            }
+        }
+        match best {
+            Some((low, high, ashman))
+                if high - low >= SEPARATE_MODES.ln() && ashman >= MIN_ASHMAN_D =>
+            {
+                Modes::Split((0.5 * (low + high)).exp())
+            }
+            _ => Modes::One,
+        }
+    }
+
+    /// The mode (0: f1, 1: f2) of a component at `hz`, the `index`-th (by frequency) of a unit's
+    /// `count`.
+    pub fn mode_of(&self, hz: f64, index: usize, count: usize) -> usize {
+        match *self {
+            Modes::ByOrder => usize::from(count == 2 && index == 1),
+            Modes::Split(boundary_hz) => usize::from(hz >= boundary_hz),
+            Modes::One => 0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn two_groups_apart_are_two_modes_and_one_group_is_one() {
+        let two = Modes::of(&[80.0, 82.0, 300.0, 310.0, 79.0, 295.0]);
+        let Modes::Split(boundary) = two else {
+            panic!("{two:?}")
+        };
+        assert!((100.0..250.0).contains(&boundary), "{boundary}");
+        assert_eq!(Modes::of(&[400.0, 420.0, 450.0, 380.0]), Modes::One);
+        // Gliding bubbles: a spread from 300 to 1000 Hz without a gap.
+        let spread: Vec<f64> = (0..40)
+            .map(|i| 300.0 * (1000f64 / 300.0).powf(i as f64 / 39.0))
+            .collect();
+        assert_eq!(Modes::of(&spread), Modes::One);
+        assert_eq!(two.mode_of(81.0, 0, 1), 0);
+        assert_eq!(two.mode_of(305.0, 0, 1), 1);
+    }
+}
