@@ -140,6 +140,13 @@ pub fn paper() -> nice_plug_xtask::Result<()> {
         page.push('\n');
         page.push_str(&section);
     }
+    // A figure that is none means a run went wrong: the old page stays rather than a made-up one.
+    if let Some(line) = page.lines().find(|line| {
+        line.split(|c: char| !c.is_alphanumeric())
+            .any(|word| word == "NaN" || word == "inf")
+    }) {
+        anyhow::bail!("{PAGE} not written: a figure is not a number in {line:?}");
+    }
     write_all_or_nothing(Path::new(PAGE), &page)?;
     println!("{PAGE} regenerated");
     Ok(())
