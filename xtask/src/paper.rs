@@ -331,8 +331,8 @@ fn constant_stimuli() -> nice_plug_xtask::Result<String> {
         text,
         "\nSo a study of this design knows its 25 % point to about ±{:.3} and its 75 % point to \
          about ±{:.3} in c (half the median interval): the paper's 0.29 and 0.42 are each one \
-         such estimate, and a repetition of the study would put them anywhere in the column \
-         above.",
+         such estimate, and a repetition of the study would put them, 95 times in 100, within \
+         the range of the third column.",
         width("25")? / 2.0,
         width("75")? / 2.0,
     );
@@ -470,11 +470,15 @@ fn median(values: &[f64]) -> f64 {
     }
 }
 
+/// An estimate of `sake-glug fit --json`: its value, its 95 % interval if it has one, and the
+/// units it comes from.
+type Estimate = (f64, Option<(f64, f64)>, u64);
+
 /// §5, fig. 7: the amplitude law that `sake-glug fit` finds in a render of the default bottle
 /// held at 135° and recorded at 25 kHz.
 fn amplitude_law(dir: &Path) -> nice_plug_xtask::Result<String> {
     let fit = fit_render(dir, FIG_7_TILT_DEG)?;
-    let estimate = |key: &str| -> nice_plug_xtask::Result<(f64, Option<(f64, f64)>, u64)> {
+    let estimate = |key: &str| -> nice_plug_xtask::Result<Estimate> {
         let estimate = &fit.json["estimates"][key];
         let interval = estimate["low"].as_f64().zip(estimate["high"].as_f64());
         Ok((
@@ -645,7 +649,8 @@ fn pour(dir: &Path) -> nice_plug_xtask::Result<String> {
     Ok(format!(
         "## §3.1 The 5 s pour of 300 ml\n\n\
          `sake-glug render --state` at 1000 rows a second (simulated drain, MODEL.md §3): the \
-         first row at 0 ml. Reproduced within {:.0} % of the paper's 5 s, close within {:.0} %.\n\n{}",
+         first row at 0 ml (where a render ends within its last row's outflow, that row's time plus \
+         its volume over the outflow). Reproduced within {:.0} % of the paper's 5 s, close within {:.0} %.\n\n{}",
         100.0 * POUR_TOLERANCE.0,
         100.0 * POUR_TOLERANCE.1,
         table(&rows)
