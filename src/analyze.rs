@@ -1,5 +1,6 @@
 //! `sake-glug analyze paired|constant LOG.csv…`: the paper's two studies from their trial logs,
 //! as tables on stdout or one JSON object (`--json`), and their figure (`--plot FILE.png`).
+//! `sake-glug analyze plan constant …`: a constant-stimuli design simulated before it is run.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -9,8 +10,9 @@ use sake_glug_io::text::{printable, quoted};
 
 use sake_glug_analysis::{
     analyze_constant_logs, analyze_paired_logs, constant_json, draw_constant_plot,
-    draw_paired_plot, paired_json, AnalysisError, ChiSquareTest, ConstantAnalysis, PairedAnalysis,
-    Placement, PsychometricFit, PsychometricOptions, MAX_RESAMPLES, POINT_PERCENTS,
+    draw_paired_plot, paired_json, plan_constant, plan_json, AnalysisError, ChiSquareTest,
+    ConstantAnalysis, ConstantPlan, PairedAnalysis, Placement, PlanOutcome, PsychometricFit,
+    PsychometricOptions, MAX_RESAMPLES, POINT_PERCENTS,
 };
 
 #[derive(Args, Debug)]
@@ -41,6 +43,55 @@ enum Design {
         #[arg(long, default_value_t = PsychometricOptions::default().max_lapse, value_name = "MAX")]
         lapse: f64,
     },
+    /// Plans a study: simulates its design with observers of a known curve, and says how wide
+    /// its intervals would be and how often they would hold the truth.
+    Plan {
+        #[command(subcommand)]
+        design: PlanDesign,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum PlanDesign {
+    /// Constant stimuli: each simulated study fitted as `analyze constant` fits a log.
+    Constant(PlanConstantArgs),
+}
+
+#[derive(Args, Debug)]
+struct PlanConstantArgs {
+    /// The comparison levels, rising, comma-separated (e.g. 0.18,0.22,0.26).
+    #[arg(
+        long,
+        required = true,
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        value_name = "L1,L2,…"
+    )]
+    levels: Vec<f64>,
+    /// Presentations of each level to each participant.
+    #[arg(long, value_name = "N")]
+    repetitions: u32,
+    /// Participants, their answers pooled into one fit.
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    participants: u32,
+    /// The simulated observers' 25 % point (a logistic through it and --p75).
+    #[arg(long, allow_hyphen_values = true, value_name = "LEVEL")]
+    p25: f64,
+    /// Their 75 % point.
+    #[arg(long, allow_hyphen_values = true, value_name = "LEVEL")]
+    p75: f64,
+    /// Studies simulated.
+    #[arg(long, default_value_t = 1000, value_name = "N")]
+    studies: u32,
+    /// Bootstrap resamples of each study's intervals.
+    #[arg(long, default_value_t = 1000, value_name = "N")]
+    resamples: usize,
+    /// Seed of the simulation (the same seed gives the same figures).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Prints one JSON object instead of the table.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Args, Debug)]
@@ -60,6 +111,9 @@ struct Common {
 /// bad option.
 pub fn run(args: AnalyzeArgs) -> ExitCode {
     let outcome = match args.design {
+        Design::Plan {
+            design: PlanDesign::Constant(args),
+        } => return plan(args),
         Design::Paired { common } => analyze_paired_logs(&common.logs).and_then(|analysis| {
             if let Some(path) = &common.plot {
                 draw_paired_plot(&analysis, path)?;
@@ -104,6 +158,74 @@ pub fn run(args: AnalyzeArgs) -> ExitCode {
             }
         }
     }
+}
+
+/// Exit status 0 when simulated, 2 for an argument refused (named as its option).
+fn plan(args: PlanConstantArgs) -> ExitCode {
+    let plan = ConstantPlan {
+        levels: args.levels,
+        repetitions: args.repetitions,
+        participants: args.participants,
+        p25: args.p25,
+        p75: args.p75,
+        studies: args.studies,
+        resamples: args.resamples,
+        seed: args.seed,
+    };
+    match plan_constant(&plan) {
+        Ok(outcome) => {
+            match args.json {
+                true => println!("{}", plan_json(&outcome)),
+                false => println!("{}", plan_text(&outcome)),
+            }
+            ExitCode::SUCCESS
+        }
+        Err(error) => {
+            eprintln!("error: --{}: {}", error.argument, error.message);
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn plan_text(outcome: &PlanOutcome) -> String {
+    let plan = &outcome.plan;
+    let (first, last) = (plan.levels[0], plan.levels[plan.levels.len() - 1]);
+    let mut text = format!(
+        "{} levels ({first} … {last}) × {} repetitions × {} participant(s) = {} trials a \
+         study, pooled\nobservers: a logistic with its 25 % point at {} and its 75 % at {}\n\
+         {} studies simulated, {} fitted, {} without a fit; {} resamples each, seed {}\n\n",
+        plan.levels.len(),
+        plan.repetitions,
+        plan.participants,
+        outcome.trials_a_study,
+        plan.p25,
+        plan.p75,
+        plan.studies,
+        outcome.fitted,
+        outcome.unfitted,
+        plan.resamples,
+        plan.seed,
+    );
+    text += "point  truth    median estimate  95 % of estimates  median interval width  \
+             coverage\n";
+    for point in &outcome.points {
+        text += &format!(
+            "{:>2} %   {:<7.4}  {:<15.4}  {:.4} … {:.4}    {:<21.4}  {:.1} % ({:.1} … {:.1} %)\n",
+            point.percent,
+            point.truth,
+            point.median_estimate,
+            point.estimate_low,
+            point.estimate_high,
+            point.median_width,
+            100.0 * point.coverage,
+            100.0 * point.coverage_low,
+            100.0 * point.coverage_high,
+        );
+    }
+    text += "\ninterval: each study's 95 % BCa interval; coverage: the share of the fitted \
+             studies whose interval holds the truth (in brackets, its 95 % Clopper-Pearson \
+             interval)\n";
+    text.trim_end().to_owned()
 }
 
 fn test_text(name: &str, test: Option<ChiSquareTest>, absent: &str) -> String {

@@ -41,7 +41,8 @@ enum Command {
     Parameters(parameters::ParametersArgs),
     /// Fits a model (a scene file) to recordings of a bottle: see MODEL.md §13.
     Fit(fit::FitArgs),
-    /// Analyses study logs: Thurstone scaling (paired) or a psychometric fit (constant).
+    /// Analyses study logs (Thurstone scaling of paired comparisons, a psychometric fit of
+    /// constant stimuli), or plans a constant-stimuli study by simulation.
     Analyze(analyze::AnalyzeArgs),
     /// Runs a listening study's session (paired or constant stimuli) for one participant.
     Experiment(experiment::ExperimentArgs),

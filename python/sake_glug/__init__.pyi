@@ -95,5 +95,8 @@ def analyze_constant(
     lapse: Optional[float] = None,
 ) -> Dict[str, Any]:
     """The constant-stimuli analysis of trial logs, as `sake-glug analyze constant --json`:
-    resamples from 1 to 100,000 (default 2000), seed and lapse as its options. Ctrl-C returns
-    at once (the analysis runs on in the background, its result dropped)."""
+    resamples from 1 to 100,000 (default 2000), seed and lapse as its options. Each point
+    ("25", "50", "75") has "value", "low", "high" and "placement" ("within", "below_levels",
+    "above_levels"): only a point within the levels tested is an estimate, so outside them its
+    value and interval are None, and an interval's end beyond them is None. Ctrl-C returns at
+    once (the analysis runs on in the background, its result dropped)."""

@@ -384,7 +384,8 @@ fn analyze_paired(py: Python<'_>, logs: Vec<PathBuf>) -> PyResult<Bound<'_, PyAn
 
 /// The constant-stimuli analysis of trial logs (`sake-glug analyze constant --json`): the
 /// logistic fit pooled and per participant, its 25/50/75 % "points" with 95 % intervals
-/// ("value", "low", "high"), as a dict. resamples (1 to 100,000), seed and lapse as the command
+/// ("value", "low", "high"; None beyond the levels tested, "placement" says where), as a dict.
+/// resamples (1 to 100,000), seed and lapse as the command
 /// line's options. Ctrl-C returns at once (the analysis runs on in the background, its result
 /// dropped).
 #[pyfunction]

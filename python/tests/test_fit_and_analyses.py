@@ -27,10 +27,10 @@ def write_paired_log(path):
     path.write_text("\n".join(rows) + "\n")
 
 
-def write_constant_log(path):
+def write_constant_log(path, participants=2):
     chance = random.Random(9)
     rows = ["participant,level,chose_comparison"]
-    for participant in range(2):
+    for participant in range(participants):
         for level in [0.18, 0.22, 0.26, 0.29, 0.33, 0.37, 0.41, 0.45, 0.49]:
             for _ in range(10):
                 chosen = chance.random() < 1 / (1 + 2.718 ** (-(level - 0.35) / 0.04))

@@ -12,9 +12,7 @@ use crate::{analyze, json_of};
 
 /// The paper's §4.4: nine comparison levels from c = 0.18 to 0.49, ten trials each.
 fn paper_levels() -> Vec<f64> {
-    (0..9)
-        .map(|index| 0.18 + 0.31 * f64::from(index) / 8.0)
-        .collect()
+    vec![0.18, 0.22, 0.26, 0.29, 0.33, 0.37, 0.41, 0.45, 0.49]
 }
 const TRIALS_PER_LEVEL: usize = 10;
 

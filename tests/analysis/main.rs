@@ -2,12 +2,13 @@
 //! the psychometric fit of constant stimuli and the coverage of its intervals, checked by
 //! simulation; bad logs refused with file, line and column; hostile logs (too many stimuli, a
 //! device, a log given twice, random answers) refused or reported for what they are; the JSON
-//! shapes.
+//! shapes; the plan of a constant-stimuli study, its coverage checked by simulation.
 
 mod bad_logs;
 mod constant;
 mod hostile_logs;
 mod paired;
+mod plan;
 
 use std::path::Path;
 use std::process::{Command, Output};

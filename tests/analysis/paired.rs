@@ -231,3 +231,38 @@ fn the_text_report_shows_the_matrix_the_scale_and_both_tests() {
     let left: Vec<_> = std::fs::read_dir(folder.path()).unwrap().collect();
     assert_eq!(left.len(), 2, "the log and the plot, no temporary file");
 }
+
+/// Determinism: the same trials give the same bits in every run. Each HashMap iterates in an
+/// order of its own, so a sum over one (the participants' χ² did) changes its last bits from
+/// map to map, which Python saw as the package and the command line disagreeing.
+#[test]
+fn the_same_trials_give_the_same_bits_every_time() {
+    let mut trials = Vec::new();
+    // Many participants and stimuli, so that the cells have many orders to be summed in.
+    let stimuli: Vec<String> = (0..12).map(|s| format!("s{s}")).collect();
+    for participant in 0..30 {
+        for (i, first) in stimuli.iter().enumerate() {
+            for (j, second) in stimuli.iter().enumerate().skip(i + 1) {
+                let answer = if (participant * 7 + i * 3 + j) % 5 < 3 {
+                    first
+                } else {
+                    second
+                };
+                trials.push(PairedTrial {
+                    participant: format!("P{participant}"),
+                    first: first.clone(),
+                    second: second.clone(),
+                    answer: answer.clone(),
+                });
+            }
+        }
+    }
+    let bits = |analysis: &sake_glug_analysis::PairedAnalysis| {
+        let agreement = analysis.agreement.expect("a homogeneity test");
+        (agreement.chi2.to_bits(), agreement.p.to_bits())
+    };
+    let first = bits(&scale_paired(&trials).unwrap());
+    for _ in 0..20 {
+        assert_eq!(bits(&scale_paired(&trials).unwrap()), first);
+    }
+}

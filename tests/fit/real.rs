@@ -1,15 +1,19 @@
 //! Real recordings (tests/fixtures/recordings, CC0): clips of bubbles the paper's model was not
-//! made from. On each: most detected units used; each used unit's stronger component at that
-//! unit's own spectral peak (found here by a plain DFT, not the fit's FFT); the model's spectrum
-//! closer to the recording's than the default bottle's (MODEL.md §13's correlation); and a
-//! recording the units explain poorly said to be so (the report's warning and the model file's
-//! header). A brook's babble, which no unit of eq. 1 describes, is refused with the reasons.
+//! made from. On each glug-like clip: most detected units used; each used unit's stronger
+//! component at that unit's own spectral peak (found here by a plain DFT, not the fit's FFT); the
+//! model's spectrum closer to the recording's than the default bottle's (MODEL.md §13's
+//! correlation); and a recording the units explain poorly said to be so (the report's warning and
+//! the model file's header). A brook's babble and a splash, which no unit of eq. 1 describes, are
+//! refused with the reasons; lava's bubbling over a rumble is fitted, but said to be described
+//! poorly.
 
 use std::f64::consts::TAU;
 use std::path::PathBuf;
 
-use sake_glug_fit::compare::compare;
-use sake_glug_fit::{fit_session, Audio, FitError, FitSession, AT_PEAK_SHARE, LOW_EXPLAINED};
+use sake_glug_fit::compare::{compare, Comparison};
+use sake_glug_fit::{
+    fit_session, Audio, FitError, FitSession, SessionFit, AT_PEAK_SHARE, LOW_EXPLAINED,
+};
 
 fn clip(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -41,84 +45,153 @@ fn strongest_peak_hz(samples: &[f64], fs: f64) -> f64 {
         .map_or(f64::NAN, |(hz, _)| hz)
 }
 
-#[test]
-fn real_bubbles_are_fitted_by_their_own_peaks_and_judged_honestly() {
-    for name in ["opensfx-bubbles-44k.wav", "opensfx-bubbles-8k.wav"] {
-        let path = clip(name);
-        let session = FitSession::of_clips(std::slice::from_ref(&path), None, None).unwrap();
-        let fit = fit_session(&session).unwrap_or_else(|error| panic!("{name}: {error}"));
-        let recording = &fit.recordings[0];
-        let (detected, used) = (recording.detected.len(), recording.units.len());
-        let comparison = &compare(&fit).unwrap()[0];
-        eprintln!(
-            "{name}: {used} of {detected} units used, explaining {:.0} % of its energy; spectral \
-             correlation with the fitted model {:.2}, with the default bottle {:.2}",
-            100.0 * recording.explained,
-            comparison.fitted,
-            comparison.default
-        );
-        assert!(detected >= 5, "{name}: {detected} units detected");
-        assert!(2 * used > detected, "{name}: {used} of {detected} used");
-        // Each used unit against its own span of the recording, less the units before it.
-        let audio = Audio::read(&path, name).unwrap();
-        let fs = f64::from(audio.sample_rate);
-        for (index, unit) in recording.units.iter().enumerate() {
-            let (first, end) = unit.fit.window;
-            let span: Vec<f64> = (first..end)
-                .map(|n| {
-                    let t = n as f64 / fs;
-                    f64::from(audio.samples[n])
-                        - recording.units[..index]
-                            .iter()
-                            .map(|u| u.fit.value_at(t))
-                            .sum::<f64>()
-                })
-                .collect();
-            let peak_hz = strongest_peak_hz(&span, fs);
-            let heard_hz = unit.fit.stronger().unwrap().heard_hz;
-            let tolerance = (AT_PEAK_SHARE * peak_hz).max(fs / span.len() as f64) + 2.0;
-            assert!(
-                (heard_hz - peak_hz).abs() <= tolerance,
-                "{name}: the unit at {:.3} s rings at {heard_hz:.1} Hz, its span peaks at \
-                 {peak_hz:.1} Hz",
-                unit.fit.onset_s
-            );
-        }
-        let model = &fit.liquids[0].model_toml;
+/// The fit of one clip alone (a session of the defaults) and its spectral comparison, with the
+/// figures printed for the report: units used of those detected, the energy they explain, the
+/// correlations of the fitted model's and the default bottle's spectra with the recording's.
+fn fitted(name: &str) -> (SessionFit, Comparison) {
+    let session = FitSession::of_clips(&[clip(name)], None, None).unwrap();
+    let fit = fit_session(&session).unwrap_or_else(|error| panic!("{name}: {error}"));
+    let comparison = compare(&fit).unwrap().remove(0);
+    let recording = &fit.recordings[0];
+    eprintln!(
+        "{name}: {} of {} units used, explaining {:.0} % of its energy; spectral correlation \
+         with the fitted model {:.2}, with the default bottle {:.2}",
+        recording.units.len(),
+        recording.detected.len(),
+        100.0 * recording.explained,
+        comparison.fitted,
+        comparison.default
+    );
+    (fit, comparison)
+}
+
+/// A recording the units explain poorly is said to be so, in the warnings and in the model file;
+/// one they explain well carries no caution.
+fn is_judged_honestly(name: &str, fit: &SessionFit) {
+    let model = &fit.liquids[0].model_toml;
+    if fit.recordings[0].explained >= LOW_EXPLAINED {
+        assert!(!model.contains("# Caution"), "{name}: {model}");
+    } else {
+        let warnings = fit.warnings.join("\n");
         assert!(
-            comparison.fitted > comparison.default,
-            "{name}: the model is no closer to the recording than the default bottle: \
-             {comparison:?}"
+            warnings.contains("describes this recording poorly"),
+            "{name}: {warnings}"
         );
-        if recording.explained >= LOW_EXPLAINED {
-            assert!(!model.contains("# Caution"), "{model}");
-        } else {
-            let warnings = fit.warnings.join("\n");
-            assert!(
-                warnings.contains("describes this recording poorly"),
-                "{warnings}"
-            );
-            assert!(
-                model.contains("# Caution: the units fitted explain only"),
-                "{model}"
-            );
+        assert!(
+            model.contains("# Caution: the units fitted explain only"),
+            "{name}: {model}"
+        );
+    }
+}
+
+/// The checks of a clip of glugs: most detected units used, each used unit's stronger component
+/// at its own span's spectral peak, the model closer to the recording than the default bottle,
+/// and an honest word on how much of the recording the units explain. Every check that fails is
+/// named, with its numbers, before the test stops.
+fn is_fitted_like_glugs(name: &str) {
+    let (fit, comparison) = fitted(name);
+    let recording = &fit.recordings[0];
+    let (detected, used) = (recording.detected.len(), recording.units.len());
+    let mut failed = Vec::new();
+    if detected < 5 {
+        failed.push(format!("{detected} units detected"));
+    }
+    if 2 * used <= detected {
+        failed.push(format!("{used} of {detected} units used"));
+    }
+    // Each used unit against its own span of the recording, less the units before it.
+    let audio = Audio::read(&clip(name), name).unwrap();
+    let fs = f64::from(audio.sample_rate);
+    for (index, unit) in recording.units.iter().enumerate() {
+        let (first, end) = unit.fit.window;
+        let span: Vec<f64> = (first..end)
+            .map(|n| {
+                let t = n as f64 / fs;
+                f64::from(audio.samples[n])
+                    - recording.units[..index]
+                        .iter()
+                        .map(|u| u.fit.value_at(t))
+                        .sum::<f64>()
+            })
+            .collect();
+        let peak_hz = strongest_peak_hz(&span, fs);
+        let heard_hz = unit.fit.stronger().unwrap().heard_hz;
+        let tolerance = (AT_PEAK_SHARE * peak_hz).max(fs / span.len() as f64) + 2.0;
+        if (heard_hz - peak_hz).abs() > tolerance {
+            failed.push(format!(
+                "the unit at {:.3} s rings at {heard_hz:.1} Hz, its span peaks at {peak_hz:.1} Hz",
+                unit.fit.onset_s
+            ));
         }
+    }
+    if comparison.fitted <= comparison.default {
+        failed.push(format!(
+            "the model is no closer to the recording than the default bottle: {comparison:?}"
+        ));
+    }
+    assert!(failed.is_empty(), "{name}: {}", failed.join("; "));
+    is_judged_honestly(name, &fit);
+}
+
+/// A clip no unit of eq. 1 describes is refused, with the reasons, and no model is written: what
+/// happened instead, if not.
+fn refusal_missed(name: &str) -> Option<String> {
+    let session = FitSession::of_clips(&[clip(name)], None, None).unwrap();
+    match fit_session(&session) {
+        Err(error @ (FitError::NoUnitDescribed { .. } | FitError::NoGlugs { .. })) => {
+            let message = error.to_string();
+            eprintln!("{name}: {message}");
+            let said = message.contains("no model is written") || message.contains("no glugs");
+            (!said).then(|| format!("{name}: {message}"))
+        }
+        Err(error) => Some(format!("{name}: {error}")),
+        Ok(fit) => Some(format!(
+            "{name}: a model was fitted: {} of {} units used",
+            fit.recordings[0].units.len(),
+            fit.recordings[0].detected.len()
+        )),
     }
 }
 
 #[test]
-fn a_brooks_babble_is_refused_with_the_reasons() {
-    let path = clip("brook-11k.wav");
-    let session = FitSession::of_clips(&[path], None, None).unwrap();
-    match fit_session(&session) {
-        Err(error @ (FitError::NoUnitDescribed { .. } | FitError::NoGlugs { .. })) => {
-            let message = error.to_string();
-            assert!(message.contains("no model is written") || message.contains("no glugs"));
-        }
-        Err(error) => panic!("{error}"),
-        Ok(fit) => panic!(
-            "a model was fitted: {} units used",
-            fit.recordings[0].units.len()
-        ),
+fn real_bubbles_are_fitted_by_their_own_peaks_and_judged_honestly() {
+    for name in ["opensfx-bubbles-44k.wav", "opensfx-bubbles-8k.wav"] {
+        is_fitted_like_glugs(name);
     }
+}
+
+/// Lava bubbling over a low rumble (Minetest Game's env_sounds, CC0): the units the fit keeps
+/// ring at the rumble's 60–150 Hz, not at the pops', so it must say the model describes the
+/// recording poorly.
+#[test]
+fn lava_bubbling_over_a_rumble_is_said_to_be_described_poorly() {
+    let name = "lava-bubbles-22k.wav";
+    let (fit, _) = fitted(name);
+    assert!(
+        fit.recordings[0].explained < LOW_EXPLAINED,
+        "{name}: the units explain {:.0} % of it",
+        100.0 * fit.recordings[0].explained
+    );
+    is_judged_honestly(name, &fit);
+}
+
+/// The glug checks on the lava clip, for the lead to judge (issue 28). Measured on 2026-11-25: 23
+/// of 46 units used (not most), explaining 29 % of its energy; spectral correlation 0.97 with the
+/// fitted model, 0.79 with the default bottle (closer: passes); four used units (at 0.426, 0.463,
+/// 0.597 and 1.899 s) ring at 149.1, 115.1, 106.2 and 92.8 Hz where a plain DFT of their spans
+/// (less the units before them) peaks at 20.0 Hz, the bottom of its scan.
+#[test]
+#[ignore = "fails on lava-bubbles-22k.wav: 23 of 46 units used, 4 used units off their span's \
+            DFT peak (20 Hz); the numbers are in the comment above"]
+fn lava_bubbling_is_fitted_like_glugs() {
+    is_fitted_like_glugs("lava-bubbles-22k.wav");
+}
+
+#[test]
+fn a_brooks_babble_and_a_splash_are_refused_with_the_reasons() {
+    let missed: Vec<String> = ["brook-11k.wav", "opensfx-splat-44k.wav"]
+        .into_iter()
+        .filter_map(refusal_missed)
+        .collect();
+    assert!(missed.is_empty(), "{}", missed.join("\n"));
 }

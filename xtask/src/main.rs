@@ -10,10 +10,12 @@
 //! - `cargo xtask docs [--bench]`: regenerates every table and picture of docs/ from the current
 //!   code (the accuracy table and plot, the stability report, the pour plot, the presets as
 //!   scene files and VST3 preset files, a VST3 ramp measured in Ardour when it is installed, the
-//!   standalone app's live latency under a JACK server when one can run),
+//!   standalone app's live latency under a JACK server when one can run, the paper's numbers),
 //!   stamped with the commit and the machine, and the cost
 //!   figures of docs/scaling.md (callgrind, when valgrind is installed; the render benchmark's
 //!   last report, or a new one with `--bench`).
+//! - `cargo xtask docs paper`: only docs/paper.md, the paper's numbers beside the product's
+//!   (which `cargo xtask docs` also writes).
 //! - `cargo xtask latency`: only the live-latency figures of `cargo xtask docs`
 //!   (docs/latency.md).
 //! - `cargo xtask screenshots`: the editor in a real window (the standalone app under Xvfb), idle
@@ -32,6 +34,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod paper;
 mod screenshots;
 
 /// An error is said in one line, without the backtrace anyhow adds under `RUST_BACKTRACE`: it
@@ -101,6 +104,11 @@ fn xtask() -> nice_plug_xtask::Result<()> {
                 &maturin_of(&python),
                 &["build", "--release", "-m", "python/Cargo.toml"],
             )
+        }
+        Some("docs") if args.get(1).is_some_and(|arg| arg == "paper") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            build_cli()?;
+            paper::paper()
         }
         Some("docs") => {
             nice_plug_xtask::chdir_workspace_root()?;
@@ -312,6 +320,7 @@ fn docs() -> nice_plug_xtask::Result<()> {
             "docs/pour-plot.png",
         ],
     )?;
+    paper::paper()?;
     vst3_ramp_figures()?;
     live_latency()
 }

@@ -4,8 +4,8 @@
 use serde_json::{json, Map, Value};
 
 use super::{
-    ChiSquareTest, ConstantAnalysis, PairedAnalysis, Placement, PointEstimate, PsychometricFit,
-    POINT_PERCENTS,
+    ChiSquareTest, ConstantAnalysis, PairedAnalysis, Placement, PlanOutcome, PointEstimate,
+    PsychometricFit, POINT_PERCENTS,
 };
 
 fn test_json(test: Option<ChiSquareTest>) -> Value {
@@ -91,4 +91,37 @@ pub fn constant_json(analysis: &ConstantAnalysis) -> Value {
     object["design"] = json!("constant");
     object["participants"] = Value::Object(participants);
     object
+}
+
+/// `sake-glug analyze plan constant --json`: the plan as given, the observers' curve, the
+/// studies fitted and not, and for each point (`"25"`, `"50"`, `"75"`) its truth, coverage (with
+/// its 95 % interval), the median width of the intervals and where the estimates fell.
+pub fn plan_json(outcome: &PlanOutcome) -> Value {
+    let points: Map<String, Value> = outcome
+        .points
+        .iter()
+        .map(|point| {
+            let value = json!({
+                "truth": point.truth,
+                "covered": point.covered,
+                "coverage": point.coverage,
+                "coverage_low": point.coverage_low,
+                "coverage_high": point.coverage_high,
+                "median_width": point.median_width,
+                "median_estimate": point.median_estimate,
+                "estimate_low": point.estimate_low,
+                "estimate_high": point.estimate_high,
+            });
+            (point.percent.to_string(), value)
+        })
+        .collect();
+    json!({
+        "design": "plan constant",
+        "plan": outcome.plan,
+        "observer": outcome.observer,
+        "trials_a_study": outcome.trials_a_study,
+        "fitted": outcome.fitted,
+        "unfitted": outcome.unfitted,
+        "points": points,
+    })
 }

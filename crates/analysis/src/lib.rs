@@ -4,7 +4,9 @@
 //!   fit and a test of the participants' agreement ([`analyze_paired_logs`]);
 //! - constant stimuli (§4.4): a logistic psychometric function fitted by maximum likelihood,
 //!   its 25/50/75 % points with parametric-bootstrap 95 % intervals, pooled and per participant
-//!   ([`analyze_constant_logs`]).
+//!   ([`analyze_constant_logs`]);
+//! - the plan of a constant-stimuli study: its intervals and their coverage, simulated with
+//!   observers of a known curve ([`plan_constant`]).
 //!
 //! A log is CSV with a header; only the columns an analysis names are read. A bad log is
 //! refused with its file, line and column ([`AnalysisError`]), never analysed in part.
@@ -14,6 +16,7 @@ mod error;
 mod json;
 mod log;
 mod paired;
+mod plan;
 #[cfg(feature = "plot")]
 mod plot;
 
@@ -23,10 +26,14 @@ pub use constant::{
     CONSTANT_COLUMNS, MAX_LAPSE, MAX_RESAMPLES, POINT_PERCENTS,
 };
 pub use error::AnalysisError;
-pub use json::{constant_json, paired_json};
+pub use json::{constant_json, paired_json, plan_json};
 pub use paired::{
     analyze_paired_logs, scale_paired, ChiSquareTest, PairedAnalysis, PairedTrial,
     MAX_PAIRED_STIMULI, PAIRED_COLUMNS,
+};
+pub use plan::{
+    plan_constant, ConstantPlan, PlanError, PlanOutcome, PlannedPoint, MAX_PLAN_FITS,
+    MAX_PLAN_LEVELS, MAX_PLAN_PARTICIPANTS, MAX_PLAN_REPETITIONS, MAX_STUDIES,
 };
 #[cfg(feature = "plot")]
 pub use plot::{draw_constant_plot, draw_paired_plot};

@@ -1,7 +1,7 @@
 //! The paired-comparison study (the paper's §3): every ordered pair of stimuli, the participant
 //! names the one that is more so. Scaled by Thurstone's Case V (docs/studies.md).
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 use sake_glug_io::text::quoted;
@@ -176,8 +176,10 @@ pub fn scale_paired(trials: &[PairedTrial]) -> Result<PairedAnalysis, String> {
         ));
     }
     let mut counts = vec![vec![0u32; n]; n];
-    // Who chose what, kept sparse: a participant chooses few of many stimuli.
-    let mut wins: HashMap<(usize, usize), u32> = HashMap::new();
+    // Who chose what, kept sparse: a participant chooses few of many stimuli. Ordered, so that
+    // the χ² sums its cells in one order in every process (a HashMap's order is random per map,
+    // and so were the last bits of the sum).
+    let mut wins: BTreeMap<(usize, usize), u32> = BTreeMap::new();
     for &(participant, chosen, other) in &choices {
         counts[chosen][other] += 1;
         *wins.entry((participant, chosen)).or_default() += 1;
@@ -271,7 +273,7 @@ fn mosteller_fit(
 /// degrees of freedom. χ² = Σ (O − E)²/E = Σ O²/E − N over every cell, the second form summed
 /// over the cells that are not 0 alone.
 fn homogeneity(
-    wins: &HashMap<(usize, usize), u32>,
+    wins: &BTreeMap<(usize, usize), u32>,
     participants: usize,
     stimuli: usize,
 ) -> Option<ChiSquareTest> {

@@ -7,7 +7,7 @@ use std::path::Path;
 use sake_glug_plot::plotters::prelude::*;
 use sake_glug_plot::{Plot, FONT};
 
-use super::constant::{ConstantAnalysis, POINT_PERCENTS};
+use super::constant::{ConstantAnalysis, Placement, PointEstimate, POINT_PERCENTS};
 use super::error::AnalysisError;
 use super::paired::PairedAnalysis;
 
@@ -131,22 +131,34 @@ pub fn draw_constant_plot(analysis: &ConstantAnalysis, path: &Path) -> Result<()
             .map_err(|e| fail(&e))?;
         for (percent, point) in POINT_PERCENTS.iter().zip(&pooled.points) {
             let y = f64::from(*percent) / 100.0;
-            chart
-                .draw_series([
-                    PathElement::new(vec![(low, y), (high, y)], RED.mix(0.3)),
-                    PathElement::new(vec![(point.low, y), (point.high, y)], RED.stroke_width(3)),
-                    PathElement::new(
-                        vec![(point.value, y - 0.03), (point.value, y + 0.03)],
-                        RED.stroke_width(3),
-                    ),
-                ])
-                .map_err(|e| fail(&e))?;
-            chart
-                .draw_series(std::iter::once(Text::new(
+            let (label, marks) = match drawn_estimate(point, first, last) {
+                Some((value, from, to)) => (
                     format!(
                         "{percent} %: {:.3} [{:.3}, {:.3}]",
                         point.value, point.low, point.high
                     ),
+                    vec![
+                        PathElement::new(vec![(from, y), (to, y)], RED.stroke_width(3)),
+                        PathElement::new(
+                            vec![(value, y - 0.03), (value, y + 0.03)],
+                            RED.stroke_width(3),
+                        ),
+                    ],
+                ),
+                None => (
+                    format!("{percent} %: beyond the levels tested, no estimate"),
+                    Vec::new(),
+                ),
+            };
+            chart
+                .draw_series(
+                    std::iter::once(PathElement::new(vec![(low, y), (high, y)], RED.mix(0.3)))
+                        .chain(marks),
+                )
+                .map_err(|e| fail(&e))?;
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    label,
                     (low + 0.02 * (high - low), y + 0.045),
                     (FONT, 16).into_font().color(&RED),
                 )))
@@ -155,4 +167,39 @@ pub fn draw_constant_plot(analysis: &ConstantAnalysis, path: &Path) -> Result<()
         Ok(())
     })?;
     Ok(())
+}
+
+/// A point's mark on the plot (the estimate and its interval's ends), as the text report gives
+/// it: a point beyond the levels tested (`first` to `last`) is no estimate and gets no mark; an
+/// interval's end beyond them is drawn at the last level.
+fn drawn_estimate(point: &PointEstimate, first: f64, last: f64) -> Option<(f64, f64, f64)> {
+    (point.placement == Placement::Within)
+        .then(|| (point.value, point.low.max(first), point.high.min(last)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_an_estimate_within_the_levels_is_drawn() {
+        let point = |value, placement| PointEstimate {
+            value,
+            low: value - 0.5,
+            high: value + 0.5,
+            placement,
+        };
+        assert_eq!(
+            drawn_estimate(&point(0.4, Placement::Within), 0.2, 0.6),
+            Some((0.4, 0.2, 0.6))
+        );
+        assert_eq!(
+            drawn_estimate(&point(-1.0, Placement::BelowLevels), 0.2, 0.6),
+            None
+        );
+        assert_eq!(
+            drawn_estimate(&point(2.0, Placement::AboveLevels), 0.2, 0.6),
+            None
+        );
+    }
 }

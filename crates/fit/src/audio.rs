@@ -7,7 +7,7 @@
 use sake_glug_io::read::{self, InputKind};
 use std::path::Path;
 
-use super::error::FitError;
+use super::error::{FitError, SampleFault};
 
 /// The lowest sample rate the fit accepts (Hz): the glug's components lie below 1 kHz.
 pub const MIN_SAMPLE_RATE_HZ: u32 = 8_000;
@@ -168,57 +168,6 @@ impl Audio {
     /// Length (s).
     pub fn duration_s(&self) -> f64 {
         self.samples.len() as f64 / self.sample_rate as f64
-    }
-}
-
-/// What is wrong with a recording's samples.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum SampleFault {
-    /// Samples that are NaN or infinite (a float WAV only).
-    NonFinite {
-        /// How many.
-        count: usize,
-        /// The first's index.
-        first: usize,
-        /// …and time (s).
-        first_s: f64,
-    },
-    /// One sample far above every other, more than 1 ms away.
-    Spike {
-        /// Its index.
-        at: usize,
-        /// …and time (s).
-        at_s: f64,
-        /// Its value.
-        value: f64,
-        /// How many times the largest other sample it is.
-        ratio: f64,
-    },
-}
-
-impl std::fmt::Display for SampleFault {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match *self {
-            SampleFault::NonFinite {
-                count,
-                first,
-                first_s,
-            } => write!(
-                f,
-                "{count} sample(s) are not finite numbers (NaN or infinite), the first at sample \
-                 {first} ({first_s:.4} s): the file is corrupt"
-            ),
-            SampleFault::Spike {
-                at,
-                at_s,
-                value,
-                ratio,
-            } => write!(
-                f,
-                "an isolated spike of {value:e} at sample {at} ({at_s:.4} s), {ratio:.3e} times \
-                 any other sample: a corrupt sample, not a glug"
-            ),
-        }
     }
 }
 

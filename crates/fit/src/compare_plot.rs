@@ -6,9 +6,10 @@
 
 use sake_glug_io::PendingFile;
 use sake_glug_plot::plotters::prelude::*;
-use sake_glug_plot::{Canvas, Plot, PlotError};
+use sake_glug_plot::{Canvas, Plot, PlotError, FONT};
 
 use super::compare::{render_default, render_model, smoothed_db, spectral_correlation};
+use super::plot::draw_units_panel;
 use super::session_fit::SessionFit;
 use super::spectrum::Spectrum;
 
@@ -66,7 +67,7 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
             * 1.1;
         let mut chart = ChartBuilder::on(panel)
             .margin(12)
-            .caption(caption, ("sans-serif", 22))
+            .caption(caption, (FONT, 22))
             .x_label_area_size(35)
             .y_label_area_size(70)
             .build_cartesian_2d(0.0..span_s, -peak..peak)
@@ -118,7 +119,7 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
         .margin(12)
         .caption(
             "(c) spectra, smoothed (dB below each one's peak)",
-            ("sans-serif", 22),
+            (FONT, 22),
         )
         .x_label_area_size(35)
         .y_label_area_size(70)
@@ -152,45 +153,13 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
     if let (Some(first), Some(last)) = (units.first(), units.last()) {
         let from_s = (first.fit.onset_s - 0.005).max(0.0);
         let to_s = (last.fit.window.1 as f64 / rate).max(from_s + 0.02);
-        let samples = &recording.excerpt;
-        let range = ((from_s * rate) as usize).min(samples.len())
-            ..((to_s * rate) as usize).min(samples.len());
-        let peak = samples[range.clone()]
-            .iter()
-            .fold(1e-9f64, |p, &y| p.max(f64::from(y).abs()))
-            * 1.1;
-        let mut chart = ChartBuilder::on(&panels[3])
-            .margin(12)
-            .caption(
-                format!("(d) its first {} units and their fits", units.len()),
-                ("sans-serif", 22),
-            )
-            .x_label_area_size(35)
-            .y_label_area_size(70)
-            .build_cartesian_2d(from_s..to_s, -peak..peak)
-            .map_err(|x| e(&x))?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .draw()
-            .map_err(|x| e(&x))?;
-        chart
-            .draw_series(LineSeries::new(
-                range
-                    .clone()
-                    .map(|n| (n as f64 / rate, f64::from(samples[n]))),
-                BLUE.mix(0.6),
-            ))
-            .map_err(|x| e(&x))?;
-        chart
-            .draw_series(LineSeries::new(
-                range.map(|n| {
-                    let t = n as f64 / rate;
-                    (t, units.iter().map(|u| u.fit.value_at(t)).sum::<f64>())
-                }),
-                RED,
-            ))
-            .map_err(|x| e(&x))?;
+        draw_units_panel(
+            &panels[3],
+            &format!("(d) its first {} units and their fits", units.len()),
+            recording,
+            &units,
+            from_s..to_s,
+        )?;
     }
     Ok(())
 }

@@ -7,8 +7,6 @@ use sake_glug_io::text::{cut_short, printable};
 use sake_glug_io::ReadError;
 use sake_glug_render::human_bytes;
 
-use super::audio::SampleFault;
-
 /// Why `sake-glug fit` could not fit a model.
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
@@ -177,4 +175,55 @@ pub enum FitError {
 /// A path for a message.
 pub(crate) fn shown(path: &Path) -> String {
     printable(&path.to_string_lossy()).into_owned()
+}
+
+/// What is wrong with a recording's samples.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SampleFault {
+    /// Samples that are NaN or infinite (a float WAV only).
+    NonFinite {
+        /// How many.
+        count: usize,
+        /// The first's index.
+        first: usize,
+        /// …and time (s).
+        first_s: f64,
+    },
+    /// One sample far above every other, more than 1 ms away.
+    Spike {
+        /// Its index.
+        at: usize,
+        /// …and time (s).
+        at_s: f64,
+        /// Its value.
+        value: f64,
+        /// How many times the largest other sample it is.
+        ratio: f64,
+    },
+}
+
+impl std::fmt::Display for SampleFault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            SampleFault::NonFinite {
+                count,
+                first,
+                first_s,
+            } => write!(
+                f,
+                "{count} sample(s) are not finite numbers (NaN or infinite), the first at sample \
+                 {first} ({first_s:.4} s): the file is corrupt"
+            ),
+            SampleFault::Spike {
+                at,
+                at_s,
+                value,
+                ratio,
+            } => write!(
+                f,
+                "an isolated spike of {value:e} at sample {at} ({at_s:.4} s), {ratio:.3e} times \
+                 any other sample: a corrupt sample, not a glug"
+            ),
+        }
+    }
 }

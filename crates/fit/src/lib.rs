@@ -35,11 +35,11 @@ mod write;
 
 pub mod compare;
 
-pub use audio::{Audio, SampleFault, FIT_BYTES_PER_SAMPLE, MIN_SAMPLE_RATE_HZ};
+pub use audio::{Audio, FIT_BYTES_PER_SAMPLE, MIN_SAMPLE_RATE_HZ};
 #[cfg(feature = "plot")]
 pub use compare_plot::draw_compare_plot;
 pub use curves::FittedCurves;
-pub use error::FitError;
+pub use error::{FitError, SampleFault};
 pub use estimate::{Estimate, MIN_UNITS_FOR_INTERVAL, MIN_UNITS_FOR_MODEL};
 pub use json::fit_json;
 pub use liquid::LiquidFit;

@@ -5,8 +5,9 @@
 
 use sake_glug_io::PendingFile;
 use sake_glug_plot::plotters::prelude::*;
-use sake_glug_plot::{Canvas, Plot, PlotError};
+use sake_glug_plot::{Canvas, Plot, PlotError, FONT};
 
+use super::recording::{FittedUnit, RecordingFit};
 use super::session_fit::SessionFit;
 
 /// The plot: its name in messages and its size.
@@ -29,54 +30,14 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
 
     // (a) The recording and the fitted units over its first glugs.
     if let Some(recording) = fit.recordings.iter().find(|r| !r.units.is_empty()) {
-        let fs = recording.sample_rate as f64;
-        let samples = &recording.excerpt;
-        let excerpt_s = samples.len() as f64 / fs;
-        let from_s = (recording.units[0].fit.onset_s - 0.01).clamp(0.0, excerpt_s);
-        let to_s = from_s + UNITS_SPAN_S;
-        let range =
-            ((from_s * fs) as usize).min(samples.len())..((to_s * fs) as usize).min(samples.len());
-        let peak = samples[range.clone()]
-            .iter()
-            .fold(1e-9f64, |p, &y| p.max(f64::from(y).abs()))
-            * 1.1;
-        let mut chart = ChartBuilder::on(&panels[0])
-            .margin(12)
-            .caption(
-                format!("(a) {} and its unit fits", recording.spec.key),
-                ("sans-serif", 22),
-            )
-            .x_label_area_size(35)
-            .y_label_area_size(70)
-            .build_cartesian_2d(from_s..to_s, -peak..peak)
-            .map_err(|x| e(&x))?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .draw()
-            .map_err(|x| e(&x))?;
-        chart
-            .draw_series(LineSeries::new(
-                range
-                    .clone()
-                    .map(|n| (n as f64 / fs, f64::from(samples[n]))),
-                BLUE.mix(0.6),
-            ))
-            .map_err(|x| e(&x))?;
-        let model = range.map(|n| {
-            let t = n as f64 / fs;
-            (
-                t,
-                recording
-                    .units
-                    .iter()
-                    .map(|u| u.fit.value_at(t))
-                    .sum::<f64>(),
-            )
-        });
-        chart
-            .draw_series(LineSeries::new(model, RED))
-            .map_err(|x| e(&x))?;
+        let from_s = recording.units[0].fit.onset_s - 0.01;
+        draw_units_panel(
+            &panels[0],
+            &format!("(a) {} and its unit fits", recording.spec.key),
+            recording,
+            &recording.units.iter().collect::<Vec<_>>(),
+            from_s..from_s + UNITS_SPAN_S,
+        )?;
     }
 
     // (b) The spectrum with f1 and f2.
@@ -94,7 +55,7 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
         let high = points.iter().map(|p| p.1).fold(f64::MIN, f64::max);
         let mut chart = ChartBuilder::on(&panels[1])
             .margin(12)
-            .caption("(b) spectrum, f1 and f2", ("sans-serif", 22))
+            .caption("(b) spectrum, f1 and f2", (FONT, 22))
             .x_label_area_size(35)
             .y_label_area_size(70)
             .build_cartesian_2d(0.0..top_hz, (high - 70.0)..(high + 3.0))
@@ -151,7 +112,7 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
             * 1.1;
         let mut chart = ChartBuilder::on(&panels[2])
             .margin(12)
-            .caption("(c) Asum against V (fig. 7)", ("sans-serif", 22))
+            .caption("(c) Asum against V (fig. 7)", (FONT, 22))
             .x_label_area_size(35)
             .y_label_area_size(70)
             .build_cartesian_2d(0.0..capacity, 0.0..top)
@@ -205,10 +166,7 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
         .fold(0.1, f64::max);
     let mut chart = ChartBuilder::on(&panels[3])
         .margin(12)
-        .caption(
-            "(d) V(t) per recording and its line (fig. 6)",
-            ("sans-serif", 22),
-        )
+        .caption("(d) V(t) per recording and its line (fig. 6)", (FONT, 22))
         .x_label_area_size(35)
         .y_label_area_size(70)
         .build_cartesian_2d(0.0..end_s, 0.0..capacity)
@@ -260,15 +218,63 @@ fn say<DB: DrawingBackend>(
     why: &str,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let (_, height) = panel.dim_in_pixel();
-    panel.draw_text(
-        caption,
-        &("sans-serif", 22).into_font().color(&BLACK),
-        (12, 12),
-    )?;
+    panel.draw_text(caption, &(FONT, 22).into_font().color(&BLACK), (12, 12))?;
     panel.draw_text(
         why,
-        &("sans-serif", 20).into_font().color(&BLACK.mix(0.7)),
+        &(FONT, 20).into_font().color(&BLACK.mix(0.7)),
         (40, height as i32 / 2),
     )?;
+    Ok(())
+}
+
+/// A panel of `recording`'s excerpt over `span_s` (clamped to it) in blue, and the sum of
+/// `units`' fits in red: panel (a) of the fit plot and (d) of the comparison picture.
+pub(crate) fn draw_units_panel(
+    area: &Canvas<'_>,
+    caption: &str,
+    recording: &RecordingFit,
+    units: &[&FittedUnit],
+    span_s: std::ops::Range<f64>,
+) -> Result<(), String> {
+    let e = |error: &dyn std::fmt::Display| error.to_string();
+    let fs = recording.sample_rate as f64;
+    let samples = &recording.excerpt;
+    let excerpt_s = samples.len() as f64 / fs;
+    let (from_s, to_s) = (span_s.start.clamp(0.0, excerpt_s), span_s.end);
+    let range =
+        ((from_s * fs) as usize).min(samples.len())..((to_s * fs) as usize).min(samples.len());
+    let peak = samples[range.clone()]
+        .iter()
+        .fold(1e-9f64, |p, &y| p.max(f64::from(y).abs()))
+        * 1.1;
+    let mut chart = ChartBuilder::on(area)
+        .margin(12)
+        .caption(caption, (FONT, 22))
+        .x_label_area_size(35)
+        .y_label_area_size(70)
+        .build_cartesian_2d(from_s..to_s, -peak..peak)
+        .map_err(|x| e(&x))?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .draw()
+        .map_err(|x| e(&x))?;
+    chart
+        .draw_series(LineSeries::new(
+            range
+                .clone()
+                .map(|n| (n as f64 / fs, f64::from(samples[n]))),
+            BLUE.mix(0.6),
+        ))
+        .map_err(|x| e(&x))?;
+    chart
+        .draw_series(LineSeries::new(
+            range.map(|n| {
+                let t = n as f64 / fs;
+                (t, units.iter().map(|u| u.fit.value_at(t)).sum::<f64>())
+            }),
+            RED,
+        ))
+        .map_err(|x| e(&x))?;
     Ok(())
 }
