@@ -88,7 +88,7 @@ pub struct RenderArgs {
     model: Option<PathBuf>,
     #[arg(long, value_name = "NAME|FILE.toml", help = format!(
         "Compensates every unit for an actuator (MODEL.md §18) so that the device delivers the \
-         model's c: a shipped profile ({}) or a profile file (what measure-actuator writes)",
+         model's c: a shipped profile ({}) or a profile file (with the keys of the shipped ones)",
         shipped_names().join(", ")
     ))]
     actuator: Option<String>,

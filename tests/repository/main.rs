@@ -11,8 +11,9 @@ use std::path::{Path, PathBuf};
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// How a repository path starts: one of the top-level folders, or it is a top-level file.
-const FOLDERS: [&str; 14] = [
+const FOLDERS: [&str; 15] = [
     "src/",
+    "actuators/",
     "crates/",
     "include/",
     "bindings/",

@@ -311,7 +311,7 @@ fn pairs(key: &'static str, value: &toml::Value) -> Result<Vec<(f64, f64)>, Prof
         .collect()
 }
 
-/// A profile to write (what `sake-glug measure-actuator` measured), as TOML that
+/// A profile to write (a measured response), as TOML that
 /// [`ActuatorProfile::parse`] reads back.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProfileText {

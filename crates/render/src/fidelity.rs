@@ -9,11 +9,10 @@
 
 use std::path::Path;
 
-use serde_json::Value;
-
 use super::clips::{clip_onsets, ClipSource, Glug};
 use super::render::{RenderObserver, RenderSummary};
 use super::scene::Scene;
+use super::sinks::read_back::{ReadBack, Reading, WrittenClip};
 use super::sinks::{Output, OutputError, OutputFormat, OutputOptions};
 use super::steps::ComponentEnvelopes;
 use sake_glug_engine::{ActuatorResponse, UnitOnset, Voicing};
@@ -121,44 +120,6 @@ fn delivered_c(actuator: &ActuatorResponse, units: &[DrivenUnit]) -> DeliveredC 
     DeliveredC::Measured { without, with }
 }
 
-/// How the fidelity report reads a played format back; a format not played (the plot, the
-/// tables, read by people and programs) declares none and is not measured.
-#[derive(Clone, Copy)]
-pub(crate) enum ReadBack {
-    /// The render's samples themselves: the onsets to the sample, no envelope apart from the
-    /// waveform; `limits` says what the platform took of them for a scene.
-    Waveform {
-        /// The platform limits the file met.
-        limits: fn(&Scene) -> String,
-    },
-    /// A clip: its onsets and its envelope, read from the file.
-    Clip(fn(&WrittenClip) -> Result<Reading, OutputError>),
-}
-
-/// The limits column of a waveform its platform takes as it is: "—".
-pub(crate) fn no_limits(_: &Scene) -> String {
-    "—".to_owned()
-}
-
-/// A clip's file as written, and the model's glugs it was written from.
-pub(crate) struct WrittenClip<'a> {
-    /// The file.
-    pub path: &'a Path,
-    /// The model's glugs.
-    pub source: &'a ClipSource<'a>,
-}
-
-impl WrittenClip<'_> {
-    /// The file as JSON.
-    pub fn json(&self) -> Result<Value, OutputError> {
-        let text = std::fs::read_to_string(self.path).map_err(OutputError::io(self.path))?;
-        serde_json::from_str(&text).map_err(|error| OutputError::Io {
-            path: self.path.to_owned(),
-            source: error.into(),
-        })
-    }
-}
-
 /// The formats measured: every one played that this build writes.
 fn measured_formats() -> impl Iterator<Item = (OutputFormat, ReadBack)> {
     OutputFormat::ALL
@@ -258,19 +219,6 @@ pub fn measure(
         .collect()
 }
 
-/// What a clip's file says of the render, read back: its onsets and its envelope.
-pub(crate) struct Reading {
-    /// Times (s) the format marks an onset at.
-    pub onsets: Vec<f64>,
-    /// Whether a glug shows from the last mark before its onset (a rumble frame carries it
-    /// from the frame's start), rather than from the nearest mark.
-    pub from_mark_before: bool,
-    /// The format's level (0..1 of full scale) at a time.
-    pub envelope: Box<dyn Fn(f64) -> f64>,
-    /// The platform limits the file met.
-    pub limits: String,
-}
-
 /// Mean and worst distance (ms) from the model's audible onsets to the format's marks.
 fn onset_error_ms(source: &ClipSource, reading: &Reading) -> Option<(f64, f64)> {
     let onsets: Vec<f64> = clip_onsets(source)
@@ -322,43 +270,6 @@ fn envelope_error_db(
         .map(|(&t, &level)| (20.0 * (envelope(t).max(LEVEL_FLOOR) / level).log10()).abs())
         .collect();
     (!errors.is_empty()).then(|| errors.iter().sum::<f64>() / errors.len() as f64)
-}
-
-/// The number at `key` of `value`, 0 if none.
-pub(crate) fn number(value: &Value, key: &str) -> f64 {
-    value.get(key).and_then(Value::as_f64).unwrap_or(0.0)
-}
-
-/// The array at `pointer` in `value`, empty if none.
-pub(crate) fn array<'a>(value: &'a Value, pointer: &str) -> &'a [Value] {
-    value
-        .pointer(pointer)
-        .and_then(Value::as_array)
-        .map_or(&[], Vec::as_slice)
-}
-
-/// Straight lines between `(time, level)` points; 0 outside them.
-pub(crate) fn linear(points: Vec<(f64, f64)>) -> Box<dyn Fn(f64) -> f64> {
-    Box::new(move |t| {
-        let next = points.partition_point(|p| p.0 <= t);
-        if next == 0 || next == points.len() {
-            return 0.0;
-        }
-        let (a, b) = (points[next - 1], points[next]);
-        a.1 + (b.1 - a.1) * (t - a.0) / (b.0 - a.0).max(1e-12)
-    })
-}
-
-/// Levels held over `(start, end, level)` spans; 0 outside them.
-pub(crate) fn held(mut spans: Vec<(f64, f64, f64)>) -> Box<dyn Fn(f64) -> f64> {
-    spans.sort_by(|a, b| a.0.total_cmp(&b.0));
-    Box::new(move |t| {
-        let next = spans.partition_point(|span| span.0 <= t);
-        match next.checked_sub(1).map(|i| spans[i]) {
-            Some((_, end, level)) if t < end => level,
-            _ => 0.0,
-        }
-    })
 }
 
 /// The measurements as the Markdown table the README shows; with an actuator profile, two more

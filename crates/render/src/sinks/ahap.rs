@@ -8,12 +8,12 @@
 use serde::Serialize;
 use serde_json::Value;
 
+use super::read_back::{array, held, number, ReadBack, Reading, WrittenClip};
 use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
 use crate::clips::{
     clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, transient_intensity,
     ClipSource, HapticBand, ENVELOPE_FLOOR,
 };
-use crate::fidelity::{array, held, number, ReadBack, Reading, WrittenClip};
 
 /// `.ahap`: an Apple Core Haptics pattern.
 pub(super) const FORMAT: OutputFormat = OutputFormat {

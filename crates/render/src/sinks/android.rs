@@ -7,9 +7,9 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
+use super::read_back::{array, held, ReadBack, Reading, WrittenClip};
 use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
 use crate::clips::{clip_onsets, ClipSource};
-use crate::fidelity::{array, held, ReadBack, Reading, WrittenClip};
 use crate::steps::{android_steps, ANDROID_FULL_AMPLITUDE, ANDROID_STEP_MS};
 
 /// `.xml`: Android's vibration XML (`VibrationXmlParser`).

@@ -15,10 +15,10 @@ use std::num::{NonZeroU32, NonZeroU8};
 #[cfg(feature = "ogg")]
 use vorbis_rs::{VorbisBitrateManagementStrategy, VorbisEncoder, VorbisEncoderBuilder};
 
+use super::read_back::{no_limits, ReadBack};
 #[cfg(feature = "ogg")]
 use super::{AudioChannels, PendingFile};
 use super::{OutputError, OutputFormat, Sink, SinkContext};
-use crate::fidelity::{no_limits, ReadBack};
 #[cfg(feature = "ogg")]
 use crate::RenderSummary;
 

@@ -6,8 +6,8 @@ use std::fmt::Write as _;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 
+use super::read_back::{no_limits, ReadBack};
 use super::{OutputError, OutputFormat, PendingFile, Sink, SinkContext};
-use crate::fidelity::{no_limits, ReadBack};
 use crate::RenderSummary;
 
 /// How much text is gathered before it is written: large enough that the writer sees few

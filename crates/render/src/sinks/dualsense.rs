@@ -10,8 +10,8 @@ use std::path::Path;
 
 use hound::{SampleFormat, WavSpec, WavWriter};
 
+use super::read_back::ReadBack;
 use super::{OutputError, OutputFormat, PendingFile, Sink, SinkContext};
-use crate::fidelity::ReadBack;
 use crate::resample::Resample;
 use crate::{RenderSummary, Scene};
 

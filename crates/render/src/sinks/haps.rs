@@ -4,9 +4,9 @@
 
 use serde::Serialize;
 
+use super::read_back::{array, linear, number, ReadBack, Reading, WrittenClip};
 use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
 use crate::clips::{clip_end_s, clip_onsets, envelope_breakpoints, ClipSource};
-use crate::fidelity::{array, linear, number, ReadBack, Reading, WrittenClip};
 
 /// `.haps`: an Interhaptics / Razer Haptic Composer file (version 5).
 pub(super) const FORMAT: OutputFormat = OutputFormat {

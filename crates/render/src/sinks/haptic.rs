@@ -3,12 +3,12 @@
 
 use serde::Serialize;
 
+use super::read_back::{array, linear, number, ReadBack, Reading, WrittenClip};
 use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
 use crate::clips::{
     clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, transient_intensity,
     ClipSource, HapticBand,
 };
-use crate::fidelity::{array, linear, number, ReadBack, Reading, WrittenClip};
 
 /// `.haptic`: a Meta Haptics Studio 1.0 clip.
 pub(super) const FORMAT: OutputFormat = OutputFormat {

@@ -21,6 +21,7 @@ mod dualsense;
 mod haps;
 mod haptic;
 mod plot;
+pub(crate) mod read_back;
 mod rumble;
 mod state;
 mod units;
@@ -29,12 +30,12 @@ mod wav;
 use std::path::{Path, PathBuf};
 
 use super::clips::HapticBand;
-use super::fidelity::ReadBack;
 use super::memory::human_bytes;
 use super::render::{BottleReport, RenderError, RenderSummary};
 use super::scene::Scene;
 use super::tables::{StateRate, StateRateError};
 use clip::ClipSink;
+use read_back::ReadBack;
 use sake_glug_engine::{UnitOnset, Voicing};
 pub(crate) use sake_glug_io::{remove_own_temps, remove_stale_temps, PendingFile};
 

@@ -3,9 +3,9 @@
 
 use serde::Serialize;
 
+use super::read_back::{array, held, number, ReadBack, Reading, WrittenClip};
 use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
 use crate::clips::{clip_onsets, ClipSource};
-use crate::fidelity::{array, held, number, ReadBack, Reading, WrittenClip};
 use crate::steps::rumble_frames;
 
 /// `rumble` (`.json`): frames of a dual-rumble gamepad's two motors.

@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 
 use hound::{SampleFormat as HoundFormat, WavSpec, WavWriter};
 
+use super::read_back::{no_limits, ReadBack};
 use super::{OutputError, OutputFormat, PendingFile, Sink, SinkContext};
-use crate::fidelity::{no_limits, ReadBack};
 use crate::RenderSummary;
 
 /// `.wav`: the mono output, for an actuator driven from an audio interface.

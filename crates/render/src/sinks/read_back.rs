@@ -1,0 +1,100 @@
+//! How the fidelity report (`crate::fidelity`) reads a played format back: each format's
+//! entry (`super::OutputFormat::read_back`) names a [`ReadBack`], and the readers of the clips
+//! share the helpers here. Beside the formats, so that they depend on it and the report on them,
+//! never both ways.
+
+use std::path::Path;
+
+use serde_json::Value;
+
+use super::OutputError;
+use crate::clips::ClipSource;
+use crate::scene::Scene;
+
+/// How the fidelity report reads a played format back; a format not played (the plot, the
+/// tables, read by people and programs) declares none and is not measured.
+#[derive(Clone, Copy)]
+pub(crate) enum ReadBack {
+    /// The render's samples themselves: the onsets to the sample, no envelope apart from the
+    /// waveform; `limits` says what the platform took of them for a scene.
+    Waveform {
+        /// The platform limits the file met.
+        limits: fn(&Scene) -> String,
+    },
+    /// A clip: its onsets and its envelope, read from the file.
+    Clip(fn(&WrittenClip) -> Result<Reading, OutputError>),
+}
+
+/// The limits column of a waveform its platform takes as it is: "—".
+pub(crate) fn no_limits(_: &Scene) -> String {
+    "—".to_owned()
+}
+
+/// A clip's file as written, and the model's glugs it was written from.
+pub(crate) struct WrittenClip<'a> {
+    /// The file.
+    pub path: &'a Path,
+    /// The model's glugs.
+    pub source: &'a ClipSource<'a>,
+}
+
+impl WrittenClip<'_> {
+    /// The file as JSON.
+    pub fn json(&self) -> Result<Value, OutputError> {
+        let text = std::fs::read_to_string(self.path).map_err(OutputError::io(self.path))?;
+        serde_json::from_str(&text).map_err(|error| OutputError::Io {
+            path: self.path.to_owned(),
+            source: error.into(),
+        })
+    }
+}
+
+/// What a clip's file says of the render, read back: its onsets and its envelope.
+pub(crate) struct Reading {
+    /// Times (s) the format marks an onset at.
+    pub onsets: Vec<f64>,
+    /// Whether a glug shows from the last mark before its onset (a rumble frame carries it
+    /// from the frame's start), rather than from the nearest mark.
+    pub from_mark_before: bool,
+    /// The format's level (0..1 of full scale) at a time.
+    pub envelope: Box<dyn Fn(f64) -> f64>,
+    /// The platform limits the file met.
+    pub limits: String,
+}
+
+/// The number at `key` of `value`, 0 if none.
+pub(crate) fn number(value: &Value, key: &str) -> f64 {
+    value.get(key).and_then(Value::as_f64).unwrap_or(0.0)
+}
+
+/// The array at `pointer` in `value`, empty if none.
+pub(crate) fn array<'a>(value: &'a Value, pointer: &str) -> &'a [Value] {
+    value
+        .pointer(pointer)
+        .and_then(Value::as_array)
+        .map_or(&[], Vec::as_slice)
+}
+
+/// Straight lines between `(time, level)` points; 0 outside them.
+pub(crate) fn linear(points: Vec<(f64, f64)>) -> Box<dyn Fn(f64) -> f64> {
+    Box::new(move |t| {
+        let next = points.partition_point(|p| p.0 <= t);
+        if next == 0 || next == points.len() {
+            return 0.0;
+        }
+        let (a, b) = (points[next - 1], points[next]);
+        a.1 + (b.1 - a.1) * (t - a.0) / (b.0 - a.0).max(1e-12)
+    })
+}
+
+/// Levels held over `(start, end, level)` spans; 0 outside them.
+pub(crate) fn held(mut spans: Vec<(f64, f64, f64)>) -> Box<dyn Fn(f64) -> f64> {
+    spans.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Box::new(move |t| {
+        let next = spans.partition_point(|span| span.0 <= t);
+        match next.checked_sub(1).map(|i| spans[i]) {
+            Some((_, end, level)) if t < end => level,
+            _ => 0.0,
+        }
+    })
+}
