@@ -6,7 +6,9 @@ The offline renderer of the ``sake-glug`` command line, for Python::
     samples = sake_glug.render({"tilt_deg": 135.0, "duration_s": 2.0})
 
 - :func:`render` renders a scene (a file, TOML text, a dict, or the built-in pour) to a NumPy
-  ``float32`` array, bit for bit the samples ``sake-glug render`` writes to an f32 WAV;
+  ``float32`` array, bit for bit the samples ``sake-glug render`` writes to an f32 WAV, and
+  with ``actuator=`` (a shipped profile's name or a profile file) compensated for a device as
+  ``--actuator`` does;
 - :func:`render_tables` renders the same samples with the glug data: one row per unit and the
   bottle's state at a fixed rate, the tables of ``sake-glug render --units/--state``;
 - :func:`fit` fits a model to a session's recordings (``sake-glug fit``), and
@@ -54,8 +56,8 @@ class Tables(NamedTuple):
 
 
 def render_tables(scene: Any = None, **options: Any) -> Tables:
-    """Renders a scene as :func:`render` does (same arguments but ``progress``, plus
-    ``state_rate`` in Hz, 1000 by default) and returns its samples with its units and state
+    """Renders a scene as :func:`render` does (same arguments but ``progress``, ``actuator``
+    and ``felt`` included, plus ``state_rate`` in Hz, 1000 by default) and returns its samples with its units and state
     tables, the rows ``sake-glug render --units/--state`` writes. The scene renders twice: once
     keeping nothing, to refuse tables that cannot fit in memory with the figure, then into
     them."""

@@ -17,6 +17,7 @@ __all__ = [
 ]
 
 _Scene = Union[str, "os.PathLike[str]", Mapping[str, Any], None]
+_Actuator = Union[str, "os.PathLike[str]", None]
 
 class SakeGlugError(ValueError):
     """A scene, preset or sample rate that Sake Glug refuses, with the command line's message."""
@@ -35,6 +36,8 @@ def render(
     sample_rate: Optional[float] = None,
     preset: Optional[str] = None,
     progress: Optional[Callable[[int, Optional[int]], object]] = None,
+    actuator: _Actuator = None,
+    felt: bool = False,
 ) -> npt.NDArray[np.float32]:
     """Renders a scene and returns its samples (mono, float32), bit for bit those of
     `sake-glug render` of the same scene.
@@ -47,6 +50,11 @@ def render(
     overrides the scene's (Hz); preset renders a preset instead of a scene. progress is called
     as progress(done, total) about every 20 ms with the samples rendered and the render's
     length (None without duration_s); what it raises stops the render and is raised.
+    actuator compensates every unit for a device (MODEL.md §18) as --actuator does: a shipped
+    profile's name (flat, haptuator-mark2, lra, phone, dualsense, vr-controller; a str names a
+    shipped one first) or a profile file's path; felt (with actuator) equalises over the
+    skin's threshold instead, as --felt does. A refused profile raises SakeGlugError naming
+    the file and the key.
 
     The samples are held in memory: a render that cannot fit (a day at 48 kHz is 16.6 GB) is
     refused before it starts, or, without duration_s, as soon as it outgrows the memory
@@ -68,10 +76,12 @@ def render_tables(
     sample_rate: Optional[float] = None,
     preset: Optional[str] = None,
     state_rate: float = 1000.0,
+    actuator: _Actuator = None,
+    felt: bool = False,
 ) -> Tables:
     """Renders a scene as render() does and returns its samples with its units and state
     tables (a float64 array per column, named as the columns of `sake-glug render --units` and
-    `--state`). The scene renders twice: once keeping nothing, to count the tables' rows and
+    `--state`); actuator and felt as render()'s. The scene renders twice: once keeping nothing, to count the tables' rows and
     refuse them with the figure if they cannot fit in memory, then into the tables. Ctrl-C
     stops it. Raises SakeGlugError for what it refuses."""
 

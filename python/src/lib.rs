@@ -18,6 +18,7 @@ use pyo3::exceptions::{PyTypeError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyInt, PyString};
 
+use sake_glug_actuator::{ActuatorProfile, Equalise};
 use sake_glug_analysis::{
     analyze_constant_logs, analyze_paired_logs, constant_json, paired_json, PsychometricOptions,
     MAX_RESAMPLES,
@@ -95,8 +96,14 @@ impl SceneSource {
     }
 
     /// The scene, read and validated as the command line reads it (`render_job` of
-    /// `sake-glug render`): the preset only without a scene, then the sample rate's override.
-    fn load(self, preset: Option<&str>, sample_rate: Option<f64>) -> Result<Scene, Refused> {
+    /// `sake-glug render`): the preset only without a scene, then the sample rate's override,
+    /// then the actuator's response.
+    fn load(
+        self,
+        preset: Option<&str>,
+        sample_rate: Option<f64>,
+        actuator: Option<&ActuatorProfile>,
+    ) -> Result<Scene, Refused> {
         let preset = match preset {
             None => None,
             Some(name) => Some(Preset::find(name).ok_or_else(|| {
@@ -114,11 +121,49 @@ impl SceneSource {
             (Self::File(path), None) => Scene::load(&path)?,
             (Self::Toml(text), None) => Scene::parse(&text)?,
         };
-        Ok(match sample_rate {
+        let mut scene = match sample_rate {
             Some(sample_rate) => scene.with_sample_rate(sample_rate)?,
             None => scene,
-        })
+        };
+        scene.actuator = actuator.map(ActuatorProfile::response);
+        Ok(scene)
     }
+}
+
+/// The actuator profile of `actuator=` and `felt=`, as `sake-glug render --actuator` and
+/// `--felt` read it: a str is a shipped profile's name or else a file's path, an `os.PathLike`
+/// a file's path. A refused profile raises SakeGlugError naming the file and the key.
+fn actuator_profile(
+    actuator: Option<&Bound<'_, PyAny>>,
+    felt: bool,
+) -> PyResult<Option<ActuatorProfile>> {
+    let found = match actuator.filter(|actuator| !actuator.is_none()) {
+        None if felt => {
+            return Err(SakeGlugError::new_err(
+                "felt=True needs an actuator (as --felt needs --actuator): the skin's \
+                 sensitivity is equalised on a device's response",
+            ))
+        }
+        None => return Ok(None),
+        Some(actuator) => {
+            if let Ok(name) = actuator.cast::<PyString>() {
+                ActuatorProfile::find(&name.to_cow()?)
+            } else if let Ok(path) = actuator.extract::<PathBuf>() {
+                ActuatorProfile::load(&path)
+            } else {
+                return Err(PyTypeError::new_err(format!(
+                    "actuator must be a shipped profile's name, a path or None, not {}",
+                    actuator.get_type().name()?
+                )));
+            }
+        }
+    };
+    let profile = found.map_err(|error| SakeGlugError::new_err(format!("actuator: {error}")))?;
+    Ok(Some(if felt {
+        profile.equalising(Equalise::Felt)
+    } else {
+        profile
+    }))
 }
 
 /// A scene and a preset given together (`sake-glug render` refuses `--preset` with a scene).
@@ -177,6 +222,11 @@ impl Refused {
 /// progress: called as progress(done, total) about every 20 ms while rendering, with the
 ///     samples rendered and the render's length (None for a scene without duration_s, whose
 ///     end is known only when it comes); what it raises stops the render and is raised.
+/// actuator: compensates every unit for a device (MODEL.md §18), as --actuator does: a
+///     shipped profile's name (flat, haptuator-mark2, lra, phone, dualsense, vr-controller)
+///     or a profile file's path (str or os.PathLike); a str names a shipped profile first.
+/// felt: with actuator, equalises over the skin's threshold instead of the acceleration, as
+///     --felt does.
 ///
 /// The sample rate of the result is the scene's (or sample_rate if given). The GIL is
 /// released while rendering; Ctrl-C stops it. The samples are held in memory: a render
@@ -185,18 +235,23 @@ impl Refused {
 /// SakeGlugError with the command line's message for a scene, preset or sample rate it
 /// refuses.
 #[pyfunction]
-#[pyo3(signature = (scene=None, *, sample_rate=None, preset=None, progress=None))]
+#[pyo3(signature = (
+    scene=None, *, sample_rate=None, preset=None, progress=None, actuator=None, felt=false
+))]
 fn render<'py>(
     py: Python<'py>,
     scene: Option<&Bound<'py, PyAny>>,
     sample_rate: Option<f64>,
     preset: Option<&str>,
     progress: Option<&Bound<'py, PyAny>>,
+    actuator: Option<&Bound<'py, PyAny>>,
+    felt: bool,
 ) -> PyResult<Bound<'py, PyArray1<f32>>> {
     let source = SceneSource::of(scene)?;
     let progress = callback("progress", progress)?;
+    let actuator = actuator_profile(actuator, felt)?;
     let rendered = py.detach(|| {
-        let scene = source.load(preset, sample_rate)?;
+        let scene = source.load(preset, sample_rate, actuator.as_ref())?;
         let total = scene.duration_samples();
         let mut samples = match total {
             Some(total) => Samples::with_room(total, scene.sample_rate),
@@ -262,23 +317,29 @@ impl RenderObserver for CountingUnits {
 /// each k/state_rate). MODEL.md §14 says what each column is.
 ///
 /// state_rate: rows a second of the state table (Hz, above 0 and at most the sample rate).
+/// actuator, felt: as render()'s; the tables are then those `sake-glug render --actuator` writes.
 ///
 /// The scene renders twice: once keeping nothing, to count what the tables will hold and
 /// refuse them with the figure if they cannot fit in memory, then into the tables.
 #[pyfunction]
-#[pyo3(signature = (scene=None, *, sample_rate=None, preset=None, state_rate=1000.0))]
+#[pyo3(signature = (
+    scene=None, *, sample_rate=None, preset=None, state_rate=1000.0, actuator=None, felt=false
+))]
 fn render_tables<'py>(
     py: Python<'py>,
     scene: Option<&Bound<'py, PyAny>>,
     sample_rate: Option<f64>,
     preset: Option<&str>,
     state_rate: f64,
+    actuator: Option<&Bound<'py, PyAny>>,
+    felt: bool,
 ) -> PyResult<TablesTuple<'py>> {
     let source = SceneSource::of(scene)?;
     let state_rate = StateRate::new(state_rate)
         .map_err(|error| SakeGlugError::new_err(format!("state_rate: {error}")))?;
+    let actuator = actuator_profile(actuator, felt)?;
     let rendered = py.detach(|| {
-        let scene = source.load(preset, sample_rate)?;
+        let scene = source.load(preset, sample_rate, actuator.as_ref())?;
         // A bound: row k is at sample ⌈k·fs/R⌉, before the end.
         let state_rows =
             |samples: u64| (samples as f64 * state_rate.hz() / scene.sample_rate as f64) as u64 + 2;

@@ -8,6 +8,7 @@ mod clap_host;
 mod fuzz;
 mod host;
 
+mod actuator;
 mod automation;
 mod clap_state;
 mod descriptors;

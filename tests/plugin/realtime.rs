@@ -1,6 +1,7 @@
 //! process() is real-time safe: no allocation (checked by nice-plug's `assert_no_alloc` when
 //! built with `--features assert_process_allocs` in the dev profile), under every kind of input a
-//! host sends: odd block sizes, parameter changes, note-ons, CCs, transport starts and jumps.
+//! host sends: odd block sizes, parameter changes, note-ons, CCs, transport starts and jumps, an
+//! actuator chosen or cleared.
 //!
 //! Run: `cargo test --features assert_process_allocs --test plugin realtime`
 
@@ -45,6 +46,13 @@ fn process_does_not_allocate_under_a_busy_session() {
                 3 => host.set_normalized("seed", (index as f32 * 0.07) % 1.0),
                 4 => host.set_normalized("drain", (index % 2) as f32),
                 _ => host.set_normalized("b1", (index as f32 * 0.77) % 1.0),
+            }
+            // The editor picks an actuator (or none) between blocks: process() takes it.
+            if index % 4 == 2 {
+                let names = ["lra", "phone", "none", "haptuator-mark2"];
+                let actuator =
+                    sake_glug_plugin::Actuator::shipped(names[index / 4 % 4], index % 8 == 2);
+                host.plugin.glug_params().actuator.set(actuator);
             }
             let last = len as u32 - 1;
             let events = vec![

@@ -1,6 +1,7 @@
 //! The plugin shell: the CLAP and VST3 plugin around the real-time glue in [`realtime`]. It holds
 //! the parameters, hands MIDI and the transport to [`RealtimeEngine`] and keeps no DSP of its own.
 
+mod actuator_setting;
 mod feed;
 mod layering;
 mod loaded_model;
@@ -14,6 +15,7 @@ mod transport;
 #[cfg(feature = "editor")]
 mod editor;
 
+pub use actuator_setting::{Actuator, ActuatorSetting, ACTUATOR_FELT_KEY, ACTUATOR_KEY};
 pub use feed::{Feed, UnitView, Visible, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
 pub use layering::model_values;
 pub use loaded_model::{LoadedModel, ModelLayer, MODEL_KEY, MODEL_NAME_KEY};
@@ -29,6 +31,7 @@ use std::sync::Arc;
 
 use nice_plug::prelude::*;
 
+use sake_glug_actuator::ActuatorResponse;
 use sake_glug_device::midi::{MidiInput, MidiMap};
 
 /// The plugin shell: parameters and lifecycle around [`RealtimeEngine`], which does the work.
@@ -48,6 +51,9 @@ pub struct SakeGlugPlugin<const RAW_MIDI: bool> {
     /// The audio thread's copy of the loaded model (MODEL.md §12.1), taken from
     /// [`GlugParams::loaded_model`] at the start of each block.
     model: Option<ModelLayer>,
+    /// The audio thread's copy of the actuator's response (MODEL.md §18), taken from
+    /// [`GlugParams::actuator`] at the start of each block.
+    actuator: Option<ActuatorResponse>,
 }
 
 /// The CLAP plugin, with raw MIDI from the device.
@@ -67,6 +73,7 @@ impl<const RAW_MIDI: bool> Default for SakeGlugPlugin<RAW_MIDI> {
             osc: Arc::new(OscInput::default()),
             renderer: None,
             model: None,
+            actuator: None,
         }
     }
 }
@@ -92,13 +99,19 @@ impl<const RAW_MIDI: bool> SakeGlugPlugin<RAW_MIDI> {
         self.renderer.as_ref()
     }
 
-    /// The parameters' values over the loaded model, after taking the newest model loaded
-    /// (lock-free: also on the audio thread).
+    /// The parameters' values over the loaded model, with the actuator, after taking the
+    /// newest model and actuator chosen (lock-free: also on the audio thread).
     fn settings(&mut self) -> Settings {
         if let Some(model) = self.params.loaded_model.take_change() {
             self.model = model;
         }
-        Settings::with_model(&self.params, self.model.as_ref())
+        if let Some(actuator) = self.params.actuator.take_change() {
+            self.actuator = actuator;
+        }
+        Settings {
+            actuator: self.actuator,
+            ..Settings::with_model(&self.params, self.model.as_ref())
+        }
     }
 }
 

@@ -14,6 +14,7 @@ use nice_plug::params::persist::{self, PersistentField};
 use nice_plug::plugin::ParamValue;
 use nice_plug::prelude::*;
 
+use crate::actuator_setting::{saved_actuator, ActuatorSetting};
 use crate::loaded_model::{saved_model, LoadedModel, MODEL_KEY, MODEL_NAME_KEY};
 use crate::osc_input::OscSettings;
 use sake_glug_device::midi::{MidiMap, MidiSetting};
@@ -138,6 +139,9 @@ pub struct GlugParams {
     pub osc: OscSettings,
     /// The model file loaded, if any (saved with the state as its text, MODEL.md §12.1).
     pub loaded_model: LoadedModel,
+    /// The actuator compensated for, if any (saved with the state as a shipped profile's name
+    /// or a profile's text, and the felt flag, MODEL.md §18).
+    pub actuator: ActuatorSetting,
 }
 
 /// The saved state's layout. 0: before states carried a version (the parameters and MIDI
@@ -173,11 +177,17 @@ pub fn migrate_state(state: &mut PluginState) {
 /// plugin would save them again (a MIDI byte out of range as off, a field that does not parse as
 /// its default). So a state the plugin saves is always one it loads.
 ///
-/// A state whose model is no model is refused whole: its parameters and fields are emptied, so
-/// that loading it changes nothing (nice-plug gives `filter_state` no way to fail a load).
+/// A state whose model is no model, or whose actuator is no profile, is refused whole: its
+/// parameters and fields are emptied, so that loading it changes nothing (nice-plug gives
+/// `filter_state` no way to fail a load).
 pub fn validate_state(state: &mut PluginState) {
-    if let Err(reason) = saved_model(&state.fields) {
-        nice_warn!("state refused, nothing of it loads: its model: {reason}");
+    let refused = match (saved_model(&state.fields), saved_actuator(&state.fields)) {
+        (Err(reason), _) => Some(format!("its model: {reason}")),
+        (_, Err(reason)) => Some(format!("its actuator: {reason}")),
+        _ => None,
+    };
+    if let Some(reason) = refused {
+        nice_warn!("state refused, nothing of it loads: {reason}");
         state.params.clear();
         state.fields.clear();
         return;
@@ -333,6 +343,7 @@ impl Default for GlugParams {
             state_version: AtomicU8::new(STATE_VERSION),
             osc: OscSettings::default(),
             loaded_model: LoadedModel::default(),
+            actuator: ActuatorSetting::default(),
         }
     }
 }
@@ -398,6 +409,7 @@ unsafe impl Params for GlugParams {
             }
         }
         fields.extend(self.osc.serialize_fields());
+        fields.extend(self.actuator.serialize_fields());
         if let Some((name, text)) = self.loaded_model.saved() {
             for (key, value) in [(MODEL_NAME_KEY, name), (MODEL_KEY, text)] {
                 match persist::serialize_field(&value) {
@@ -419,6 +431,10 @@ unsafe impl Params for GlugParams {
         match saved_model(serialized) {
             Ok(model) => self.loaded_model.set(model),
             Err(reason) => nice_warn!("the saved model is kept out: {reason}"),
+        }
+        match saved_actuator(serialized) {
+            Ok(actuator) => self.actuator.set(actuator),
+            Err(reason) => nice_warn!("the saved actuator is kept out: {reason}"),
         }
         let persisted = MidiSetting::all()
             .map(|setting| setting.key())

@@ -8,7 +8,9 @@ use crate::params::GlugParams;
 use crate::transport::TransportWatch;
 use sake_glug_device::live::{LiveControls, LiveReader};
 use sake_glug_device::midi::{CcDecoder, DeviceAction, MidiInput, MidiMap, Overrides};
-use sake_glug_engine::{Control, ControlValues, Controls, Engine, ModelConfig, PerControl};
+use sake_glug_engine::{
+    ActuatorResponse, Control, ControlValues, Controls, Engine, ModelConfig, PerControl,
+};
 
 /// The longest span rendered at once, so that the editor sees (nearly) every unit start; the
 /// engine's output does not depend on how time is cut.
@@ -27,6 +29,8 @@ pub struct Settings {
     pub config: ModelConfig,
     /// The tilt device's MIDI mapping.
     pub midi: MidiMap,
+    /// The actuator the units are compensated for (MODEL.md §18), if one is chosen.
+    pub actuator: Option<ActuatorResponse>,
 }
 
 impl Settings {
@@ -49,6 +53,7 @@ impl Settings {
             values,
             config,
             midi: params.midi_map(),
+            actuator: None,
         }
     }
 }
@@ -203,6 +208,10 @@ impl RealtimeEngine {
     /// Renders `out.len()` samples under `settings` (constant over the span).
     pub fn process(&mut self, settings: &Settings, out: &mut [f32], feed: &Feed) {
         self.apply_config(settings.config);
+        // Also after a transport reset swapped in the tail, which may hold an older one.
+        if self.engine.actuator() != settings.actuator.as_ref() {
+            self.engine.set_actuator(settings.actuator);
+        }
         let values = self.overrides.apply(settings.values);
         let tilt_deg = values.tilt_deg;
         let controls = Controls::constant(values);

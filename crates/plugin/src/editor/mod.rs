@@ -1,6 +1,7 @@
 //! The egui editor: the main group's controls, the bottle at its tilt with its residual volume,
 //! a scope of the output and the last units' envelopes. One concept per file.
 
+mod actuator;
 mod bottle;
 mod controls;
 mod envelopes;
@@ -115,6 +116,7 @@ impl NiceEguiApp for GlugEditor {
                         .show(ui, |ui| {
                             presets::show(ui, &self.params, &setter, &mut self.preset);
                             model_file::show(ui, &self.params, gui, &mut self.model_field);
+                            actuator::show(ui, &self.params, Some(gui));
                             controls::show(ui, &self.params, &self.feed, &setter);
                             ui.separator();
                             self.midi_edited |= midi_settings::show(ui, &self.params);
@@ -157,6 +159,7 @@ mod tests {
             envelopes::show(ui, feed, egui::vec2(370.0, 200.0));
             midi_settings::show(ui, params);
             osc_settings::show(ui, params, &OscInput::default());
+            actuator::show(ui, params, None);
         });
         // Nothing uploads the font atlas here.
         output.textures_delta.clear();
