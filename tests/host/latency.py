@@ -68,6 +68,14 @@ def model_delay(cli, tilt_deg):
     return first, samples[first : first + COMPARED]
 
 
+def _connected(jack, client, source, destination):
+    try:
+        client.connect(source, destination)
+        return True
+    except jack.JackErrorCode:
+        return False
+
+
 def wait_for(condition, timeout_s, what):
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
@@ -103,8 +111,12 @@ class Rig:
         self.recorder.set_xrun_callback(self._xrun)
         self.tilt.activate()
         self.recorder.activate()
-        self.tilt.connect("tilt:out", "sake_glug:midi_input")
-        self.recorder.connect("sake_glug:output_1", "recorder:in")
+        # The app's ports are visible before it has activated, when connecting them still fails.
+        for client, source, destination in (
+            (self.tilt, "tilt:out", "sake_glug:midi_input"),
+            (self.recorder, "sake_glug:output_1", "recorder:in"),
+        ):
+            wait_for(lambda: _connected(jack, client, source, destination), 60, f"{source} → {destination}")
 
     def _xrun(self, delay):
         self.xruns += 1

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from test_standalone import CLI, start_jack, stop, wait_for
+from test_standalone import CLI, connect_once_active, start_jack, stop, wait_for
 
 NOISE_DBFS = -30.0
 SPEC = f"""
@@ -135,7 +135,7 @@ def test_the_runner_plays_level_matched_stimuli_at_the_logged_frames(jack_server
 
         wait_for(ports_up, 60, "the runner's ports")
         for channel in (1, 2, 3):
-            recorder.connect(f"{CLIENT}:out_{channel}", f"recorder:in_{channel}")
+            connect_once_active(recorder, f"{CLIENT}:out_{channel}", f"recorder:in_{channel}")
         # Answers typed ahead: each is read once its trial has ended.
         out, err = runner.communicate("\n" + "x\n1\n2\n" * 3, timeout=60)
         assert runner.returncode == 0, err

@@ -59,6 +59,22 @@ def wait_for(condition, timeout_s, what):
     raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
 
 
+def connect_once_active(client, source, destination, timeout_s=60):
+    """Connects two ports as soon as JACK lets it: a client's ports are visible as soon as it
+    registers them, but connecting them fails (-1) until it has activated, a window that a busy
+    machine stretches."""
+    import jack
+
+    def connected():
+        try:
+            client.connect(source, destination)
+            return True
+        except jack.JackErrorCode:
+            return False
+
+    wait_for(connected, timeout_s, f"{source} → {destination} to connect")
+
+
 def stop(process, sig=signal.SIGTERM, timeout_s=10):
     """Stops a child we started, however it is doing; returns its exit status."""
     if process.poll() is None:
@@ -197,8 +213,8 @@ class Rig:
             self.chunks.append((self.recorder.last_frame_time, self.audio_in.get_array().copy()))
 
     def connect(self):
-        self.tilt.connect("tilt:out", "sake_glug:midi_input")
-        self.recorder.connect("sake_glug:output_1", "recorder:in")
+        connect_once_active(self.tilt, "tilt:out", "sake_glug:midi_input")
+        connect_once_active(self.recorder, "sake_glug:output_1", "recorder:in")
 
     def send(self, *events):
         """Sends `events` at the start of the next cycle; returns that cycle's frame time."""
