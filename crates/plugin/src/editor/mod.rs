@@ -24,7 +24,7 @@ use crate::osc_input::OscInput;
 use crate::params::GlugParams;
 
 pub const WIDTH: f64 = 800.0;
-pub const HEIGHT: f64 = 726.0;
+pub const HEIGHT: f64 = 750.0;
 
 /// The space between the window's edges and the content.
 const MARGIN: f32 = 8.0;
