@@ -110,6 +110,13 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             build_cli()?;
             paper::paper()
         }
+        // The cost figures alone (callgrind, and the benchmark's report with --bench): seconds,
+        // where the whole of `docs` renders for minutes.
+        Some("docs") if args.get(1).is_some_and(|arg| arg == "scaling") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            build_cli()?;
+            scaling_docs(args.iter().any(|arg| arg == "--bench"))
+        }
         Some("docs") => {
             nice_plug_xtask::chdir_workspace_root()?;
             build_cli()?;
