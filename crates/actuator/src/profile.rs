@@ -80,8 +80,8 @@ pub struct ActuatorProfile {
 impl ActuatorProfile {
     /// A shipped profile's name, or else the path of a profile file.
     pub fn find(name_or_path: &str) -> Result<Self, ProfileError> {
-        if let Some(profile) = shipped::shipped(name_or_path) {
-            return Ok(profile);
+        if let Some(text) = shipped::shipped_text(name_or_path) {
+            return Ok(Self::parse(text).expect("a shipped profile is valid"));
         }
         Self::load(Path::new(name_or_path)).map_err(|error| match error {
             ProfileError::Read(ReadError {
@@ -378,6 +378,23 @@ fn float(value: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_shipped_profile_is_valid_and_named_as_its_file() {
+        for (name, text) in shipped::SHIPPED {
+            let profile =
+                ActuatorProfile::parse(text).unwrap_or_else(|error| panic!("{name}: {error}"));
+            assert_eq!(profile.name(), name);
+        }
+    }
+
+    #[test]
+    fn a_flat_profile_changes_no_gain() {
+        let flat = ActuatorProfile::find("flat").unwrap().response();
+        for frequency_hz in [[80.0, 300.0], [2.0, 90_000.0], [1.0, 1.0]] {
+            assert_eq!(flat.gains(frequency_hz), [1.0, 1.0]);
+        }
+    }
 
     const GOOD: &str = r#"
 name = "test"
