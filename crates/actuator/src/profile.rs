@@ -78,10 +78,16 @@ pub struct ActuatorProfile {
 }
 
 impl ActuatorProfile {
+    /// The shipped profile called `name` (one of `actuators/`), if there is one.
+    pub fn shipped(name: &str) -> Option<Self> {
+        shipped::shipped_text(name)
+            .map(|text| Self::parse(text).expect("a shipped profile is valid"))
+    }
+
     /// A shipped profile's name, or else the path of a profile file.
     pub fn find(name_or_path: &str) -> Result<Self, ProfileError> {
-        if let Some(text) = shipped::shipped_text(name_or_path) {
-            return Ok(Self::parse(text).expect("a shipped profile is valid"));
+        if let Some(profile) = Self::shipped(name_or_path) {
+            return Ok(profile);
         }
         Self::load(Path::new(name_or_path)).map_err(|error| match error {
             ProfileError::Read(ReadError {

@@ -9,7 +9,7 @@ use std::sync::Mutex;
 use crossbeam_queue::ArrayQueue;
 use nice_plug::params::persist;
 
-use sake_glug_actuator::{ActuatorProfile, ActuatorResponse, Equalise, SHIPPED};
+use sake_glug_actuator::{ActuatorProfile, ActuatorResponse, Equalise};
 
 /// The persisted field that holds the actuator: a shipped profile's name, or else a profile's
 /// whole text (a project must load on a machine without the file). Absent without one, so a
@@ -38,8 +38,7 @@ pub struct Actuator {
 impl Actuator {
     /// The shipped profile called `name`, if there is one.
     pub fn shipped(name: &str, felt: bool) -> Option<Self> {
-        let (_, text) = SHIPPED.iter().find(|(shipped, _)| *shipped == name)?;
-        let profile = ActuatorProfile::parse(text).expect("a shipped profile is valid");
+        let profile = ActuatorProfile::shipped(name)?;
         Some(Self {
             profile,
             shipped: true,
