@@ -39,6 +39,25 @@ pub struct TimedRender {
     pub last_onset_by: u64,
 }
 
+impl TimedRender {
+    /// A render that has produced nothing yet, with room for `kept` samples.
+    pub fn nothing_yet(kept: usize) -> Self {
+        Self {
+            kept: Vec::with_capacity(kept),
+            engine_time: Duration::ZERO,
+            peak: 0.0,
+            all_finite: true,
+            energies: Vec::new(),
+            span_times: Vec::new(),
+            max_sounding: 0,
+            limiter_events: 0,
+            non_finite_before_limiter: 0,
+            span_limiter_events: Vec::new(),
+            last_onset_by: 0,
+        }
+    }
+}
+
 /// Options of [`timed_render`] besides the controls.
 pub struct RenderSpec<'a> {
     /// Sample rate (Hz).
@@ -72,19 +91,7 @@ pub fn timed_render_on<S: Synthesis>(
         .iter()
         .map(|w| w.end.min(spec.len) - w.start.min(spec.len))
         .sum();
-    let mut result = TimedRender {
-        kept: Vec::with_capacity(kept_len as usize),
-        engine_time: Duration::ZERO,
-        peak: 0.0,
-        all_finite: true,
-        energies: Vec::new(),
-        span_times: Vec::new(),
-        max_sounding: 0,
-        limiter_events: 0,
-        non_finite_before_limiter: 0,
-        span_limiter_events: Vec::new(),
-        last_onset_by: 0,
-    };
+    let mut result = TimedRender::nothing_yet(kept_len as usize);
     // Counts since the engine's reset; a caller's engine may have rendered before.
     let (limiter_before, non_finite_before) =
         (engine.limiter_events(), engine.non_finite_before_limiter());

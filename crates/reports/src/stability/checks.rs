@@ -290,17 +290,8 @@ mod tests {
     fn run_taking(engine_time: Duration) -> Run {
         Run {
             render: TimedRender {
-                kept: Vec::new(),
                 engine_time,
-                peak: 0.0,
-                all_finite: true,
-                energies: Vec::new(),
-                span_times: Vec::new(),
-                max_sounding: 0,
-                limiter_events: 0,
-                non_finite_before_limiter: 0,
-                span_limiter_events: Vec::new(),
-                last_onset_by: 0,
+                ..TimedRender::nothing_yet(0)
             },
             sample_rate: 48_000.0,
             len: 48_000,
