@@ -1,7 +1,7 @@
 //! The dry run: scripted (#30), bounded, cleaned up after, and open to every user (#31).
 
 use std::path::Path;
-use std::process::Command;
+use std::process::{Command, Output};
 
 use super::{answers, finish, refused, run, SHORT_PAIRED};
 
@@ -26,18 +26,7 @@ fn names(folder: &Path) -> Vec<String> {
 #[test]
 fn a_scripted_dry_run_writes_the_folder_and_exits_0() {
     let dir = study();
-    let output = run(
-        dir.path(),
-        &[
-            "study.toml",
-            "--participant",
-            "p1",
-            "--dry-run",
-            "dry",
-            "--no-answers",
-        ],
-        "",
-    );
+    let output = scripted_dry_run(dir.path());
     assert!(
         output.status.success(),
         "{}",
@@ -67,18 +56,7 @@ fn a_session_past_the_trial_limit_is_refused_up_front() {
     let dir = tempfile::tempdir().unwrap();
     let spec = SHORT_PAIRED.replace("repetitions = 2", "repetitions = 1000000");
     std::fs::write(dir.path().join("study.toml"), spec).unwrap();
-    let output = run(
-        dir.path(),
-        &[
-            "study.toml",
-            "--participant",
-            "p1",
-            "--dry-run",
-            "dry",
-            "--no-answers",
-        ],
-        "",
-    );
+    let output = scripted_dry_run(dir.path());
     refused(
         &output,
         &[
@@ -140,18 +118,7 @@ fn a_killed_dry_runs_temporary_folder_is_removed_by_the_next() {
         std::fs::create_dir(folder).unwrap();
         std::fs::write(folder.join("trial-001-1-model.wav"), "RIFF").unwrap();
     }
-    let output = run(
-        dir.path(),
-        &[
-            "study.toml",
-            "--participant",
-            "p1",
-            "--dry-run",
-            "dry",
-            "--no-answers",
-        ],
-        "",
-    );
+    let output = scripted_dry_run(dir.path());
     assert!(
         output.status.success(),
         "{}",
@@ -224,4 +191,21 @@ fn a_dry_run_works_for_a_user_who_is_not_root() {
         "{:o}",
         meta.permissions().mode()
     );
+}
+
+/// `experiment study.toml --participant p1 --dry-run dry --no-answers` in `dir`: a scripted dry
+/// run into `dir/dry`.
+fn scripted_dry_run(dir: &Path) -> Output {
+    run(
+        dir,
+        &[
+            "study.toml",
+            "--participant",
+            "p1",
+            "--dry-run",
+            "dry",
+            "--no-answers",
+        ],
+        "",
+    )
 }
