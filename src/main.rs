@@ -5,6 +5,7 @@ mod accuracy;
 mod analyze;
 mod experiment;
 mod fit;
+mod measure_actuator;
 mod parameters;
 mod presets;
 mod render;
@@ -46,6 +47,9 @@ enum Command {
     Analyze(analyze::AnalyzeArgs),
     /// Runs a listening study's session (paired or constant stimuli) for one participant.
     Experiment(experiment::ExperimentArgs),
+    /// Measures an actuator's response on a JACK server (stepped sines out, its accelerometer
+    /// in) and writes its profile: see MODEL.md §18.1.
+    MeasureActuator(measure_actuator::MeasureActuatorArgs),
 }
 
 /// A `--sample-rate` as a scene's `sample_rate` is checked (in range, whole), refused by the
@@ -71,5 +75,6 @@ fn main() -> ExitCode {
         Command::Fit(args) => fit::run(args),
         Command::Analyze(args) => analyze::run(args),
         Command::Experiment(args) => experiment::run(args),
+        Command::MeasureActuator(args) => measure_actuator::run(args),
     }
 }

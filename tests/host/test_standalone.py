@@ -87,15 +87,16 @@ def stop(process, sig=signal.SIGTERM, timeout_s=10):
     return process.returncode
 
 
-def start_jack(name):
-    """Starts a JACK server called `name` on the dummy driver; returns (process, its log)."""
+def start_jack(name, period=PERIOD):
+    """Starts a JACK server called `name` on the dummy driver, `period` frames a cycle; returns
+    (process, its log)."""
     import jack
 
     log = tempfile.TemporaryFile()
     server = subprocess.Popen(
         # Not --sync: a client leaving mid-cycle can stall a synchronous server. A cycle that
         # a busy machine misses spoils a measurement, which is then taken again.
-        ["jackd", "--no-realtime", "-n", name, "-d", "dummy", "-r", str(RATE), "-p", str(PERIOD)],
+        ["jackd", "--no-realtime", "-n", name, "-d", "dummy", "-r", str(RATE), "-p", str(period)],
         stdout=log,
         stderr=subprocess.STDOUT,
         stdin=subprocess.DEVNULL,

@@ -1,0 +1,129 @@
+"""`sake-glug measure-actuator` on a real JACK server (dummy driver).
+
+A test client stands in for the device and its accelerometer: it filters what the command plays
+into what it records with a known response (SciPy's second-order Butterworth high-pass at 90 Hz
+and first-order low-pass at 600 Hz, at half gain). The profile the command writes gives that
+response within 0.5 dB at every point, relative to its strongest point as the profile's levels
+are; with `--repeat 2` it gives each point's spread; the renderer takes it as `--actuator`. A
+port the server does not have is refused by name, and no file is written.
+
+The server runs with long cycles (2048 frames), so the Python client keeps up on a busy machine;
+a cycle it still misses is an xrun, which the command answers by playing that step again.
+
+Needs the release `sake-glug` built with audio (`cargo xtask test` builds it), `jackd` (Debian's
+jackd2) and the JACK-Client and SciPy packages (tests/host/requirements.txt).
+"""
+
+import os
+import shutil
+import signal
+import subprocess
+import tomllib
+
+import numpy as np
+import pytest
+
+from test_standalone import CLI, RATE, start_jack, stop
+
+FILTER = "device-under-test"
+GAIN = 0.5
+
+
+def device_response():
+    """The test device's filter, as second-order sections."""
+    from scipy.signal import butter
+
+    return np.vstack([
+        butter(2, 90.0, "highpass", fs=RATE, output="sos"),
+        butter(1, 600.0, "lowpass", fs=RATE, output="sos"),
+    ])
+
+
+@pytest.fixture(scope="module")
+def jack_server():
+    if shutil.which("jackd") is None:
+        if os.environ.get("CI"):
+            pytest.fail("jackd is not installed (Debian: jackd2); .ci/run installs it")
+        pytest.skip("jackd is not installed (Debian: jackd2)")
+    assert CLI.exists(), f"{CLI} is missing: build it with --features audio"
+    # A name of our own: other host tests may run a server at the same time.
+    name = f"sakeglug-measure-{os.getpid()}"
+    server, log = start_jack(name, period=2048)
+    try:
+        yield name
+    finally:
+        stop(server, signal.SIGTERM)
+        log.close()
+
+
+@pytest.fixture
+def device(jack_server):
+    """The filter between `device-under-test:drive_in` and `device-under-test:accel_out`."""
+    import jack
+    from scipy.signal import sosfilt
+
+    sos = device_response()
+    client = jack.Client(FILTER, servername=jack_server, no_start_server=True)
+    drive = client.inports.register("drive_in")
+    accelerometer = client.outports.register("accel_out")
+    state = [np.zeros((sos.shape[0], 2))]
+
+    def process(frames):
+        filtered, state[0] = sosfilt(sos, drive.get_array(), zi=state[0])
+        accelerometer.get_array()[:] = GAIN * filtered
+
+    client.set_process_callback(process)
+    client.activate()
+    try:
+        yield sos
+    finally:
+        client.deactivate()
+        client.close()
+
+
+def measure(jack_server, tmp_path, *options):
+    env = dict(os.environ, JACK_DEFAULT_SERVER=jack_server, JACK_NO_START_SERVER="1")
+    return subprocess.run(
+        [CLI, "measure-actuator", "-o", "device.toml", "--client-name", "measure-under-test",
+         "--play-to", f"{FILTER}:drive_in", "--record-from", f"{FILTER}:accel_out", *options],
+        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300,
+    )
+
+
+def test_the_measured_profile_is_the_device_response_within_half_a_db(
+    jack_server, device, tmp_path
+):
+    from scipy.signal import sosfreqz
+
+    done = measure(jack_server, tmp_path, "--from", "40", "--to", "1000", "--per-octave", "2",
+                   "--settle", "0.2", "--measure", "0.3", "--repeat", "2")
+    assert done.returncode == 0, done.stderr
+    profile = tomllib.loads((tmp_path / "device.toml").read_text())
+    hz = np.array([point[0] for point in profile["response"]])
+    db = np.array([point[1] for point in profile["response"]])
+    assert hz[0] == pytest.approx(40.0) and hz[-1] == pytest.approx(1000.0)
+    assert len(hz) == 11, hz
+    _, response = sosfreqz(device, worN=hz, fs=RATE)
+    expected = 20 * np.log10(GAIN * np.abs(response))
+    expected -= expected.max()
+    error = db - expected
+    assert np.abs(error).max() < 0.5, dict(zip(hz.round(1), error.round(3)))
+    # The same filter twice: the repeats agree.
+    spread = np.array(profile["spread_db"])
+    assert len(spread) == len(hz) and spread.max() < 0.5, spread
+    assert profile["band_hz"] == [hz[0], hz[-1]]
+    assert profile["sample_rate_hz"] == RATE
+    assert profile["name"] == "device"
+    # The renderer takes it.
+    render = subprocess.run([CLI, "render", "--actuator", "device.toml",
+                             "-o", "pour.wav"], cwd=tmp_path, capture_output=True, text=True)
+    assert render.returncode == 0, render.stderr
+
+
+def test_a_port_the_server_lacks_is_refused_by_name_and_nothing_is_written(
+    jack_server, tmp_path
+):
+    done = measure(jack_server, tmp_path, "--from", "40", "--to", "1000")
+    assert done.returncode == 1
+    assert f"no port named {FILTER}:drive_in" in done.stderr, done.stderr
+    assert not (tmp_path / "device.toml").exists()
