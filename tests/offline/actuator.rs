@@ -466,3 +466,41 @@ fn the_fidelity_report_gives_the_c_the_device_delivers() {
     // A platform that plays c itself says so.
     assert!(report.contains("as carried"), "{report}");
 }
+
+/// `sake-glug measure-actuator` refuses a plan or a profile it could not write before anything
+/// plays, with the option or the key named (exit status 2), and a server it cannot reach with
+/// status 1; none of them writes a file. (Measuring itself is tested on JACK: tests/host.)
+#[test]
+fn measure_actuator_refuses_what_it_cannot_measure_before_playing() {
+    let directory = tempfile::tempdir().unwrap();
+    for (options, named) in [
+        (&["--per-octave", "0"][..], "--per-octave"),
+        (&["--from", "20", "--measure", "0.2"], "--measure"),
+        (&["--level", "3"], "--level"),
+        (&["--to", "10"], "--from/--to"),
+        (&["--max-amplitude", "2"], "`max_amplitude`"),
+        (&["--name", " "], "`name`"),
+    ] {
+        let mut args = vec!["measure-actuator", "-o", "device.toml"];
+        args.extend_from_slice(options);
+        let output = sake_glug(directory.path(), &args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{options:?}: {stderr}");
+        assert!(stderr.contains(named), "{options:?}: {stderr}");
+        assert!(!directory.path().join("device.toml").exists());
+    }
+    // No server of that name, and none started: refused after the plan, before the file.
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_sake-glug"))
+        .current_dir(directory.path())
+        .args(["measure-actuator", "-o", "device.toml"])
+        .env("JACK_DEFAULT_SERVER", "sakeglug-no-such-server")
+        .env("JACK_NO_START_SERVER", "1")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("cannot reach a JACK server"), "{stderr}");
+    // Not even the temporary file beside it is left.
+    let left: Vec<_> = std::fs::read_dir(directory.path()).unwrap().collect();
+    assert!(left.is_empty(), "{left:?}");
+}
