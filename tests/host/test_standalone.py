@@ -345,29 +345,32 @@ def quits_cleanly(process, log, server, *signals):
         print("(the app ended through its watch: the JACK backend did not stop in time)")
 
 
-def model_first_glug_s(tilt_deg):
-    """When the model makes the first glug of a full bottle tilted at t = 0: the offline
-    renderer's first non-zero sample, with the plugin's defaults (seed 1, −6 dB)."""
+def model_first_glug_s(tilt_deg, *render_options):
+    """When the model makes the first glug of a full bottle tilted at t = 0, and its samples: the
+    offline renderer's first non-zero sample, with the plugin's defaults (seed 1, −6 dB), and
+    `render_options` (an actuator)."""
     with tempfile.TemporaryDirectory() as directory:
         scene = Path(directory) / "tilt.toml"
         scene.write_text(f"sample_rate = {RATE}\nduration_s = 1.0\ntilt_deg = {tilt_deg!r}\n")
         samples_csv = Path(directory) / "tilt.csv"
-        subprocess.run([str(CLI), "render", str(scene), "-o", str(samples_csv)], check=True)
+        subprocess.run([str(CLI), "render", str(scene), "-o", str(samples_csv), *render_options],
+                       check=True)
         samples = np.loadtxt(samples_csv, dtype=np.float32)
     first = int(np.flatnonzero(samples)[0])
     return first, samples
 
 
-def test_tilt_glugs_as_the_model_says_and_upright_is_silent(jack_server, app):
-    expected, offline = model_first_glug_s(TILT_DEG)
-    model_s = expected / RATE
+def pour_live(jack_server, app, *app_options):
+    """Starts the app with `app_options`, checks that it is silent upright, tilts it to
+    TILT_DEG by MIDI and records a second; returns (the app and its log, the CC's frame, the
+    recording's first frame, the recording)."""
     rig = Rig(jack_server)
     try:
         # Freewheeling, no cycle can be missed however busy the machine is. Should one still be
         # (a server that cannot freewheel), the measurement is taken again with a fresh app: a
         # refill would keep the random draws going, so the glugs would differ.
         for attempt in range(3):
-            process, log = app()
+            process, log = app(*app_options)
             rig.connect()
             # A client cannot join a freewheeling server: the app first, then freewheel.
             rig.freewheel(True)
@@ -381,39 +384,77 @@ def test_tilt_glugs_as_the_model_says_and_upright_is_silent(jack_server, app):
                 cc_frame = rig.send(*tilt_ccs(TILT_VALUE))
                 start, poured = rig.record(1.0, keep=True)
                 if poured is not None:
-                    break
+                    return (process, log), cc_frame, start, poured
             print(f"attempt {attempt + 1}: the recording missed a cycle; again")
             rig.freewheel(False)
             stop(process, signal.SIGKILL)
             wait_for(lambda: client_gone(jack_server), 5, "the killed app's JACK client to go")
-        else:
-            pytest.fail("every attempt missed JACK cycles")
-        assert start <= cc_frame, "the recording began before the CC's cycle"
-        offset = cc_frame - start
-        assert np.all(poured[:offset] == 0.0)
-        nonzero = np.flatnonzero(poured)
-        assert nonzero.size, "no glug within a second of tilting to 135°"
-        first_glug_frame = start + int(nonzero[0])
-        latency_s = (first_glug_frame - cc_frame) / RATE
-        added_s = latency_s - model_s
-        print(
-            f"\nCC → first glug sample: {latency_s * 1000:.2f} ms "
-            f"({first_glug_frame - cc_frame} frames at {RATE} Hz); the model's own time to the "
-            f"first glug (5 ml of outflow at {TILT_DEG:.2f}°): {model_s * 1000:.2f} ms; added by "
-            f"the app: {added_s * 1000:.2f} ms ({first_glug_frame - cc_frame - expected} frames); "
-            f"JACK period {PERIOD} frames = {PERIOD / RATE * 1000:.2f} ms"
-        )
-        assert 0.0 <= added_s <= MAX_ADDED_LATENCY_S
-        # The same glugs as the offline renderer, from the CC's sample on.
-        live = poured[offset : offset + len(offline)]
-        n = min(len(live), len(offline))
-        error = np.abs(live[:n] - offline[:n]).max() / np.abs(offline[:n]).max()
-        print(f"largest difference from the offline render: {20 * np.log10(error + 1e-30):.1f} dB")
-        assert error < 1e-3
+        pytest.fail("every attempt missed JACK cycles")
     finally:
         rig.freewheel(False)
         rig.close()
+
+
+def difference_from(live, offline):
+    """The largest difference between two renders, relative to the offline one's peak."""
+    n = min(len(live), len(offline))
+    return np.abs(live[:n] - offline[:n]).max() / np.abs(offline[:n]).max()
+
+
+def test_tilt_glugs_as_the_model_says_and_upright_is_silent(jack_server, app):
+    expected, offline = model_first_glug_s(TILT_DEG)
+    model_s = expected / RATE
+    (process, log), cc_frame, start, poured = pour_live(jack_server, app)
+    assert start <= cc_frame, "the recording began before the CC's cycle"
+    offset = cc_frame - start
+    assert np.all(poured[:offset] == 0.0)
+    nonzero = np.flatnonzero(poured)
+    assert nonzero.size, "no glug within a second of tilting to 135°"
+    first_glug_frame = start + int(nonzero[0])
+    latency_s = (first_glug_frame - cc_frame) / RATE
+    added_s = latency_s - model_s
+    print(
+        f"\nCC → first glug sample: {latency_s * 1000:.2f} ms "
+        f"({first_glug_frame - cc_frame} frames at {RATE} Hz); the model's own time to the "
+        f"first glug (5 ml of outflow at {TILT_DEG:.2f}°): {model_s * 1000:.2f} ms; added by "
+        f"the app: {added_s * 1000:.2f} ms ({first_glug_frame - cc_frame - expected} frames); "
+        f"JACK period {PERIOD} frames = {PERIOD / RATE * 1000:.2f} ms"
+    )
+    assert 0.0 <= added_s <= MAX_ADDED_LATENCY_S
+    # The same glugs as the offline renderer, from the CC's sample on.
+    error = difference_from(poured[offset:], offline)
+    print(f"largest difference from the offline render: {20 * np.log10(error + 1e-30):.1f} dB")
+    assert error < 1e-3
     quits_cleanly(process, log, jack_server, signal.SIGINT)
+
+
+def test_the_app_compensates_for_its_actuator_as_the_renderer_does(jack_server, app, tmp_path):
+    """`--actuator` and `--felt` on the app's command line: the glugs of `sake-glug render
+    --actuator … --felt`, not the model's drive. A profile file of one's own, as
+    `measure-actuator` writes it, is taken by path."""
+    profile = tmp_path / "shaker.toml"
+    profile.write_text(
+        'name = "shaker"\nresponse = [[20.0, -24.0], [1000.0, 0.0]]\nband_hz = [20.0, 1000.0]\n'
+        "max_amplitude = 1.0\nsample_rate_hz = 48000\n"
+    )
+    _, plain = model_first_glug_s(TILT_DEG)
+    for options in (["--actuator", "haptuator-mark2", "--felt"], ["--actuator", str(profile)]):
+        _, offline = model_first_glug_s(TILT_DEG, *options)
+        (process, log), cc_frame, start, poured = pour_live(jack_server, app, *options)
+        live = poured[cc_frame - start :]
+        assert difference_from(live, offline) < 1e-3, options
+        # Not the model's drive: the compensation shows.
+        assert difference_from(live, plain) > 0.05, options
+        quits_cleanly(process, log, jack_server, signal.SIGINT)
+
+
+def test_an_actuator_the_app_cannot_read_ends_it_at_once():
+    done = subprocess.run(
+        [str(APP), "--no-editor", "--backend", "dummy", "--actuator", "no-such-profile"],
+        capture_output=True, text=True, timeout=30,
+    )
+    assert done.returncode == 2
+    assert "--actuator: no actuator profile no-such-profile" in done.stderr, done.stderr
 
 
 def osc_message(address, *floats):

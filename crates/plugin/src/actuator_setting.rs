@@ -9,7 +9,7 @@ use std::sync::Mutex;
 use crossbeam_queue::ArrayQueue;
 use nice_plug::params::persist;
 
-use sake_glug_actuator::{ActuatorProfile, ActuatorResponse, Equalise};
+use sake_glug_actuator::{ActuatorProfile, ActuatorResponse, Equalise, ProfileError};
 
 /// The persisted field that holds the actuator: a shipped profile's name, or else a profile's
 /// whole text (a project must load on a machine without the file). Absent without one, so a
@@ -42,6 +42,19 @@ impl Actuator {
         Some(Self {
             profile,
             shipped: true,
+            felt,
+        })
+    }
+
+    /// A shipped profile's name, or else a profile file's path (the app's `--actuator`, the
+    /// editor's "Load profile…"), as `sake-glug render --actuator` finds it.
+    pub fn find(name_or_path: &str, felt: bool) -> Result<Self, ProfileError> {
+        if let Some(actuator) = Self::shipped(name_or_path, felt) {
+            return Ok(actuator);
+        }
+        Ok(Self {
+            profile: ActuatorProfile::find(name_or_path)?,
+            shipped: false,
             felt,
         })
     }
@@ -162,4 +175,28 @@ pub fn saved_actuator(fields: &BTreeMap<String, String>) -> Result<Option<Actuat
         shipped: false,
         felt,
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shipped_name_is_kept_by_name_and_a_file_by_its_text() {
+        let shipped = Actuator::find("lra", true).unwrap();
+        assert!(shipped.shipped && shipped.felt);
+        assert_eq!(shipped.saved(), "lra");
+
+        let directory = tempfile::tempdir().unwrap();
+        let path = directory.path().join("shaker.toml");
+        let text = "name = \"shaker\"\nresponse = [[20.0, -24.0], [1000.0, 0.0]]\n\
+                    band_hz = [20.0, 1000.0]\nmax_amplitude = 1.0\nsample_rate_hz = 48000\n";
+        std::fs::write(&path, text).unwrap();
+        let own = Actuator::find(path.to_str().unwrap(), false).unwrap();
+        assert!(!own.shipped && !own.felt);
+        assert_eq!(own.saved(), text);
+
+        let error = Actuator::find("no-such-profile", false).unwrap_err();
+        assert!(matches!(error, ProfileError::Unknown(_)), "{error}");
+    }
 }

@@ -67,6 +67,9 @@ impl<const RAW_MIDI: bool> Default for SakeGlugPlugin<RAW_MIDI> {
         if let Some(model) = standalone::options().and_then(|options| options.model.as_ref()) {
             layering::load_unshared(model, &params);
         }
+        if let Some(actuator) = standalone::options().and_then(|options| options.actuator.clone()) {
+            params.actuator.set(Some(actuator));
+        }
         Self {
             params: Arc::new(params),
             feed: Arc::new(Feed::default()),

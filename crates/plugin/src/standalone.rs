@@ -21,6 +21,8 @@ pub struct StandaloneOptions {
     pub osc_interface: IpAddr,
     /// The model file to start with (`--model`), loaded as the editor's "Load model…" loads it.
     pub model: Option<sake_glug_model_file::ModelFile>,
+    /// The actuator to compensate for (`--actuator`, `--felt`), as the editor's menu sets it.
+    pub actuator: Option<crate::actuator_setting::Actuator>,
 }
 
 static OPTIONS: OnceLock<StandaloneOptions> = OnceLock::new();

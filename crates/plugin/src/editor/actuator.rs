@@ -1,8 +1,10 @@
 //! "Actuator": the device the output drives (MODEL.md §18), one of the shipped profiles or none,
-//! and the felt flag. A profile of one's own comes with a saved state and is shown by name.
+//! and the felt flag; or a profile of one's own (`sake-glug measure-actuator` writes one), its
+//! path typed and loaded with "Load profile…", or come with a saved state, shown by name.
 
 use nice_plug::context::gui::GuiContext;
 
+use super::PathField;
 use crate::actuator_setting::Actuator;
 use crate::params::GlugParams;
 use sake_glug_actuator::shipped_names;
@@ -10,9 +12,14 @@ use sake_glug_actuator::shipped_names;
 /// What the menu shows without an actuator.
 const NONE: &str = "none";
 
-/// Shows the menu of the shipped profiles and "none", and the felt flag; a change is saved in
-/// the state and told to the host.
-pub fn show(ui: &mut egui::Ui, params: &GlugParams, gui: Option<&GuiContext>) {
+/// Shows the menu of the shipped profiles and "none", the felt flag, and the path field of a
+/// profile of one's own; a change is saved in the state and told to the host.
+pub fn show(
+    ui: &mut egui::Ui,
+    params: &GlugParams,
+    gui: Option<&GuiContext>,
+    field: &mut PathField,
+) {
     let chosen = params.actuator.get();
     let shown = match &chosen {
         None => NONE.to_owned(),
@@ -48,6 +55,25 @@ pub fn show(ui: &mut egui::Ui, params: &GlugParams, gui: Option<&GuiContext>) {
             }));
         }
     });
+    ui.horizontal(|ui| {
+        ui.add(
+            egui::TextEdit::singleline(&mut field.path)
+                .hint_text("/path/to/profile.toml")
+                .desired_width(170.0),
+        );
+        if ui.button("Load profile…").clicked() {
+            match Actuator::find(field.path.trim(), felt) {
+                Ok(actuator) => {
+                    field.refused = None;
+                    changed = Some(Some(actuator));
+                }
+                Err(error) => field.refused = Some(error.to_string()),
+            }
+        }
+    });
+    if let Some(reason) = &field.refused {
+        ui.colored_label(ui.visuals().error_fg_color, reason);
+    }
     if let Some(actuator) = changed {
         params.actuator.set(actuator);
         if let Some(gui) = gui {

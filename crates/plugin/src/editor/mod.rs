@@ -47,7 +47,19 @@ pub struct GlugEditor {
     /// let go, not at every step of a drag).
     midi_edited: bool,
     /// The model file's path field and the last refusal.
-    model_field: model_file::ModelField,
+    model_field: PathField,
+    /// The actuator profile's path field and the last refusal.
+    actuator_field: PathField,
+}
+
+/// A file's path, typed or pasted (a file dialog would need GTK's development files or a
+/// desktop portal's D-Bus stack: see the README), and why its last load was refused.
+#[derive(Debug, Default)]
+pub struct PathField {
+    /// The path as typed.
+    pub path: String,
+    /// Why the last load was refused, until the next load or clear.
+    pub refused: Option<String>,
 }
 
 pub fn create(
@@ -69,7 +81,8 @@ pub fn create(
         gui: None,
         preset: 0,
         midi_edited: false,
-        model_field: model_file::ModelField::default(),
+        model_field: PathField::default(),
+        actuator_field: PathField::default(),
     };
     create_egui_editor(
         EguiEditorState::from_size(LogicalSize::new(WIDTH, HEIGHT), 1.0),
@@ -116,7 +129,7 @@ impl NiceEguiApp for GlugEditor {
                         .show(ui, |ui| {
                             presets::show(ui, &self.params, &setter, &mut self.preset);
                             model_file::show(ui, &self.params, gui, &mut self.model_field);
-                            actuator::show(ui, &self.params, Some(gui));
+                            actuator::show(ui, &self.params, Some(gui), &mut self.actuator_field);
                             controls::show(ui, &self.params, &self.feed, &setter);
                             ui.separator();
                             self.midi_edited |= midi_settings::show(ui, &self.params);
@@ -159,7 +172,7 @@ mod tests {
             envelopes::show(ui, feed, egui::vec2(370.0, 200.0));
             midi_settings::show(ui, params);
             osc_settings::show(ui, params, &OscInput::default());
-            actuator::show(ui, params, None);
+            actuator::show(ui, params, None, &mut PathField::default());
         });
         // Nothing uploads the font atlas here.
         output.textures_delta.clear();

@@ -8,21 +8,13 @@ use std::path::Path;
 use nice_plug::context::gui::GuiContext;
 use nice_plug::prelude::*;
 
+use super::PathField;
 use crate::layering::model_values;
 use crate::params::GlugParams;
 use sake_glug_model_file::ModelFile;
 
-/// What the section remembers between frames.
-#[derive(Debug, Default)]
-pub struct ModelField {
-    /// The path as typed.
-    pub path: String,
-    /// Why the last load was refused, until the next load or clear.
-    pub refused: Option<String>,
-}
-
 /// Shows the loaded model's name, the path field and the Load and Clear buttons.
-pub fn show(ui: &mut egui::Ui, params: &GlugParams, gui: &GuiContext, field: &mut ModelField) {
+pub fn show(ui: &mut egui::Ui, params: &GlugParams, gui: &GuiContext, field: &mut PathField) {
     ui.label(egui::RichText::new("Model file").strong());
     let loaded = params.loaded_model.name();
     ui.label(match &loaded {

@@ -31,15 +31,24 @@ pub struct AppArgs {
     /// editor's "Load model…" loads it.
     #[arg(long, value_name = "MODEL.toml")]
     pub model: Option<PathBuf>,
+    /// An actuator to compensate for (MODEL.md §18): a shipped profile's name or a profile
+    /// file's path, as the editor's Actuator menu or "Load profile…" sets it.
+    #[arg(long, value_name = "NAME|PROFILE.toml")]
+    pub actuator: Option<String>,
+    /// With --actuator: equalises the level over the skin's threshold (the editor's "felt").
+    #[arg(long, requires = "actuator")]
+    pub felt: bool,
 }
 
 /// Our options and whether each takes a value.
-const OWN: [(&str, bool); 5] = [
+const OWN: [(&str, bool); 7] = [
     ("--osc-port", true),
     ("--osc-bind", true),
     ("--osc-axis", true),
     ("--no-editor", false),
     ("--model", true),
+    ("--actuator", true),
+    ("--felt", false),
 ];
 
 /// Splits the command line into our options (as `--name=value`, after the program name) and
@@ -140,6 +149,29 @@ mod tests {
         let (own, _) = split(strings(&["app", "--model"]));
         let error = parse(&own).unwrap_err().to_string();
         assert!(error.contains("--model"), "{error}");
+    }
+
+    #[test]
+    fn the_actuator_and_felt_are_taken_out() {
+        let (own, rest) = split(strings(&[
+            "app",
+            "--actuator",
+            "my shaker.toml",
+            "--felt",
+            "--backend",
+            "jack",
+        ]));
+        assert_eq!(
+            own,
+            strings(&["app", "--actuator=my shaker.toml", "--felt"])
+        );
+        assert_eq!(rest, strings(&["app", "--backend", "jack"]));
+        let parsed = parse(&own).unwrap();
+        assert_eq!(parsed.actuator.as_deref(), Some("my shaker.toml"));
+        assert!(parsed.felt);
+        // --felt alone means nothing.
+        let error = parse(&strings(&["app", "--felt"])).unwrap_err().to_string();
+        assert!(error.contains("--actuator"), "{error}");
     }
 
     #[test]

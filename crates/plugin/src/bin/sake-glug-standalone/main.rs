@@ -11,7 +11,9 @@
 //! - `--osc-axis AXIS`: the sensor axis from the bottle's base to its mouth (`+y` by default);
 //! - `--no-editor`: no window (no display needed); quit with Ctrl-C, SIGTERM or SIGHUP;
 //! - `--model MODEL.toml`: play a model file's bottle and liquid (MODEL.md §12.1); a model that
-//!   is refused ends the app at once (status 2) with the reason.
+//!   is refused ends the app at once (status 2) with the reason;
+//! - `--actuator NAME|PROFILE.toml [--felt]`: compensate for an actuator (MODEL.md §18), as the
+//!   editor's Actuator menu does; a profile that is refused ends the app at once (status 2).
 //!
 //! If the audio stops coming (the JACK server or the audio device went away) the app says so and
 //! exits with status 1.
@@ -26,6 +28,7 @@ use std::time::Duration;
 use nice_plug::prelude::nice_export_standalone_with_args;
 use sake_glug_model_file::ModelFile;
 use sake_glug_plugin::standalone::{self, StandaloneOptions};
+use sake_glug_plugin::Actuator;
 use sake_glug_plugin::SakeGlug;
 
 /// How long the wrapper gets to stop after a quit signal before the process ends anyway (it
@@ -54,11 +57,22 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let actuator = match options.actuator.as_deref() {
+        None => None,
+        Some(name_or_path) => match Actuator::find(name_or_path, options.felt) {
+            Ok(actuator) => Some(actuator),
+            Err(error) => {
+                eprintln!("error: --actuator: {error}");
+                return ExitCode::from(2);
+            }
+        },
+    };
     standalone::configure(StandaloneOptions {
         editor: !options.no_editor,
         osc: options.osc_port.map(|port| (port, options.osc_axis)),
         osc_interface: options.osc_bind,
         model,
+        actuator,
     });
     #[cfg(unix)]
     watch::spawn_watch(QUIT_GRACE, AUDIO_LOST_AFTER);
