@@ -10,7 +10,7 @@ use std::sync::Arc;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use sake_glug_actuator::{shipped_names, ActuatorProfile, Equalise};
+use sake_glug_actuator::{shipped_names, ActuatorProfile};
 use sake_glug_engine::Preset;
 use sake_glug_io::text::{printable, quoted};
 use sake_glug_model_file::ModelFile;
@@ -168,8 +168,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
         .map(ActuatorProfile::find)
         .transpose()
     {
-        Ok(actuator) if args.felt => actuator.map(|profile| profile.equalising(Equalise::Felt)),
-        Ok(actuator) => actuator,
+        Ok(actuator) => actuator.map(|profile| profile.felt_if(args.felt)),
         Err(error) => {
             eprintln!("error: --actuator: {error}");
             return ExitCode::from(2);

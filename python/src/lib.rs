@@ -18,7 +18,7 @@ use pyo3::exceptions::{PyTypeError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyInt, PyString};
 
-use sake_glug_actuator::{ActuatorProfile, Equalise};
+use sake_glug_actuator::ActuatorProfile;
 use sake_glug_analysis::{
     analyze_constant_logs, analyze_paired_logs, constant_json, paired_json, PsychometricOptions,
     MAX_RESAMPLES,
@@ -159,11 +159,7 @@ fn actuator_profile(
         }
     };
     let profile = found.map_err(|error| SakeGlugError::new_err(format!("actuator: {error}")))?;
-    Ok(Some(if felt {
-        profile.equalising(Equalise::Felt)
-    } else {
-        profile
-    }))
+    Ok(Some(profile.felt_if(felt)))
 }
 
 /// A scene and a preset given together (`sake-glug render` refuses `--preset` with a scene).

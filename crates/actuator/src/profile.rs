@@ -229,6 +229,16 @@ impl ActuatorProfile {
         }
     }
 
+    /// With `felt` (the command line's `--felt`, the editor's "felt"), the same profile
+    /// equalising over the skin's threshold; without, equalising as the file says.
+    pub fn felt_if(self, felt: bool) -> Self {
+        if felt {
+            self.equalising(Equalise::Felt)
+        } else {
+            self
+        }
+    }
+
     /// The `[Hz, dB]` points as written.
     pub fn points(&self) -> &[(f64, f64)] {
         &self.points

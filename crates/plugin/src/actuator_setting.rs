@@ -9,7 +9,7 @@ use std::sync::Mutex;
 use crossbeam_queue::ArrayQueue;
 use nice_plug::params::persist;
 
-use sake_glug_actuator::{ActuatorProfile, ActuatorResponse, Equalise, ProfileError};
+use sake_glug_actuator::{ActuatorProfile, ActuatorResponse, ProfileError};
 
 /// The persisted field that holds the actuator: a shipped profile's name, or else a profile's
 /// whole text (a project must load on a machine without the file). Absent without one, so a
@@ -62,12 +62,7 @@ impl Actuator {
     /// The response the engine compensates for: as `sake-glug render --actuator` reads the
     /// profile, and with the felt flag as `--felt` equalises it.
     pub fn response(&self) -> ActuatorResponse {
-        let response = self.profile.response();
-        if self.felt {
-            response.equalising(Equalise::Felt)
-        } else {
-            response
-        }
+        self.profile.clone().felt_if(self.felt).response()
     }
 
     /// What the state keeps of it: the name of a shipped profile, the text of any other.
