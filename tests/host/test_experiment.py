@@ -16,8 +16,6 @@ Needs the release `sake-glug` built with audio (`cargo build --release --bin sak
 
 import csv
 import os
-import shutil
-import signal
 import subprocess
 import time
 from pathlib import Path
@@ -25,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from test_standalone import CLI, connect_once_active, start_jack, stop, wait_for
+from test_standalone import CLI, connect_once_active, own_jack_server, stop, wait_for
 
 NOISE_DBFS = -30.0
 SPEC = f"""
@@ -91,19 +89,7 @@ def dry_run(tmp_path):
 
 @pytest.fixture(scope="module")
 def jack_server():
-    if shutil.which("jackd") is None:
-        if os.environ.get("CI"):
-            pytest.fail("jackd is not installed (Debian: jackd2); .ci/run installs it")
-        pytest.skip("jackd is not installed (Debian: jackd2)")
-    assert CLI.exists(), f"{CLI} is missing: build it with --features cli,audio"
-    # A name of our own: other host tests may run a server at the same time.
-    name = f"sakeglug-experiment-{os.getpid()}"
-    server, log = start_jack(name)
-    try:
-        yield name
-    finally:
-        stop(server, signal.SIGTERM)
-        log.close()
+    yield from own_jack_server("sakeglug-experiment", (CLI, "--features cli,audio"))
 
 
 def test_the_runner_plays_level_matched_stimuli_at_the_logged_frames(jack_server, tmp_path):

@@ -15,15 +15,13 @@ jackd2) and the JACK-Client and SciPy packages (tests/host/requirements.txt).
 """
 
 import os
-import shutil
-import signal
 import subprocess
 import tomllib
 
 import numpy as np
 import pytest
 
-from test_standalone import CLI, RATE, start_jack, stop
+from test_standalone import CLI, RATE, own_jack_server
 
 FILTER = "device-under-test"
 GAIN = 0.5
@@ -41,19 +39,8 @@ def device_response():
 
 @pytest.fixture(scope="module")
 def jack_server():
-    if shutil.which("jackd") is None:
-        if os.environ.get("CI"):
-            pytest.fail("jackd is not installed (Debian: jackd2); .ci/run installs it")
-        pytest.skip("jackd is not installed (Debian: jackd2)")
-    assert CLI.exists(), f"{CLI} is missing: build it with --features audio"
-    # A name of our own: other host tests may run a server at the same time.
-    name = f"sakeglug-measure-{os.getpid()}"
-    server, log = start_jack(name, period=2048)
-    try:
-        yield name
-    finally:
-        stop(server, signal.SIGTERM)
-        log.close()
+    # Long cycles (2048 frames), so that the Python client keeps up on a busy machine.
+    yield from own_jack_server("sakeglug-measure", (CLI, "--features audio"), period=2048)
 
 
 @pytest.fixture

@@ -132,26 +132,34 @@ def forget_jack(name):
         semaphore.unlink(missing_ok=True)
 
 
-@pytest.fixture(scope="module")
-def jack_server():
-    """A JACK server of our own name on the dummy driver; stopped after the tests."""
+def own_jack_server(prefix, needs, period=PERIOD):
+    """A JACK server on the dummy driver, named `prefix` and this process (other host tests may
+    run a server at the same time), for a module fixture to yield from: skipped (failed in CI)
+    without jackd, failed if the program `needs` is not built; stopped afterwards, cleanly."""
     if shutil.which("jackd") is None:
         if os.environ.get("CI"):
             pytest.fail("jackd is not installed (Debian: jackd2); .ci/run installs it")
         pytest.skip("jackd is not installed (Debian: jackd2)")
     import jack  # noqa: F401  libjack is loaded here, so only when a server can run
 
-    assert APP.exists(), f"{APP} is missing: build it with --features standalone"
-    name = f"sakeglug-test-{os.getpid()}"
-    server, log = start_jack(name)
+    program, build = needs
+    assert program.exists(), f"{program} is missing: build it with {build}"
+    name = f"{prefix}-{os.getpid()}"
+    server, log = start_jack(name, period)
     try:
         yield name
     finally:
         status = stop(server, signal.SIGTERM)
         log.seek(0)
         print(log.read().decode(errors="replace")[-2000:])
+        log.close()
         assert server.poll() is not None, "the JACK server is stopped"
         assert status == 0, f"jackd exit status {status}"
+
+
+@pytest.fixture(scope="module")
+def jack_server():
+    yield from own_jack_server("sakeglug-test", (APP, "--features standalone"))
 
 
 @pytest.fixture(scope="module")
