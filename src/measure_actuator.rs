@@ -11,6 +11,9 @@ use sake_glug_actuator::ActuatorProfile;
 use sake_glug_io::pending::{PendingFile, WriteError};
 use sake_glug_io::text::quoted;
 
+/// Why a build without the `audio` feature measures nothing.
+const NO_AUDIO: &str = "this build plays no audio: build it with `--features audio` (JACK)";
+
 /// The JACK client's name unless `--client-name` gives one.
 const CLIENT_NAME: &str = "sake-glug-measure";
 
@@ -81,10 +84,9 @@ pub fn run(args: MeasureActuatorArgs) -> ExitCode {
 
 fn measure(args: &MeasureActuatorArgs) -> Result<(), (u8, Failure)> {
     let usage = |error: MeasureError| (2, Failure::from(error));
-    #[cfg(not(feature = "audio"))]
-    return Err(usage(MeasureError::Audio(
-        "this build plays no audio: build it with `--features audio` (JACK)".into(),
-    )));
+    if !cfg!(feature = "audio") {
+        return Err(usage(MeasureError::Audio(NO_AUDIO.into())));
+    }
     let plan = Plan::stepped(
         args.from,
         args.to,
@@ -214,4 +216,9 @@ fn run_on_jack(args: &MeasureActuatorArgs, plan: &Plan) -> Result<Measured, Meas
         }
     };
     sake_glug_actuator::measure::measure(plan, &mut rig, &mut progress)
+}
+
+#[cfg(not(feature = "audio"))]
+fn run_on_jack(_: &MeasureActuatorArgs, _: &Plan) -> Result<Measured, MeasureError> {
+    Err(MeasureError::Audio(NO_AUDIO.into()))
 }

@@ -84,6 +84,9 @@ fn xtask() -> nice_plug_xtask::Result<()> {
                 "-D",
                 "warnings",
             ])?;
+            // The command line as the main job builds it (its default features, no `audio`):
+            // code behind a feature must compile, and cleanly, without it too.
+            cargo(&["clippy", "-p", "sake-glug", "--", "-D", "warnings"])?;
             // All features, assert_process_allocs among them: the dev profile keeps the debug
             // assertions it needs.
             cargo(&["test", "--workspace", "--no-fail-fast", "--all-features"])?;
