@@ -9,7 +9,7 @@ use sake_glug_plot::plotters::prelude::*;
 use sake_glug_plot::{Canvas, Plot, PlotError, FONT};
 
 use super::compare::{render_default, render_model, smoothed_db, spectral_correlation};
-use super::plot::draw_units_panel;
+use super::plot::{draw_units_panel, waveform_chart};
 use super::session_fit::SessionFit;
 use super::spectrum::Spectrum;
 
@@ -61,22 +61,7 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
         ),
     ] {
         let len = ((span_s * rate) as usize).min(samples.len());
-        let peak = samples[..len]
-            .iter()
-            .fold(1e-9f64, |p, &y| p.max(f64::from(y).abs()))
-            * 1.1;
-        let mut chart = ChartBuilder::on(panel)
-            .margin(12)
-            .caption(caption, (FONT, 22))
-            .x_label_area_size(35)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0.0..span_s, -peak..peak)
-            .map_err(|x| e(&x))?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .draw()
-            .map_err(|x| e(&x))?;
+        let mut chart = waveform_chart(panel, &caption, 0.0..span_s, &samples[..len])?;
         chart
             .draw_series(LineSeries::new(
                 (0..len).map(|n| (n as f64 / rate, f64::from(samples[n]))),

@@ -4,6 +4,7 @@
 //! log nor drain line: a clip) says so in words instead of showing empty axes.
 
 use sake_glug_io::PendingFile;
+use sake_glug_plot::plotters::coord::types::RangedCoordf64;
 use sake_glug_plot::plotters::prelude::*;
 use sake_glug_plot::{Canvas, Plot, PlotError, FONT};
 
@@ -243,22 +244,7 @@ pub(crate) fn draw_units_panel(
     let (from_s, to_s) = (span_s.start.clamp(0.0, excerpt_s), span_s.end);
     let range =
         ((from_s * fs) as usize).min(samples.len())..((to_s * fs) as usize).min(samples.len());
-    let peak = samples[range.clone()]
-        .iter()
-        .fold(1e-9f64, |p, &y| p.max(f64::from(y).abs()))
-        * 1.1;
-    let mut chart = ChartBuilder::on(area)
-        .margin(12)
-        .caption(caption, (FONT, 22))
-        .x_label_area_size(35)
-        .y_label_area_size(70)
-        .build_cartesian_2d(from_s..to_s, -peak..peak)
-        .map_err(|x| e(&x))?;
-    chart
-        .configure_mesh()
-        .x_desc("time (s)")
-        .draw()
-        .map_err(|x| e(&x))?;
+    let mut chart = waveform_chart(area, caption, from_s..to_s, &samples[range.clone()])?;
     chart
         .draw_series(LineSeries::new(
             range
@@ -277,4 +263,33 @@ pub(crate) fn draw_units_panel(
         ))
         .map_err(|x| e(&x))?;
     Ok(())
+}
+
+/// A waveform panel's chart on `area`: time (s) over `time_s`, and ±1.1 × the peak of `samples`
+/// (the samples it will show), captioned and meshed as every waveform panel is.
+pub(crate) fn waveform_chart<'a, 'b>(
+    area: &'a Canvas<'b>,
+    caption: &str,
+    time_s: std::ops::Range<f64>,
+    samples: &[f32],
+) -> Result<ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String>
+{
+    let e = |error: &dyn std::fmt::Display| error.to_string();
+    let peak = samples
+        .iter()
+        .fold(1e-9f64, |p, &y| p.max(f64::from(y).abs()))
+        * 1.1;
+    let mut chart = ChartBuilder::on(area)
+        .margin(12)
+        .caption(caption, (FONT, 22))
+        .x_label_area_size(35)
+        .y_label_area_size(70)
+        .build_cartesian_2d(time_s, -peak..peak)
+        .map_err(|x| e(&x))?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .draw()
+        .map_err(|x| e(&x))?;
+    Ok(chart)
 }
