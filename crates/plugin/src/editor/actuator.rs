@@ -56,11 +56,7 @@ pub fn show(
         }
     });
     ui.horizontal(|ui| {
-        ui.add(
-            egui::TextEdit::singleline(&mut field.path)
-                .hint_text("/path/to/profile.toml")
-                .desired_width(170.0),
-        );
+        field.text_edit(ui, "/path/to/profile.toml");
         if ui.button("Load profile…").clicked() {
             match Actuator::find(field.path.trim(), felt) {
                 Ok(actuator) => {
@@ -71,9 +67,7 @@ pub fn show(
             }
         }
     });
-    if let Some(reason) = &field.refused {
-        ui.colored_label(ui.visuals().error_fg_color, reason);
-    }
+    field.show_refusal(ui);
     if let Some(actuator) = changed {
         params.actuator.set(actuator);
         if let Some(gui) = gui {

@@ -62,6 +62,24 @@ pub struct PathField {
     pub refused: Option<String>,
 }
 
+impl PathField {
+    /// The text field, `hint` shown while it is empty.
+    pub fn text_edit(&mut self, ui: &mut egui::Ui, hint: &str) {
+        ui.add(
+            egui::TextEdit::singleline(&mut self.path)
+                .hint_text(hint)
+                .desired_width(170.0),
+        );
+    }
+
+    /// Why the last load was refused, in the error colour, if it was.
+    pub fn show_refusal(&self, ui: &mut egui::Ui) {
+        if let Some(reason) = &self.refused {
+            ui.colored_label(ui.visuals().error_fg_color, reason);
+        }
+    }
+}
+
 pub fn create(
     params: Arc<GlugParams>,
     feed: Arc<Feed>,

@@ -22,11 +22,7 @@ pub fn show(ui: &mut egui::Ui, params: &GlugParams, gui: &GuiContext, field: &mu
         None => "None: the paper's bottle".to_owned(),
     });
     ui.horizontal(|ui| {
-        ui.add(
-            egui::TextEdit::singleline(&mut field.path)
-                .hint_text("/path/to/model.toml")
-                .desired_width(170.0),
-        );
+        field.text_edit(ui, "/path/to/model.toml");
         if ui.button("Load model…").clicked() {
             field.refused = load(Path::new(field.path.trim()), params, gui).err();
         }
@@ -39,9 +35,7 @@ pub fn show(ui: &mut egui::Ui, params: &GlugParams, gui: &GuiContext, field: &mu
             super::midi_settings::tell_host(gui);
         }
     });
-    if let Some(reason) = &field.refused {
-        ui.colored_label(ui.visuals().error_fg_color, reason);
-    }
+    field.show_refusal(ui);
 }
 
 /// Loads the model at `path`: its parameters through the host, the rest through the state.
