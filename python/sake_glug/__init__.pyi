@@ -90,8 +90,12 @@ def fit(session: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
     returns what `sake-glug fit --json` prints: {"units": {"detected", "used"}, "explained":
     {recording: share}, "estimates": {key: {"value", "low", "high", "n", "in_model", "note"}},
     "liquids": {name: {"estimates", "units", "detected", "kept_default", "model"}},
-    "warnings": [...]}. Writes nothing. Ctrl-C returns at once (the fit, which cannot be
-    stopped, runs on in the background and its result is dropped)."""
+    "compared": {recording: {"rendered", "glugs", "rate_per_s", "pitch_fall", "pitch_hz",
+    "high_share", "spectral_correlation", "log_spectral_distance_db"}}, "warnings": [...]}:
+    "compared" holds what a listener hears in each recording, in its model and in the default
+    bottle, each rendered as the recording was made (MODEL.md §13). Writes nothing. Ctrl-C
+    returns at once (the fit, which cannot be stopped, runs on in the background and its
+    result is dropped)."""
 
 def analyze_paired(logs: List[Union[str, "os.PathLike[str]"]]) -> Dict[str, Any]:
     """The paired-comparison analysis of trial logs, as `sake-glug analyze paired --json`.

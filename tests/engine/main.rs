@@ -6,6 +6,7 @@ mod support;
 
 mod amplitude;
 mod drain;
+mod headspace;
 mod onsets;
 mod output_ramps;
 mod pour_spans;

@@ -128,6 +128,40 @@ fn a_bottle_of_its_own_matches_the_reference() {
 }
 
 #[test]
+fn a_bottle_whose_pitch_follows_its_headspace_matches_the_reference() {
+    // MODEL.md §5.1: a Helmholtz f1 falling and an f2 rising as the bottle empties, with the
+    // frequency spread drawn on top, in simulate mode and in follow mode; the reference reads
+    // the law from its own V_i.
+    for (drain, fill) in [
+        ("simulate", "100.0"),
+        ("follow", "[[0.0, 100.0], [6.0, 20.0]]"),
+    ] {
+        assert_matches_reference(
+            &format!(
+                r#"
+                seed = 3
+                tilt_deg = [[0.0, 90.0], [0.5, 135.0]]
+                fill_percent = {fill}
+                [bottle]
+                capacity_ml = 720.0
+                pocket_ml = 9.0
+                headspace_ml = 45.0
+                [glug]
+                f1_hz = 190.0
+                f2_hz = 1150.0
+                b2_per_s = 150.0
+                f1_headspace_exponent = 0.5
+                f2_headspace_exponent = -0.2
+                [output]
+                drain = "{drain}"
+                "#
+            ),
+            6.0,
+        );
+    }
+}
+
+#[test]
 fn a_short_flood_is_started_by_the_contracts_caps() {
     // 625 pockets are due per sample for 10 ms: 8 a sample are started (§11), and of those the
     // start budget admits a burst of 8 units and then 6000 per second, about 68 units, whose

@@ -33,6 +33,7 @@ fn unit(viscosity: f64, decay_per_s: [f64; 2]) -> UnitOnset {
         viscosity,
         shape: UnitShape {
             frequency_hz: [80.0, 300.0],
+            frequency_spread: [1.0, 1.0],
             decay_per_s,
             amplitude_factor: 1.0,
         },

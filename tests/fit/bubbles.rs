@@ -14,7 +14,7 @@ const P0: f64 = 101_325.0;
 /// Density of water (kg/m³).
 const RHO: f64 = 1_000.0;
 /// Speed of sound in air (m/s).
-const SOUND_M_PER_S: f64 = 343.0;
+pub const SOUND_M_PER_S: f64 = 343.0;
 
 /// Minnaert's resonance of a bubble of radius `a` (m), in Hz.
 pub fn minnaert_hz(a: f64) -> f64 {

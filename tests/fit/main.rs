@@ -4,6 +4,8 @@
 
 mod bad_input;
 mod bubbles;
+mod emptying;
+mod emptying_fit;
 mod command;
 mod real;
 mod round_trip;

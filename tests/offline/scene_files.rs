@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use sake_glug_engine::curves::BottleCurves;
-use sake_glug_engine::{Curve, DrainMode, ModelConfig, SilentBelow};
+use sake_glug_engine::{Curve, DrainMode, Headspace, ModelConfig, SilentBelow};
 use sake_glug_render::{Automation, Scene, SceneError};
 
 fn fixtures(kind: &str) -> Vec<(String, String)> {
@@ -90,6 +90,10 @@ fn the_full_fixture_reads_every_key_with_its_own_value() {
             decay_sigma: 0.0,
             silent_below: SilentBelow::Ml(150.0),
             amplitude_spread: 0.0,
+            headspace: Headspace {
+                headspace_ml: 42.5,
+                exponent: [0.5, -0.125],
+            },
             curves: BottleCurves {
                 rest: Curve::Rest
                     .from_points(&[(60.0, 1.0), (90.0, 0.4), (120.0, 0.0)])

@@ -6,6 +6,7 @@
 
 use super::amplitude::{SilentBelow, PAPERS_SILENT_BELOW_ML};
 use super::controls::Control;
+use super::headspace::Headspace;
 use super::curves::{BottleCurves, CurveError, TiltCurve, REFERENCE_TILT_DEG};
 use super::quantity::{Knob, Quantity, Range, ValueError};
 
@@ -85,6 +86,9 @@ macro_rules! declare_constants {
 
 /// Bottle capacity C (ml): its range bounds V0's too.
 const CAPACITY_ML: Range = Range::new(1.0, 100_000.0, 300.0);
+/// γ of the headspace law (MODEL.md §5.1): wide enough for a mode that rises (negative) and for
+/// more than a Helmholtz cavity's ½, narrow enough that every frequency it gives stays finite.
+const HEADSPACE_EXPONENT: Range = Range::new(-3.0, 3.0, 0.0);
 
 declare_constants! {
     /// Frequency f1 of the first component, the air pocket bouncing in the neck (Hz).
@@ -215,6 +219,49 @@ declare_constants! {
         },
         get: |config| config.decay_sigma,
         set: |config, value| config.decay_sigma = value,
+    };
+    /// H (ml): the air above a full bottle's liquid, in its neck and shoulder; the headspace
+    /// law of MODEL.md §5.1 measures the air above the liquid from it.
+    Headspace => ConstantSpec {
+        quantity: Quantity {
+            name: "Headspace",
+            unit: " ml",
+            scene_key: "bottle.headspace_ml",
+            param_id: "headsp",
+            note: "H of MODEL.md §5.1: the air above a full bottle's liquid",
+            range: Range::new(0.001, CAPACITY_ML.max, 30.0),
+            knob: Knob::full(1).within(1.0, 2_000.0).skewed(-1.5),
+        },
+        get: |config| config.headspace.headspace_ml,
+        set: |config, value| config.headspace.headspace_ml = value,
+    };
+    /// γ1: how f1 follows the air above the liquid (MODEL.md §5.1); 0 keeps it constant.
+    F1Exponent => ConstantSpec {
+        quantity: Quantity {
+            name: "f1 headspace exponent",
+            unit: "",
+            scene_key: "glug.f1_headspace_exponent",
+            param_id: "f1exp",
+            note: "γ1 of MODEL.md §5.1: f1·((H + b)/(H + C − V))^γ1; ½ a Helmholtz cavity, 0 constant",
+            range: HEADSPACE_EXPONENT,
+            knob: Knob::full(3),
+        },
+        get: |config| config.headspace.exponent[0],
+        set: |config, value| config.headspace.exponent[0] = value,
+    };
+    /// γ2: how f2 follows the air above the liquid (MODEL.md §5.1); 0 keeps it constant.
+    F2Exponent => ConstantSpec {
+        quantity: Quantity {
+            name: "f2 headspace exponent",
+            unit: "",
+            scene_key: "glug.f2_headspace_exponent",
+            param_id: "f2exp",
+            note: "γ2 of MODEL.md §5.1: f2·((H + b)/(H + C − V))^γ2; ½ a Helmholtz cavity, 0 constant",
+            range: HEADSPACE_EXPONENT,
+            knob: Knob::full(3),
+        },
+        get: |config| config.headspace.exponent[1],
+        set: |config, value| config.headspace.exponent[1] = value,
     };
     /// V0 (ml): the residual volume from which down a unit is silent (MODEL.md §12). Its
     /// default is the paper's, scaled with the capacity ([`SilentBelow::PapersFit`]; the range's
@@ -392,6 +439,8 @@ pub struct ModelConfig {
     pub silent_below: SilentBelow,
     /// Log-normal spread σ_A of each unit's summed amplitude (§12).
     pub amplitude_spread: f64,
+    /// H and γ1, γ2 of the headspace law (§5.1).
+    pub headspace: Headspace,
     /// r(θ), s(θ) and h(θ) (§2, §3, §12): inline, so that the constants stay `Copy`.
     pub curves: BottleCurves,
     /// Seed of the random generator of §7, applied again at every reset.
@@ -414,6 +463,10 @@ impl Default for ModelConfig {
             decay_sigma: 0.0,
             silent_below: SilentBelow::PapersFit,
             amplitude_spread: 0.0,
+            headspace: Headspace {
+                headspace_ml: 0.0,
+                exponent: [0.0; 2],
+            },
             curves: BottleCurves::default(),
             seed: SEED.range.default as u64,
             drain: DrainMode::Simulate,

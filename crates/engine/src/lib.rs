@@ -10,6 +10,7 @@ mod amplitude;
 pub mod config;
 mod controls;
 pub mod curves;
+mod headspace;
 mod output;
 pub mod pour;
 mod presets;
@@ -18,6 +19,7 @@ pub mod synthesis;
 
 pub use actuator::{ActuatorResponse, Equalise, ResponseError};
 pub use amplitude::{SilentBelow, PAPERS_SILENT_BELOW_ML};
+pub use headspace::Headspace;
 pub use config::{Constant, ConstantSpec, Curve, DrainMode, ModelConfig};
 pub use controls::{
     sample_time_s, Control, ControlSource, ControlSpec, ControlValues, Controls, DeviceInput, Lane,
@@ -26,7 +28,7 @@ pub use controls::{
 use output::OutputStage;
 use pour::MAX_ONSETS_PER_SAMPLE;
 pub use pour::{Outflow, Pour, PourStats, UnitOnset};
-pub use presets::{Preset, PresetValue, PRESETS};
+pub use presets::{Preset, PresetValue, HEADSPACE_LAW, PRESETS};
 pub use quantity::{Knob, Quantity, Range, ValueError};
 pub use synthesis::{AnchoredF32, RecursiveF32, RecursiveF64, Synthesis, GRID};
 

@@ -74,8 +74,35 @@ const fn same_target(a: PresetValue, b: PresetValue) -> bool {
     }
 }
 
+/// The constants of the headspace law (MODEL.md §5.1). The paper's bottle keeps its frequencies
+/// constant, so its presets leave them out of their files; picked in a menu, a preset that names
+/// none of them sets them to their defaults ([`Preset::menu_values`]).
+pub const HEADSPACE_LAW: [Constant; 3] = [
+    Constant::Headspace,
+    Constant::F1Exponent,
+    Constant::F2Exponent,
+];
+
+/// A 720 ml glass bottle of water emptying: its neck and shoulder hold 60 ml of air when full, and
+/// the air above the liquid rings as a Helmholtz cavity (γ1 = ½), from 190 Hz at the first glug
+/// to about a third of it (66 Hz) at the last audible one (V0, 202 ml); the pocket's own ring, bright and
+/// short (1.15 kHz, −60 dB in 46 ms), stays put.
+const GLASS_BOTTLE: [PresetValue; 11] = [
+    C(Control::Viscosity, 0.33),
+    C(Control::PourTime, 10.0),
+    K(Constant::Capacity, 720.0),
+    K(Constant::Pocket, 9.0),
+    K(Constant::F1, 190.0),
+    K(Constant::F2, 1_150.0),
+    K(Constant::B1, 30.0),
+    K(Constant::B2, 150.0),
+    K(Constant::Headspace, 60.0),
+    K(Constant::F1Exponent, 0.5),
+    K(Constant::F2Exponent, 0.0),
+];
+
 /// Every preset, in menu order.
-pub const PRESETS: [Preset; 7] = [
+pub const PRESETS: [Preset; 8] = [
     Preset {
         name: "Water",
         id: "water",
@@ -139,6 +166,14 @@ pub const PRESETS: [Preset; 7] = [
             K(Constant::B2, 32.0),
         ]),
     },
+    Preset {
+        name: "Glass bottle (falling pitch)",
+        id: "glass-bottle",
+        description: "a 720 ml glass bottle of water whose glug falls in pitch as it empties: \
+                      f1 follows its headspace as a Helmholtz cavity (γ1 = 0.5) over a bright \
+                      1.15 kHz pocket",
+        values: &GLASS_BOTTLE,
+    },
 ];
 
 impl Preset {
@@ -151,6 +186,21 @@ impl Preset {
     pub fn ids() -> String {
         let ids: Vec<&str> = PRESETS.iter().map(|preset| preset.id).collect();
         ids.join(", ")
+    }
+
+    /// What picking the preset in a menu sets: its own values, then each constant of the
+    /// headspace law it leaves out at its default, so that picking one preset after another
+    /// leaves nothing of the first.
+    pub fn menu_values(&self) -> impl Iterator<Item = PresetValue> + '_ {
+        let left_out = HEADSPACE_LAW.into_iter().filter(|law| {
+            !self
+                .values
+                .iter()
+                .any(|value| matches!(value, K(constant, _) if constant == law))
+        });
+        self.values.iter().copied().chain(
+            left_out.map(|constant| K(constant, constant.range().default)),
+        )
     }
 
     /// The model's constants: the preset's, the rest (seed, spreads, drain) as `base` has them.

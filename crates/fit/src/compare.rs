@@ -1,33 +1,58 @@
-//! How close a model sounds to a recording (MODEL.md §13): the model rendered at the recording's
-//! rate, and the correlation of the two spectra over 50–1000 Hz (Welch's power spectrum, each
-//! bin averaged in power with its neighbours within ±25 Hz, in dB, the model's read at the
-//! recording's bins). The same for the paper's default bottle, so that a fit shows whether it
-//! came closer than the default.
+//! How close a model sounds to a recording (MODEL.md §13): the model rendered as the recording
+//! was made ([`AsRecorded`]), the correlation of the two spectra over 50–1000 Hz (Welch's power
+//! spectrum, each bin averaged in power with its neighbours within ±25 Hz, in dB, the model's
+//! read at the recording's bins), and what a listener would recognise ([`super::listen`]): the
+//! rate, the pitch's fall over the glugs, the balance of the two modes and the log-spectral
+//! distance. The same for the paper's default bottle, so that a fit shows whether it came closer
+//! than the default.
 
+use sake_glug_engine::Control;
 use sake_glug_io::keys;
 use sake_glug_render::{render_scene_to_vec, Scene};
 
+use super::listen::{hear, log_spectral_distance, Heard};
+use super::recording::RecordingFit;
 use super::session_fit::SessionFit;
 use super::spectrum::Spectrum;
+use super::units::Modes;
 
 /// The band compared (Hz): the glug's components lie in it.
 pub const COMPARED_BAND_HZ: (f64, f64) = (50.0, 1000.0);
 /// Each bin is averaged with its neighbours within this distance (Hz).
 const SMOOTHING_HZ: f64 = 25.0;
-/// The length of a model's render compared (s): several glugs at any pour time.
-pub const RENDER_S: f64 = 10.0;
+/// The longest render compared (s): the recording's first seconds, as its fit keeps them.
+pub const RENDER_S: f64 = super::recording::EXCERPT_S;
 /// The default bottle: a scene of nothing but the tilt of a model file.
 const DEFAULT_BOTTLE: &str = "tilt_deg = 135.0\n";
+
+/// Where the energy is split without two modes (Hz): above a glug's low modes, below a bubble's
+/// bright ring.
+pub const ONE_MODE_SPLIT_HZ: f64 = 700.0;
 
 /// One recording against its liquid's model and the default bottle.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Comparison {
     /// The recording's name.
     pub recording: String,
+    /// How the model and the default bottle were rendered ([`AsRecorded::describe`]).
+    pub rendered: String,
     /// Correlation of the smoothed dB spectra, recording against the fitted model.
     pub fitted: f64,
     /// …and against the default bottle.
     pub default: f64,
+    /// The log-spectral distance from the recording (dB): the fitted model's, the default's.
+    pub distance: [f64; 2],
+    /// Where the modes' energy is split (Hz).
+    pub split_hz: f64,
+    /// What a listener hears: in the recording, the fitted model, the default bottle.
+    pub heard: [Heard; 3],
+}
+
+impl Comparison {
+    /// The glugs the recording's pitch fall is read over: the recording's glugs heard.
+    pub fn glugs(&self) -> usize {
+        self.heard[0].onsets_s.len()
+    }
 }
 
 /// The smoothed dB spectrum of `spectrum` at each of its bins within the compared band.
@@ -80,24 +105,69 @@ fn pearson(pairs: &[(f64, f64)]) -> f64 {
     xy / (xx * yy).sqrt()
 }
 
-/// The samples of the model file `model_toml` (a scene) rendered for [`RENDER_S`] at
-/// `sample_rate`, the bottle kept full (it glugs all along); the renderer's message if it
-/// refuses.
-pub fn render_model(model_toml: &str, sample_rate: u32) -> Result<Vec<f32>, String> {
+/// How a recording was made, so that a model is rendered as it was poured: the same tilt, the
+/// same volume at the first sample, for as long (at most [`RENDER_S`]: the plots and the measures
+/// read the recording's first seconds), at the same rate, the bottle draining as the model says.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AsRecorded {
+    /// The tilt held (°).
+    pub tilt_deg: f64,
+    /// The bottle's volume at the first sample, as a share of its capacity.
+    pub fill: f64,
+    /// The length rendered (s).
+    pub duration_s: f64,
+    /// The recording's rate (Hz).
+    pub sample_rate: u32,
+}
+
+impl AsRecorded {
+    /// How `recording` was made, in a bottle of `capacity_ml`: its session's tilt and start
+    /// volume (its `start_ml`, else its weight log's first volume, else full, as a clip is).
+    pub fn of(recording: &RecordingFit, capacity_ml: f64) -> Self {
+        let start_ml = recording
+            .spec
+            .start_ml
+            .or_else(|| recording.weight.as_ref().map(|log| log.volume_at(0.0)))
+            .filter(|ml| ml.is_finite())
+            .unwrap_or(capacity_ml);
+        Self {
+            tilt_deg: recording.spec.tilt_deg,
+            fill: (start_ml / capacity_ml).clamp(0.0, 1.0),
+            duration_s: recording.duration_s.clamp(0.05, RENDER_S),
+            sample_rate: recording.sample_rate,
+        }
+    }
+
+    /// What was rendered, in words (the picture and the JSON say it).
+    pub fn describe(&self) -> String {
+        format!(
+            "rendered as recorded: held at {}°, from {:.0} % full, for {:.2} s at {} Hz",
+            self.tilt_deg,
+            100.0 * self.fill,
+            self.duration_s,
+            self.sample_rate
+        )
+    }
+}
+
+/// The samples of the model file `model_toml` (a scene) rendered as the recording was made
+/// ([`AsRecorded`]); the renderer's message if it refuses.
+pub fn render_model(model_toml: &str, made: &AsRecorded) -> Result<Vec<f32>, String> {
     let mut table: toml::Table =
         toml::from_str(model_toml).map_err(|error| keys::syntax_message(&error, model_toml))?;
-    keys::insert(
-        &mut table,
+    let mut set = |key: &str, value: toml::Value| keys::insert(&mut table, key, value);
+    set(
         "sample_rate",
-        toml::Value::Integer(sample_rate.into()),
+        toml::Value::Integer(made.sample_rate.into()),
     );
-    keys::insert(&mut table, "duration_s", toml::Value::Float(RENDER_S));
-    // The bottle kept full: it glugs all along, at the level of the recordings' start, so that
-    // the spectrum is of many glugs rather than a few.
-    keys::insert(
-        &mut table,
-        "output.drain",
-        toml::Value::String("follow".into()),
+    set("duration_s", toml::Value::Float(made.duration_s));
+    set(
+        Control::Tilt.quantity().scene_key,
+        toml::Value::Float(made.tilt_deg),
+    );
+    set(
+        Control::Fill.quantity().scene_key,
+        toml::Value::Float(100.0 * made.fill),
     );
     let text = toml::to_string(&table).map_err(|error| error.to_string())?;
     let scene = Scene::parse(&text).map_err(|error| error.to_string())?;
@@ -107,29 +177,84 @@ pub fn render_model(model_toml: &str, sample_rate: u32) -> Result<Vec<f32>, Stri
 }
 
 /// The default bottle rendered as [`render_model`] renders a model.
-pub fn render_default(sample_rate: u32) -> Result<Vec<f32>, String> {
-    render_model(DEFAULT_BOTTLE, sample_rate)
+pub fn render_default(made: &AsRecorded) -> Result<Vec<f32>, String> {
+    render_model(DEFAULT_BOTTLE, made)
 }
 
-/// Every recording of `fit` against its liquid's model and the default bottle.
+/// Where the energy of the bottle's two modes is split for [`Heard::high_share`]: between the
+/// liquid's modes where it has two, else at [`ONE_MODE_SPLIT_HZ`].
+pub fn split_hz(modes: Modes) -> f64 {
+    match modes {
+        Modes::Split(boundary_hz) => boundary_hz,
+        Modes::ByOrder | Modes::One => ONE_MODE_SPLIT_HZ,
+    }
+}
+
+/// One recording against its liquid's model and the default bottle, with the two renders.
+pub struct Compared {
+    /// The measures.
+    pub comparison: Comparison,
+    /// The fitted model's render and the default bottle's, as the recording was made.
+    pub renders: [Vec<f32>; 2],
+    /// Their spectra.
+    pub spectra: [Spectrum; 2],
+}
+
+/// `recording` of `fit` against its liquid's model and the default bottle, each rendered as the
+/// recording was made (None: its liquid has no model).
+pub fn compare_recording(
+    fit: &SessionFit,
+    recording: &RecordingFit,
+) -> Result<Option<Compared>, String> {
+    let Some(liquid) = fit
+        .liquids
+        .iter()
+        .find(|l| l.liquid == recording.spec.liquid)
+    else {
+        return Ok(None);
+    };
+    let made = AsRecorded::of(recording, fit.session.capacity_ml);
+    let rate = f64::from(made.sample_rate);
+    let split = split_hz(liquid.modes);
+    let renders = [
+        render_model(&liquid.model_toml, &made)?,
+        render_default(&made)?,
+    ];
+    let spectra = [
+        Spectrum::of(&renders[0], rate),
+        Spectrum::of(&renders[1], rate),
+    ];
+    let comparison = Comparison {
+        recording: recording.name(),
+        rendered: made.describe(),
+        fitted: spectral_correlation(&recording.spectrum, &spectra[0]),
+        default: spectral_correlation(&recording.spectrum, &spectra[1]),
+        distance: [
+            log_spectral_distance(&recording.spectrum, &spectra[0], rate),
+            log_spectral_distance(&recording.spectrum, &spectra[1], rate),
+        ],
+        split_hz: split,
+        heard: [
+            hear(&recording.excerpt, rate, split),
+            hear(&renders[0], rate, split),
+            hear(&renders[1], rate, split),
+        ],
+    };
+    Ok(Some(Compared {
+        comparison,
+        renders,
+        spectra,
+    }))
+}
+
+/// Every recording of `fit` against its liquid's model and the default bottle, each rendered as
+/// the recording was made.
 pub fn compare(fit: &SessionFit) -> Result<Vec<Comparison>, String> {
     let mut comparisons = Vec::new();
     for recording in &fit.recordings {
-        let Some(liquid) = fit
-            .liquids
-            .iter()
-            .find(|l| l.liquid == recording.spec.liquid)
-        else {
-            continue;
-        };
-        let fs = recording.sample_rate;
-        let model = Spectrum::of(&render_model(&liquid.model_toml, fs)?, f64::from(fs));
-        let default = Spectrum::of(&render_default(fs)?, f64::from(fs));
-        comparisons.push(Comparison {
-            recording: recording.name(),
-            fitted: spectral_correlation(&recording.spectrum, &model),
-            default: spectral_correlation(&recording.spectrum, &default),
-        });
+        if let Some(compared) = compare_recording(fit, recording)? {
+            comparisons.push(compared.comparison);
+        }
     }
     Ok(comparisons)
 }

@@ -15,8 +15,10 @@ mod compare_plot;
 mod curves;
 mod error;
 mod estimate;
+mod headspace;
 mod json;
 mod liquid;
+pub mod listen;
 mod model_toml;
 mod onsets;
 #[cfg(feature = "plot")]
@@ -40,6 +42,7 @@ pub use audio::{Audio, FIT_BYTES_PER_SAMPLE, MIN_SAMPLE_RATE_HZ};
 pub use compare_plot::draw_compare_plot;
 pub use curves::FittedCurves;
 pub use error::{FitError, SampleFault};
+pub use headspace::{HeadspaceLaw, ModeLaw};
 pub use estimate::{Estimate, MIN_UNITS_FOR_INTERVAL, MIN_UNITS_FOR_MODEL};
 pub use json::fit_json;
 pub use liquid::LiquidFit;

@@ -5,13 +5,14 @@
 use super::curves::FittedCurves;
 use super::estimate::Estimate;
 use super::estimate::MIN_UNITS_FOR_MODEL;
+use super::headspace::{fit_law, HeadspaceLaw};
 use super::model_toml::model_toml;
 use super::pour::{intervals, pockets, rate_error};
 use super::recording::{FittedUnit, RecordingFit, LOW_EXPLAINED};
 use super::stats::{bootstrap, iqr, median, Line, NORMAL_IQR};
 use super::units::Modes;
 use sake_glug_engine::curves::REFERENCE_TILT_DEG;
-use sake_glug_engine::{Constant, Control, Curve, Range};
+use sake_glug_engine::{Constant, Control, Curve, Headspace, Range};
 
 /// The z of a two-sided 95 % normal interval (a line's rate).
 const Z_95: f64 = 1.959_963_984_540_054;
@@ -42,6 +43,35 @@ pub struct LiquidFit {
     pub model_toml: String,
 }
 
+impl LiquidFit {
+    /// A constant as the model file has it: its estimate where written, else its default.
+    fn model_value(&self, constant: Constant) -> f64 {
+        let key = constant.quantity().scene_key;
+        self.estimates
+            .iter()
+            .find(|e| e.key == key && e.in_model)
+            .map_or(constant.range().default, |e| e.value)
+    }
+
+    /// The frequencies f1, f2 the model plays for a unit at `volume_ml` in a bottle of
+    /// `capacity_ml`: the headspace law (MODEL.md §5.1) with the model's values, before the spread.
+    pub fn model_hz(&self, volume_ml: f64, capacity_ml: f64) -> [f64; 2] {
+        let law = Headspace {
+            headspace_ml: self.model_value(Constant::Headspace),
+            exponent: [
+                self.model_value(Constant::F1Exponent),
+                self.model_value(Constant::F2Exponent),
+            ],
+        };
+        let quoted = [
+            self.model_value(Constant::F1),
+            self.model_value(Constant::F2),
+        ];
+        let factors = law.factors(volume_ml, capacity_ml, self.model_value(Constant::Pocket));
+        [quoted[0] * factors[0], quoted[1] * factors[1]]
+    }
+}
+
 /// What one liquid's model is made of.
 pub(crate) struct LiquidInputs<'a> {
     /// Its name.
@@ -61,11 +91,14 @@ pub(crate) struct LiquidInputs<'a> {
 }
 
 /// The unit estimates, in this order: each one's model key (or name), and whether it is one.
-fn unit_keys() -> [(String, bool); 11] {
+fn unit_keys() -> [(String, bool); 14] {
     let key = |constant: Constant| (constant.quantity().scene_key.to_owned(), true);
     [
         key(Constant::F1),
         key(Constant::F2),
+        key(Constant::F1Exponent),
+        key(Constant::F2Exponent),
+        key(Constant::Headspace),
         key(Constant::FreqJitter),
         key(Constant::B1),
         key(Constant::B2),
@@ -79,11 +112,17 @@ fn unit_keys() -> [(String, bool); 11] {
 }
 
 /// The units each of [`unit_keys`]' estimates comes from.
-fn unit_counts(units: &[FittedUnit]) -> [usize; 11] {
+fn unit_counts(units: &[FittedUnit]) -> [usize; 14] {
     let in_mode = |mode: usize| {
         units
             .iter()
             .filter(|u| u.fit.frequency_hz[mode].is_finite())
+            .count()
+    };
+    let in_mode_with_volume = |mode: usize| {
+        units
+            .iter()
+            .filter(|u| u.fit.frequency_hz[mode].is_finite() && u.volume_ml.is_finite())
             .count()
     };
     let (low, high) = (in_mode(0), in_mode(1));
@@ -96,6 +135,9 @@ fn unit_counts(units: &[FittedUnit]) -> [usize; 11] {
     [
         low,
         high,
+        in_mode_with_volume(0),
+        in_mode_with_volume(1),
+        in_mode_with_volume(0).max(in_mode_with_volume(1)),
         spread,
         low,
         high,
@@ -108,8 +150,37 @@ fn unit_counts(units: &[FittedUnit]) -> [usize; 11] {
     ]
 }
 
+/// Each mode's (C − V_i, f_i) of the units whose volume is known.
+fn pitch_points(units: &[FittedUnit], capacity_ml: f64) -> [Vec<(f64, f64)>; 2] {
+    [0, 1].map(|k| {
+        units
+            .iter()
+            .filter(|u| u.volume_ml.is_finite() && u.fit.frequency_hz[k].is_finite())
+            .map(|u| (capacity_ml - u.volume_ml, u.fit.frequency_hz[k]))
+            .collect()
+    })
+}
+
+/// The headspace law of a liquid's units (MODEL.md §5.1, §13) in a bottle whose pocket is
+/// `pocket_ml`.
+fn headspace_law(units: &[FittedUnit], capacity_ml: f64, pocket_ml: f64) -> HeadspaceLaw {
+    let points = pitch_points(units, capacity_ml);
+    fit_law([&points[0], &points[1]], pocket_ml)
+}
+
+/// The pocket the model is written with: the logged recordings' (MODEL.md §13), else the
+/// default.
+fn model_pocket_ml(recordings: &[&RecordingFit]) -> f64 {
+    let pockets = pockets(recordings);
+    if pockets.is_empty() {
+        Constant::Pocket.range().default
+    } else {
+        median(&pockets)
+    }
+}
+
 /// The unit-based estimates of a liquid, in [`unit_keys`] order (NaN where unknown).
-fn unit_estimates(units: &[FittedUnit], capacity_ml: f64) -> Vec<f64> {
+fn unit_estimates(units: &[FittedUnit], capacity_ml: f64, pocket_ml: f64) -> Vec<f64> {
     let of = |get: &dyn Fn(&FittedUnit) -> f64| {
         units
             .iter()
@@ -117,7 +188,24 @@ fn unit_estimates(units: &[FittedUnit], capacity_ml: f64) -> Vec<f64> {
             .filter(|v| v.is_finite())
             .collect::<Vec<_>>()
     };
-    let f = [0, 1].map(|k| of(&|u| u.fit.frequency_hz[k]));
+    let law = headspace_law(units, capacity_ml, pocket_ml);
+    // Where a mode follows the headspace, its spread is the scatter around the law, over the
+    // units whose volume places them on it.
+    let f = [0, 1].map(|k| {
+        if law.heard() {
+            pitch_points(units, capacity_ml)[k]
+                .iter()
+                .map(|&(added_ml, hz)| hz / law.factor(k, added_ml))
+                .collect()
+        } else {
+            of(&|u| u.fit.frequency_hz[k])
+        }
+    });
+    let quoted_hz = [0, 1].map(|k| match law.modes[k] {
+        Some(mode) if mode.follows() => mode.full_hz,
+        _ => median(&of(&|u| u.fit.frequency_hz[k])),
+    });
+    let exponent = law.modes.map(|mode| mode.map_or(f64::NAN, |m| m.exponent));
     let b = [0, 1].map(|k| of(&|u| u.fit.decay_per_s[k]));
     // A spread over the modes with enough units to show one.
     let mean_over_modes = |values: &[Vec<f64>; 2], spread: &dyn Fn(&[f64]) -> f64| {
@@ -131,8 +219,8 @@ fn unit_estimates(units: &[FittedUnit], capacity_ml: f64) -> Vec<f64> {
     let relative = |values: &[f64]| iqr(values) / median(values);
     let log_sigma =
         |values: &[f64]| iqr(&values.iter().map(|v| v.ln()).collect::<Vec<_>>()) / NORMAL_IQR;
-    let law = amplitude_law(units);
-    let (silent_below, amplitude_spread, r_squared) = match law {
+    let amplitude = amplitude_law(units);
+    let (silent_below, amplitude_spread, r_squared) = match amplitude {
         Some(line) if line.slope > 0.0 => {
             let residuals: Vec<f64> = units
                 .iter()
@@ -149,13 +237,16 @@ fn unit_estimates(units: &[FittedUnit], capacity_ml: f64) -> Vec<f64> {
     };
     // The full bottle's Asum: the law at C where Asum falls with V, else the units' median (a
     // recording near full, whose law has no slope).
-    let full = match law {
+    let full = match amplitude {
         Some(line) if line.slope > 0.0 => line.at(capacity_ml),
         _ => median(&of(&|u| u.fit.amplitude_sum())),
     };
     vec![
-        median(&f[0]),
-        median(&f[1]),
+        quoted_hz[0],
+        quoted_hz[1],
+        exponent[0],
+        exponent[1],
+        law.headspace_ml,
         // j_f: f(1 + j·u), u uniform in [−1, 1], has its quartiles at f(1 ± j/2).
         mean_over_modes(&f, &relative),
         median(&b[0]),
@@ -192,8 +283,11 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
         .flat_map(|r| r.units.iter().copied())
         .collect();
     let detected = recordings.iter().map(|r| r.detected.len()).sum();
-    let values = unit_estimates(&units, capacity_ml);
-    let intervals = bootstrap(&units, |sample| unit_estimates(sample, capacity_ml));
+    let pocket_ml = model_pocket_ml(recordings);
+    let values = unit_estimates(&units, capacity_ml, pocket_ml);
+    let intervals = bootstrap(&units, |sample| {
+        unit_estimates(sample, capacity_ml, pocket_ml)
+    });
     let mut estimates: Vec<Estimate> = unit_keys()
         .into_iter()
         .zip(values.iter().zip(intervals).zip(unit_counts(&units)))
@@ -219,6 +313,10 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
         }
     }
     check_silent_below(&mut estimates, &units, capacity_ml);
+    check_headspace(
+        &mut estimates,
+        &headspace_law(&units, capacity_ml, pocket_ml),
+    );
     estimates.extend(timing_estimates(inputs));
     estimates.push(Estimate::measured(
         Constant::Capacity.quantity().scene_key,
@@ -267,6 +365,48 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
         kept_default,
         model_toml,
         amplitude_law: law,
+    }
+}
+
+/// An exponent is written only where its mode follows the headspace measurably, and H only where
+/// the units reject the default H; otherwise each keeps its default, with the reason.
+fn check_headspace(estimates: &mut [Estimate], law: &HeadspaceLaw) {
+    for (k, constant) in [Constant::F1Exponent, Constant::F2Exponent]
+        .into_iter()
+        .enumerate()
+    {
+        let key = constant.quantity().scene_key;
+        let (Some(estimate), Some(mode)) = (estimates.iter_mut().find(|e| e.key == key), law.modes[k])
+        else {
+            continue;
+        };
+        if estimate.has_value() && !mode.follows() {
+            estimate.in_model = false;
+            estimate.note = Some(format!(
+                "f{} does not move measurably with the headspace (γ = {:.3} ± {:.3}): kept at 0, \
+                 the paper's constant frequency",
+                k + 1,
+                mode.exponent,
+                Z_95 * mode.exponent_error
+            ));
+        }
+    }
+    let key = Constant::Headspace.quantity().scene_key;
+    let Some(estimate) = estimates.iter_mut().find(|e| e.key == key) else {
+        return;
+    };
+    if !law.heard() {
+        estimate.in_model = false;
+        estimate.note = Some("no mode follows the headspace: not needed".to_owned());
+    } else if !law.headspace_heard {
+        estimate.in_model = false;
+        estimate.note = Some(match law.allowed_ml {
+            Some((low, high)) => format!(
+                "the units allow any H from {low:.3} to {high:.3} ml, the default among them: \
+                 kept at its default"
+            ),
+            None => "the units do not tell H: kept at its default".to_owned(),
+        });
     }
 }
 

@@ -5,6 +5,7 @@
 
 use std::fmt::Write;
 
+use super::liquid::LiquidFit;
 use super::recording::LOW_EXPLAINED;
 use super::session_fit::SessionFit;
 use super::stats::BOOTSTRAP_RESAMPLES;
@@ -128,6 +129,7 @@ pub fn report_markdown(fit: &SessionFit) -> String {
                 law.r_squared,
             );
         }
+        write_pitch_table(&mut out, fit, liquid);
         if !liquid.kept_default.is_empty() {
             let _ = writeln!(out, "\nKept at the default:\n");
             for (key, why) in &liquid.kept_default {
@@ -157,6 +159,56 @@ pub fn report_markdown(fit: &SessionFit) -> String {
 }
 
 /// Four significant digits.
+/// The units' own frequencies beside the model's at their volumes (the headspace law of MODEL.md
+/// §5.1), at most [`PITCH_ROWS`] units of each of the liquid's recordings.
+fn write_pitch_table(out: &mut String, fit: &SessionFit, liquid: &LiquidFit) {
+    let capacity_ml = fit.session.capacity_ml;
+    let _ = writeln!(
+        out,
+        "\nPitch against the headspace (the units' own f beside the model's at their volume):\n"
+    );
+    let _ = writeln!(
+        out,
+        "| recording | onset (s) | V (ml) | f1 (Hz) | model's f1 | f2 (Hz) | model's f2 |"
+    );
+    let _ = writeln!(out, "|---|---|---|---|---|---|---|");
+    let hz = |value: f64| {
+        if value.is_finite() {
+            format!("{value:.1}")
+        } else {
+            "—".to_owned()
+        }
+    };
+    for recording in fit
+        .recordings
+        .iter()
+        .filter(|r| r.spec.liquid == liquid.liquid)
+    {
+        for unit in recording
+            .units
+            .iter()
+            .filter(|u| u.volume_ml.is_finite())
+            .take(PITCH_ROWS)
+        {
+            let model = liquid.model_hz(unit.volume_ml, capacity_ml);
+            let _ = writeln!(
+                out,
+                "| {} | {:.3} | {:.1} | {} | {} | {} | {} |",
+                cell(&recording.name()),
+                unit.fit.onset_s,
+                unit.volume_ml,
+                hz(unit.fit.frequency_hz[0]),
+                hz(model[0]),
+                hz(unit.fit.frequency_hz[1]),
+                hz(model[1]),
+            );
+        }
+    }
+}
+
+/// The units of a recording shown in the pitch table, at most.
+const PITCH_ROWS: usize = 12;
+
 fn sig(value: f64) -> String {
     if !value.is_finite() {
         return "—".into();

@@ -1,10 +1,12 @@
 //! The units table (`sake-glug fit --units FILE.csv`): a row per detected unit, used or not,
-//! with its fit in eq. 1's terms and why it was not used.
+//! with its fit in eq. 1's terms and why it was not used, and for a used unit its volume and the
+//! frequencies its liquid's model plays there (the headspace law of MODEL.md §5.1 beside the
+//! unit's own).
 
 use super::session_fit::SessionFit;
 
 /// The table's columns, in order.
-pub const UNIT_COLUMNS: [&str; 10] = [
+pub const UNIT_COLUMNS: [&str; 13] = [
     "recording",
     "onset_s",
     "f1_hz",
@@ -15,6 +17,9 @@ pub const UNIT_COLUMNS: [&str; 10] = [
     "a2",
     "used",
     "reason",
+    "volume_ml",
+    "f1_model_hz",
+    "f2_model_hz",
 ];
 
 /// The units table of `fit` as CSV text (the csv crate quotes a field that needs it).
@@ -31,7 +36,27 @@ pub fn units_csv(fit: &SessionFit) -> String {
     let _ = writer.write_record(UNIT_COLUMNS);
     for recording in &fit.recordings {
         let name = recording.name();
+        let liquid = fit
+            .liquids
+            .iter()
+            .find(|l| l.liquid == recording.spec.liquid);
         for unit in &recording.detected {
+            // A used unit's volume: the fitted unit at its onset.
+            let volume_ml = unit
+                .fit
+                .and_then(|fitted| {
+                    recording
+                        .units
+                        .iter()
+                        .find(|u| u.fit.onset_s == fitted.onset_s)
+                })
+                .map_or(f64::NAN, |u| u.volume_ml);
+            let model_hz = match liquid {
+                Some(liquid) if volume_ml.is_finite() => {
+                    liquid.model_hz(volume_ml, fit.session.capacity_ml)
+                }
+                _ => [f64::NAN; 2],
+            };
             let (f, b, a) = match unit.fit {
                 Some(fit) => (fit.frequency_hz, fit.decay_per_s, fit.amplitude),
                 None => ([f64::NAN; 2], [f64::NAN; 2], [f64::NAN; 2]),
@@ -48,6 +73,9 @@ pub fn units_csv(fit: &SessionFit) -> String {
                 number(a[1]),
                 if unit.rejection.is_none() { "1" } else { "0" }.to_owned(),
                 unit.rejection.map(|r| r.to_string()).unwrap_or_default(),
+                number(volume_ml),
+                number(model_hz[0]),
+                number(model_hz[1]),
             ]);
         }
     }

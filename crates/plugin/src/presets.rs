@@ -7,13 +7,14 @@ use nice_plug::prelude::*;
 use crate::params::GlugParams;
 use sake_glug_engine::{Preset, PresetValue};
 
-/// The parameters a preset sets, each with the preset's value for it. Every other parameter
-/// (tilt, fill level, gain, spreads, seed, drain, ceiling) is left as it is.
+/// The parameters a preset sets, each with the preset's value for it (the headspace law's at its
+/// default where the preset leaves it out: [`Preset::menu_values`]). Every other parameter (tilt,
+/// fill level, gain, spreads, seed, drain, ceiling) is left as it is.
 pub fn preset_values<'a>(
-    preset: &Preset,
+    preset: &'a Preset,
     params: &'a GlugParams,
 ) -> impl Iterator<Item = (&'a FloatParam, f64)> {
-    preset.values.iter().map(move |value| match *value {
+    preset.menu_values().map(move |value| match value {
         PresetValue::Control(control, value) => (&params.controls[control], value),
         PresetValue::Constant(constant, value) => (params.model.constant(constant), value),
     })

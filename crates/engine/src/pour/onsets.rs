@@ -74,7 +74,7 @@ impl OnsetDetector {
                 volume_ml: outflow.volume_before_ml - fraction * amount,
                 pocket_ml,
             };
-            let shape = draws.next_unit(config);
+            let shape = draws.next_unit(config, crossing.volume_ml);
             emit(crossing, shape);
             emitted += 1;
             self.accumulated_ml -= pocket_ml;

@@ -15,8 +15,10 @@ use crate::config::ModelConfig;
 /// The randomised constants of one wave unit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct UnitShape {
-    /// f1_i, f2_i: the unit's frequencies (Hz).
+    /// f1_i, f2_i: the unit's frequencies (Hz), the headspace law's (§5.1) and the draw's.
     pub frequency_hz: [f64; 2],
+    /// 1 + j_f·u of each frequency: the draw alone, without the headspace law (§7).
+    pub frequency_spread: [f64; 2],
     /// B1_i, B2_i: the unit's amplitude decay rates (1/s).
     pub decay_per_s: [f64; 2],
     /// exp(σ_A·z_i): the factor on the unit's a(V_i) (§12); exactly 1 when σ_A = 0.
@@ -58,16 +60,33 @@ impl UnitDraws {
         config.pocket_ml * (1.0 + config.timing_jitter * self.next_pocket_u)
     }
 
-    /// Draws the shape of the unit that is starting now, then the next unit's pocket volume,
-    /// then (only while σ_A > 0) the unit's amplitude factor.
-    pub fn next_unit(&mut self, config: &ModelConfig) -> UnitShape {
+    /// Draws the shape of the unit that is starting now at `volume_ml`, then the next unit's
+    /// pocket volume, then (only while σ_A > 0) the unit's amplitude factor. Its frequencies
+    /// follow the headspace law (§5.1) before the draw spreads them.
+    pub fn next_unit(&mut self, config: &ModelConfig, volume_ml: f64) -> UnitShape {
         let mut shape = UnitShape {
             frequency_hz: config.frequency_hz,
+            frequency_spread: [1.0; 2],
             decay_per_s: config.decay_per_s,
             amplitude_factor: 1.0,
         };
-        for f in &mut shape.frequency_hz {
-            *f *= 1.0 + config.freq_jitter * self.uniform();
+        // Skipped without the law, so that its frequencies are exactly the paper's.
+        if config.headspace.is_active() {
+            let factors =
+                config
+                    .headspace
+                    .factors(volume_ml, config.capacity_ml, config.pocket_ml);
+            for (f, factor) in shape.frequency_hz.iter_mut().zip(factors) {
+                *f *= factor;
+            }
+        }
+        for (f, spread) in shape
+            .frequency_hz
+            .iter_mut()
+            .zip(&mut shape.frequency_spread)
+        {
+            *spread = 1.0 + config.freq_jitter * self.uniform();
+            *f *= *spread;
         }
         for b in &mut shape.decay_per_s {
             let z: f64 = self.rng.sample(StandardNormal);
@@ -96,7 +115,7 @@ mod tests {
         let config = ModelConfig::default().deterministic();
         let mut draws = UnitDraws::new(7);
         assert_eq!(draws.next_pocket_ml(&config), 5.0);
-        let shape = draws.next_unit(&config);
+        let shape = draws.next_unit(&config, 300.0);
         assert_eq!(shape.frequency_hz, [80.0, 300.0]);
         assert_eq!(shape.decay_per_s, [45.0, 40.0]);
         assert_eq!(shape.amplitude_factor, 1.0);
@@ -116,7 +135,7 @@ mod tests {
                 plain.next_pocket_ml(&still),
                 spreading.next_pocket_ml(&spread)
             );
-            let (a, b) = (plain.next_unit(&still), spreading.next_unit(&spread));
+            let (a, b) = (plain.next_unit(&still, 300.0), spreading.next_unit(&spread, 300.0));
             assert_eq!(
                 (a.frequency_hz, a.decay_per_s),
                 (b.frequency_hz, b.decay_per_s)
@@ -128,16 +147,16 @@ mod tests {
         // Units at σ_A = 0 drew nothing from the amplitude's stream: it starts where it would.
         let mut late = UnitDraws::new(9);
         for _ in 0..50 {
-            late.next_unit(&still);
+            late.next_unit(&still, 300.0);
         }
-        assert_eq!(late.next_unit(&spread).amplitude_factor, factors[0]);
+        assert_eq!(late.next_unit(&spread, 300.0).amplitude_factor, factors[0]);
     }
 
     #[test]
     fn draws_stay_within_their_laws_and_reseeding_repeats_them() {
         let config = ModelConfig::default();
         let mut draws = UnitDraws::new(3);
-        let first: Vec<_> = (0..500).map(|_| draws.next_unit(&config)).collect();
+        let first: Vec<_> = (0..500).map(|_| draws.next_unit(&config, 300.0)).collect();
         for shape in &first {
             assert!((76.0..=84.0).contains(&shape.frequency_hz[0]));
             assert!((285.0..=315.0).contains(&shape.frequency_hz[1]));
@@ -152,6 +171,6 @@ mod tests {
         assert!(mean.abs() < 0.05, "log-normal centre drifted: {mean}");
         assert!((sd - 0.35).abs() < 0.04, "log-normal spread {sd}");
         draws.reseed(3);
-        assert_eq!(draws.next_unit(&config), first[0]);
+        assert_eq!(draws.next_unit(&config, 300.0), first[0]);
     }
 }

@@ -140,6 +140,7 @@ mod tests {
             viscosity: 0.5,
             shape: UnitShape {
                 frequency_hz: [80.0, 300.0],
+                frequency_spread: [1.0, 1.0],
                 decay_per_s: [decay_per_s; 2],
                 amplitude_factor: 1.0,
             },

@@ -2,11 +2,12 @@
 //! recursion, no dropping above −260 dB. Slow by design; the yardstick the fast paths are held to.
 //!
 //! It takes only the onset schedule from the engine: [`Pour`] gives the sample and the fraction
-//! of it at which each unit starts, and its draws: f, B and the amplitude's factor (MODEL.md §4,
-//! §7, §12; the schedule is checked on its own by `tests/engine/drain.rs` and `onsets.rs`).
+//! of it at which each unit starts, and its draws: f's spread 1 + j_f·u, B and the amplitude's
+//! factor (MODEL.md §4, §7, §12; the schedule is checked on its own by `tests/engine/drain.rs` and `onsets.rs`).
 //! Everything else it computes itself from the contract, with its own copies of the contract's
 //! formulas and constants and none of the engine's: the drain of §3 and §8 through its own reading
-//! of the bottle's curves r, s and h (§2, §12), and from it each unit's V_i; the amplitude law
+//! of the bottle's curves r, s and h (§2, §12), and from it each unit's V_i; the headspace law of
+//! §5.1 and each unit's f from it; the amplitude law
 //! a(V) with its V0 (§5, §12); the c / (1 − c) split, the gain in dB, the ceiling, the ranges
 //! inputs are brought into (§11), the onset cap and the start budget (§11). A unit the schedule
 //! starts in a sample where its own drain has no glugging outflow it leaves silent. So a fault in
@@ -76,6 +77,33 @@ const CAPACITY_ML: Allowed = Allowed {
     min: 1.0,
     max: 100_000.0,
     default: 300.0,
+};
+const FREQUENCY_HZ: [Allowed; 2] = [
+    Allowed {
+        min: 0.0,
+        max: 400_000.0,
+        default: 80.0,
+    },
+    Allowed {
+        min: 0.0,
+        max: 400_000.0,
+        default: 300.0,
+    },
+];
+const POCKET_ML: Allowed = Allowed {
+    min: 0.001,
+    max: 1_000.0,
+    default: 5.0,
+};
+const HEADSPACE_ML: Allowed = Allowed {
+    min: 0.001,
+    max: 100_000.0,
+    default: 30.0,
+};
+const HEADSPACE_EXPONENT: Allowed = Allowed {
+    min: -3.0,
+    max: 3.0,
+    default: 0.0,
 };
 const CEILING: Allowed = Allowed {
     min: 0.001,
@@ -301,7 +329,12 @@ pub fn evaluate(
                 volume_ml,
                 first_sample: onset.sample + 1,
                 amplitudes: [viscosity * amplitude, (1.0 - viscosity) * amplitude],
-                frequency_hz: onset.shape.frequency_hz,
+                frequency_hz: unit_frequencies(
+                    &config,
+                    volume_ml,
+                    capacity_ml,
+                    onset.shape.frequency_spread,
+                ),
                 decay_per_s: onset.shape.decay_per_s,
             });
         });
@@ -346,6 +379,30 @@ fn amplitude_law(volume_ml: f64, capacity_ml: f64, silent_below: SilentBelow) ->
         }
     };
     ((volume_ml - silent_ml) / (capacity_ml - silent_ml)).max(0.0)
+}
+
+/// f_k,i of MODEL.md §5.1 and §7: f_k · ((H + b)/(H + C − V_i))^γ_k · (1 + j_f·u), the law read from
+/// the unit's own V_i and only the draw (1 + j_f·u) taken from the engine. An exponent of 0 is
+/// the paper's constant frequency: the factor is exactly 1.
+fn unit_frequencies(
+    config: &ModelConfig,
+    volume_ml: f64,
+    capacity_ml: f64,
+    spread: [f64; 2],
+) -> [f64; 2] {
+    let headspace_ml = HEADSPACE_ML.bring_in(config.headspace.headspace_ml);
+    let pocket_ml = POCKET_ML.bring_in(config.pocket_ml);
+    let air_ml = headspace_ml + capacity_ml - volume_ml;
+    std::array::from_fn(|k| {
+        let quoted_hz = FREQUENCY_HZ[k].bring_in(config.frequency_hz[k]);
+        let exponent = HEADSPACE_EXPONENT.bring_in(config.headspace.exponent[k]);
+        let law = if exponent == 0.0 {
+            1.0
+        } else {
+            ((headspace_ml + pocket_ml) / air_ml).powf(exponent)
+        };
+        quoted_hz * law * spread[k]
+    })
 }
 
 /// q_i(τ) of MODEL.md §5 (without G), added at every sample of `window` with τ ≥ 0. A component

@@ -1,0 +1,202 @@
+//! The headspace law (MODEL.md §5.1) heard in a liquid's units (§13): how each mode's frequency
+//! follows the air above the liquid, H + C − V_i. For a trial H, ln f_i is a straight line in
+//! ln(H + C − V_i) whose slope is −γ; H is the one whose lines leave the least residual (a
+//! profile over a grid of H), written only where the data reject the default H. f_k is the
+//! line's frequency one pocket below full (V_ref = C − b).
+
+use super::stats::Line;
+use sake_glug_engine::Constant;
+
+/// The z of a two-sided 95 % normal interval: an exponent is heard where its line's slope lies
+/// further than this many standard errors from 0.
+const Z_95: f64 = 1.959_963_984_540_054;
+/// χ²(1) at 95 %: the H whose residual exceeds the best's by less than this (as n·ln of their
+/// ratio, the profile likelihood of a normal error) are those the data allow.
+const CHI2_1_95: f64 = 3.841_458_820_694_124;
+/// The grid of H, in steps of 2 % over [`GRID_DECADES`] decades around the volumes' span.
+const GRID_STEPS: usize = 351;
+const GRID_DECADES: f64 = 7.0;
+
+/// One mode's line under the law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModeLaw {
+    /// γ_k.
+    pub exponent: f64,
+    /// γ_k's standard error.
+    pub exponent_error: f64,
+    /// f_k: the law's frequency at a full bottle's first glug, V_ref = C − b (Hz).
+    pub full_hz: f64,
+    /// The units it comes from.
+    pub units: usize,
+}
+
+impl ModeLaw {
+    /// Whether the mode's frequency moves measurably with the headspace.
+    pub fn follows(&self) -> bool {
+        self.exponent.abs() > Z_95 * self.exponent_error
+    }
+
+}
+
+/// The law of a liquid's units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeadspaceLaw {
+    /// H the lines are drawn at (ml): the best where the data reject the default, else the
+    /// default.
+    pub headspace_ml: f64,
+    /// The H the data allow (ml, the 95 % profile set), where a mode follows.
+    pub allowed_ml: Option<(f64, f64)>,
+    /// Whether the data chose H (they reject the default).
+    pub headspace_heard: bool,
+    /// Each mode's line (None: fewer than 3 units with a volume).
+    pub modes: [Option<ModeLaw>; 2],
+    /// The pocket b the frequencies are quoted one pocket below full with (ml).
+    pub pocket_ml: f64,
+}
+
+impl HeadspaceLaw {
+    /// Whether any mode follows the headspace.
+    pub fn heard(&self) -> bool {
+        self.modes.iter().flatten().any(ModeLaw::follows)
+    }
+
+    /// The factor of mode `k`'s frequency at `added_ml` (C − V) under the law as written into the
+    /// model: 1 for a mode that does not follow.
+    pub fn factor(&self, k: usize, added_ml: f64) -> f64 {
+        match self.modes[k] {
+            Some(mode) if mode.follows() => ((self.headspace_ml + self.pocket_ml)
+                / (self.headspace_ml + added_ml))
+                .powf(mode.exponent),
+            _ => 1.0,
+        }
+    }
+}
+
+/// The line of ln f against ln(H + added) and its residual sum of squares.
+fn line_at(points: &[(f64, f64)], headspace_ml: f64) -> Option<(Line, f64)> {
+    let logs: Vec<(f64, f64)> = points
+        .iter()
+        .map(|&(added_ml, hz)| ((headspace_ml + added_ml).ln(), hz.ln()))
+        .collect();
+    let line = Line::through(&logs)?;
+    let residual = logs.iter().map(|&(x, y)| (y - line.at(x)).powi(2)).sum();
+    Some((line, residual))
+}
+
+fn mode_law(points: &[(f64, f64)], headspace_ml: f64, pocket_ml: f64) -> Option<ModeLaw> {
+    let (line, _) = line_at(points, headspace_ml)?;
+    Some(ModeLaw {
+        exponent: -line.slope,
+        exponent_error: line.slope_error,
+        full_hz: line.at((headspace_ml + pocket_ml).ln()).exp(),
+        units: points.len(),
+    })
+}
+
+/// The law of units whose modes ring at `points[k]` = (C − V_i, f_i) for mode k, in a bottle
+/// whose pocket is `pocket_ml`.
+pub fn fit_law(points: [&[(f64, f64)]; 2], pocket_ml: f64) -> HeadspaceLaw {
+    let default_ml = Constant::Headspace.range().default;
+    let at_default = points.map(|p| mode_law(p, default_ml, pocket_ml));
+    // H is heard in the mode that follows the air most clearly.
+    let leading = (0..2)
+        .filter(|&k| at_default[k].is_some_and(|m| m.exponent_error > 0.0))
+        .max_by(|&a, &b| {
+            let t = |k: usize| {
+                let mode: ModeLaw = at_default[k].expect("filtered");
+                mode.exponent.abs() / mode.exponent_error
+            };
+            t(a).total_cmp(&t(b))
+        });
+    let mut law = HeadspaceLaw {
+        headspace_ml: default_ml,
+        allowed_ml: None,
+        headspace_heard: false,
+        modes: at_default,
+        pocket_ml,
+    };
+    let Some(leading) = leading else {
+        return law;
+    };
+    let data = points[leading];
+    let (lowest, highest) = data.iter().fold((f64::INFINITY, 0f64), |(l, h), p| {
+        (l.min(p.0), h.max(p.0))
+    });
+    let span = (highest - lowest).max(highest).max(1e-3);
+    let range = Constant::Headspace.range();
+    let first = (span * 10f64.powf(-0.5 * GRID_DECADES)).max(range.min);
+    let grid: Vec<(f64, f64)> = (0..GRID_STEPS)
+        .map(|i| first * 10f64.powf(GRID_DECADES * i as f64 / (GRID_STEPS - 1) as f64))
+        .filter(|h| *h <= range.max)
+        .filter_map(|h| line_at(data, h).map(|(_, residual)| (h, residual)))
+        .collect();
+    let Some(&(best_ml, best_residual)) = grid.iter().min_by(|a, b| a.1.total_cmp(&b.1)) else {
+        return law;
+    };
+    let n = data.len() as f64;
+    // A perfect fit (no noise at all) allows only the best H.
+    let floor = best_residual.max(1e-300);
+    let allowed: Vec<f64> = grid
+        .iter()
+        .filter(|(_, residual)| n * (residual.max(1e-300) / floor).ln() <= CHI2_1_95)
+        .map(|(h, _)| *h)
+        .collect();
+    let allowed_ml = (allowed[0], allowed[allowed.len() - 1]);
+    let default_residual = line_at(data, default_ml).map_or(f64::INFINITY, |(_, r)| r);
+    let rejects_default = n * (default_residual.max(1e-300) / floor).ln() > CHI2_1_95;
+    law.allowed_ml = Some(allowed_ml);
+    if rejects_default && at_default[leading].is_some_and(|m| m.follows()) {
+        law.headspace_ml = best_ml;
+        law.headspace_heard = true;
+        law.modes = points.map(|p| mode_law(p, best_ml, pocket_ml));
+    }
+    law
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A Helmholtz mode (γ = ½) over a cavity of `h` ml, a pocket of 5 ml a glug, and a mode
+    /// that stays put.
+    fn bottle(h: f64, glugs: usize) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+        let added: Vec<f64> = (1..=glugs).map(|i| 5.0 * i as f64).collect();
+        // A small deterministic scatter, so that the lines have an error.
+        let wobble = |i: usize| 1.0 + 0.004 * ((i * 7919) % 13) as f64 / 13.0 - 0.002;
+        let low = added
+            .iter()
+            .enumerate()
+            .map(|(i, &a)| (a, 200.0 * (h / (h + a)).sqrt() * wobble(i)))
+            .collect();
+        let high = added
+            .iter()
+            .enumerate()
+            .map(|(i, &a)| (a, 1150.0 * wobble(i + 3)))
+            .collect();
+        (low, high)
+    }
+
+    #[test]
+    fn a_helmholtz_cavity_gives_a_half_and_its_headspace() {
+        let (low, high) = bottle(6.0, 24);
+        let law = fit_law([&low, &high], 5.0);
+        assert!(law.headspace_heard, "{law:?}");
+        let mode = law.modes[0].unwrap();
+        assert!((mode.exponent - 0.5).abs() < 0.03, "{law:?}");
+        assert!((law.headspace_ml / 6.0 - 1.0).abs() < 0.15, "{law:?}");
+        // The first glug, one pocket poured, at 200·√(6/11) Hz.
+        let first_hz = 200.0 * (6.0f64 / 11.0).sqrt();
+        assert!((mode.full_hz / first_hz - 1.0).abs() < 0.02, "{law:?}");
+        assert!(!law.modes[1].unwrap().follows(), "{law:?}");
+        assert_eq!(law.factor(1, 50.0), 1.0);
+    }
+
+    #[test]
+    fn constant_modes_follow_nothing_and_keep_the_default_headspace() {
+        let (_, high) = bottle(6.0, 24);
+        let law = fit_law([&high, &high], 5.0);
+        assert!(!law.heard());
+        assert!(!law.headspace_heard);
+        assert_eq!(law.headspace_ml, Constant::Headspace.range().default);
+    }
+}
