@@ -22,8 +22,7 @@ fn each_units_frequencies_follow_the_air_above_its_liquid() {
         let air_ml = headspace_ml + 300.0 - onset.volume_ml;
         for (k, exponent) in exponents.into_iter().enumerate() {
             // Quoted at a full bottle's first glug: one pocket (5 ml) poured.
-            let expected =
-                config.frequency_hz[k] * ((headspace_ml + 5.0) / air_ml).powf(exponent);
+            let expected = config.frequency_hz[k] * ((headspace_ml + 5.0) / air_ml).powf(exponent);
             let got = onset.shape.frequency_hz[k];
             assert!(
                 (got / expected - 1.0).abs() < 1e-12,
@@ -71,6 +70,11 @@ fn the_frequency_spread_draws_on_top_of_the_law_and_moves_no_other_draw() {
 #[test]
 fn exponents_of_0_leave_every_unit_as_the_paper_has_it_whatever_the_headspace() {
     let (default, _) = pour_onsets(48_000.0, ModelConfig::default(), |_| tilt_only(135.0), 5.0);
-    let (still, _) = pour_onsets(48_000.0, with_law([0.0, 0.0], 0.001), |_| tilt_only(135.0), 5.0);
+    let (still, _) = pour_onsets(
+        48_000.0,
+        with_law([0.0, 0.0], 0.001),
+        |_| tilt_only(135.0),
+        5.0,
+    );
     assert_eq!(default, still);
 }

@@ -245,9 +245,14 @@ fn a_clip_alone_is_fitted_with_every_output() {
         rows.iter().all(|row| row.starts_with("clip.wav,")),
         "{units}"
     );
+    // `used` and `reason` are the 9th and 10th columns; a used unit's volume and its model's
+    // frequencies follow.
     assert!(
-        rows.iter().any(|row| row.ends_with(",1,")),
-        "no used unit has an empty reason: {units}"
+        rows.iter().any(|row| {
+            let cells: Vec<&str> = row.split(',').collect();
+            cells[8] == "1" && cells[9].is_empty() && !cells[10].is_empty()
+        }),
+        "no used unit has an empty reason and a volume: {units}"
     );
     let json: serde_json::Value = serde_json::from_slice(&output.stdout).expect("one JSON object");
     let (detected, used) = (

@@ -1,8 +1,8 @@
 //! A glass bottle emptying, from a physical model that is not Sake Glug's, written here from the
 //! acoustics alone (no code of the engine). The bottle starts at `start_ml` of its capacity C;
-//! each glug lets one air pocket of b ml (± a uniform jitter) in, so the liquid volume V falls
-//! by one pocket a glug, and the air above the liquid is V_air = H + C − V, H the full bottle's
-//! headspace. Each glug strikes two modes, both e^(−Bτ)·sin(2πfτ) from its onset:
+//! a pocket of liquid of b ml (± a uniform jitter) pours out, and the air that replaces it enters
+//! as a glug, so the liquid volume V falls by one pocket a glug, and the air above the liquid as
+//! a glug sounds is V_air = H + C − V (its own pocket in), H the full bottle's headspace. Each glug strikes two modes, both e^(−Bτ)·sin(2πfτ) from its onset:
 //! - the **cavity**: the air above the liquid and the neck are a Helmholtz resonator,
 //!   f = (c/2π)·√(A/(V_air·L_eff)), A = πr² the neck's bore, L_eff = L + 1.7·r its length with
 //!   an end correction of 0.85·r at each end; so f ∝ V_air^(−1/2) falls from glug to glug;
@@ -143,7 +143,8 @@ impl Params {
             sample_rate,
             capacity_ml,
             start_ml: capacity_ml,
-            headspace_ml: air_ml,
+            // The first glug's air holds its own pocket.
+            headspace_ml: air_ml - pocket_ml,
             neck_radius_m,
             neck_length_m: neck_length_m(first_hz, air_ml, neck_radius_m),
             glugs,
@@ -169,12 +170,12 @@ impl Params {
     }
 
     /// A short clip: 5 glugs of 40 ml from a full 300 ml bottle (the fit's default capacity) at
-    /// about 8 a second, the cavity falling from 194 Hz to 86 Hz (through a 4 mm neck), decaying
+    /// about 8 a second, the cavity falling from 194 Hz to 90 Hz (through a 4 mm neck), decaying
     /// at 25 /s; the bubble rising from 1.1 kHz to 1.35 kHz over the glugs, ringing 30 to 60 ms
     /// to −40 dB, with the share of the amplitude that gives it 38 % of a glug's energy.
     pub fn short_clip(sample_rate: f64) -> Params {
         let (capacity_ml, glugs, pocket_ml, first_hz, last_hz): (f64, usize, f64, f64, f64) =
-            (300.0, 5, 40.0, 194.0, 86.0);
+            (300.0, 5, 40.0, 194.0, 90.0);
         let air_ml = first_air_ml(first_hz, last_hz, glugs, pocket_ml);
         let neck_radius_m = 0.004;
         let (bubble_first_hz, bubble_last_hz) = (1100.0, 1350.0);
@@ -186,7 +187,7 @@ impl Params {
             sample_rate,
             capacity_ml,
             start_ml: capacity_ml,
-            headspace_ml: air_ml,
+            headspace_ml: air_ml - pocket_ml,
             neck_radius_m,
             neck_length_m: neck_length_m(first_hz, air_ml, neck_radius_m),
             glugs,
@@ -223,9 +224,9 @@ pub struct Simulated {
     pub samples: Vec<f32>,
     /// The onsets (s).
     pub onsets: Vec<f64>,
-    /// The liquid in the bottle before each glug, V_i (ml).
+    /// The liquid in the bottle as each glug sounds, its pocket of liquid poured, V_i (ml).
     pub volume_ml: Vec<f64>,
-    /// Each glug's pocket (ml): V_(i+1) = V_i − b_i.
+    /// Each glug's pocket (ml): V_i = V_(i−1) − b_i.
     pub pocket_ml: Vec<f64>,
     /// The air above the liquid at each glug, H + C − V_i (ml).
     pub air_ml: Vec<f64>,
@@ -259,10 +260,11 @@ pub struct Simulated {
     pub low_mode_share: f64,
     /// The bubble's share of the glugs' energy, each mode ringing alone: ΣE_bubble/ΣE.
     pub bubble_energy_share: f64,
-    /// When the liquid stops (s): one interval (the next drawn) after the last glug.
+    /// When the liquid stops (s): at the last glug, whose pocket of liquid has then poured.
     pub flow_end_s: f64,
-    /// The true liquid volume (time s, ml) at the log's rate: V falls linearly from each glug's
-    /// V_i to the next one's, by the last pocket over one more interval after the last glug.
+    /// The true liquid volume (time s, ml) at the log's rate: V falls linearly from the start
+    /// volume at 0 s to the first glug's V_1 and from each glug's V_i to the next one's, then
+    /// stays.
     pub weight_log: Vec<(f64, f64)>,
 }
 
@@ -352,6 +354,8 @@ pub fn simulate(params: &Params) -> Simulated {
         let interval = (1.0 + params.timing_jitter * draws.signed()) / params.rate_per_s;
         let decay = params.bubble_decay * params.bubble_decay_spread.powf(draws.signed());
         let jitter = 1.0 + params.level_jitter * draws.signed();
+        // The pocket's liquid has poured; its air enters as the glug.
+        volume -= pocket;
         let air = params.headspace_ml + params.capacity_ml - volume;
         let along = if params.glugs > 1 {
             glug as f64 / (params.glugs - 1) as f64
@@ -370,11 +374,10 @@ pub fn simulate(params: &Params) -> Simulated {
         bubble_hz.push(minnaert_hz(params.bubble_radius_m) * (1.0 + params.bubble_rise * along));
         bubble_decay.push(decay);
         level.push((1.0 - params.amplitude_fall * (1.0 - volume / params.capacity_ml)) * jitter);
-        volume -= pocket;
         t += interval;
     }
-    // The liquid stops one interval after the last glug; then the tail.
-    let (flow_end, end_volume) = (t, volume);
+    // The liquid stops with the last glug; then the tail.
+    let flow_end = onsets.last().copied().unwrap_or(LEAD_IN_S);
     let duration = flow_end + params.tail_s;
     let len = (duration * fs) as usize;
     let mut dry = vec![0.0f64; len];
@@ -450,13 +453,10 @@ pub fn simulate(params: &Params) -> Simulated {
         .collect();
     let bubble_total: f64 = bubble_energy.iter().sum();
     let total = bubble_total + cavity_energy.iter().sum::<f64>();
-    // V(t): through each glug's V_i, then the last pocket gone by the end of the flow.
-    let mut knots: Vec<(f64, f64)> = onsets
-        .iter()
-        .copied()
-        .zip(volume_ml.iter().copied())
+    // V(t): from the start volume through each glug's V_i.
+    let knots: Vec<(f64, f64)> = std::iter::once((0.0, params.start_ml))
+        .chain(onsets.iter().copied().zip(volume_ml.iter().copied()))
         .collect();
-    knots.push((flow_end, end_volume));
     let weight_log = if params.log_hz > 0.0 {
         (0..=(duration * params.log_hz) as usize)
             .map(|k| {
@@ -471,7 +471,7 @@ pub fn simulate(params: &Params) -> Simulated {
     let drain_ml_per_s = if glugs > 1 {
         (volume_ml[0] - volume_ml[glugs - 1]) / (onsets[glugs - 1] - onsets[0])
     } else {
-        pocket_ml[0] / (flow_end - onsets[0])
+        pocket_ml[0] / LEAD_IN_S
     };
     Simulated {
         samples,

@@ -4,9 +4,9 @@
 
 mod bad_input;
 mod bubbles;
+mod command;
 mod emptying;
 mod emptying_fit;
-mod command;
 mod real;
 mod round_trip;
 mod simulated;

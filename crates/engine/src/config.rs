@@ -6,8 +6,8 @@
 
 use super::amplitude::{SilentBelow, PAPERS_SILENT_BELOW_ML};
 use super::controls::Control;
-use super::headspace::Headspace;
 use super::curves::{BottleCurves, CurveError, TiltCurve, REFERENCE_TILT_DEG};
+use super::headspace::Headspace;
 use super::quantity::{Knob, Quantity, Range, ValueError};
 
 /// Sample rate fs of a render (Hz).

@@ -19,12 +19,12 @@ pub mod synthesis;
 
 pub use actuator::{ActuatorResponse, Equalise, ResponseError};
 pub use amplitude::{SilentBelow, PAPERS_SILENT_BELOW_ML};
-pub use headspace::Headspace;
 pub use config::{Constant, ConstantSpec, Curve, DrainMode, ModelConfig};
 pub use controls::{
     sample_time_s, Control, ControlSource, ControlSpec, ControlValues, Controls, DeviceInput, Lane,
     LinearSegment, PerControl,
 };
+pub use headspace::Headspace;
 use output::OutputStage;
 use pour::MAX_ONSETS_PER_SAMPLE;
 pub use pour::{Outflow, Pour, PourStats, UnitOnset};

@@ -198,9 +198,10 @@ impl Preset {
                 .iter()
                 .any(|value| matches!(value, K(constant, _) if constant == law))
         });
-        self.values.iter().copied().chain(
-            left_out.map(|constant| K(constant, constant.range().default)),
-        )
+        self.values
+            .iter()
+            .copied()
+            .chain(left_out.map(|constant| K(constant, constant.range().default)))
     }
 
     /// The model's constants: the preset's, the rest (seed, spreads, drain) as `base` has them.

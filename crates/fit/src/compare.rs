@@ -156,10 +156,7 @@ pub fn render_model(model_toml: &str, made: &AsRecorded) -> Result<Vec<f32>, Str
     let mut table: toml::Table =
         toml::from_str(model_toml).map_err(|error| keys::syntax_message(&error, model_toml))?;
     let mut set = |key: &str, value: toml::Value| keys::insert(&mut table, key, value);
-    set(
-        "sample_rate",
-        toml::Value::Integer(made.sample_rate.into()),
-    );
+    set("sample_rate", toml::Value::Integer(made.sample_rate.into()));
     set("duration_s", toml::Value::Float(made.duration_s));
     set(
         Control::Tilt.quantity().scene_key,

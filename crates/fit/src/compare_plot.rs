@@ -197,7 +197,11 @@ fn draw_pitch_panel(
             .label(label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
         chart
-            .draw_series(track.into_iter().map(|p| Circle::new(p, 4, colour.filled())))
+            .draw_series(
+                track
+                    .into_iter()
+                    .map(|p| Circle::new(p, 4, colour.filled())),
+            )
             .map_err(|x| e(&x))?;
     }
     chart
@@ -227,7 +231,10 @@ fn draw_measures_panel(panel: &Canvas<'_>, comparison: &Comparison) -> Result<()
             ["recording", "model", "default"].map(str::to_owned),
         ),
         ("glugs".into(), each(&|h| h.onsets_s.len().to_string())),
-        ("glugs a second".into(), each(&|h| format!("{:.1}", h.rate_per_s))),
+        (
+            "glugs a second".into(),
+            each(&|h| format!("{:.1}", h.rate_per_s)),
+        ),
         (
             format!("pitch fall over {glugs} glugs"),
             each(&|h| format!("{:.2}×", h.fall_over(glugs))),

@@ -13,6 +13,10 @@ const Z_95: f64 = 1.959_963_984_540_054;
 /// χ²(1) at 95 %: the H whose residual exceeds the best's by less than this (as n·ln of their
 /// ratio, the profile likelihood of a normal error) are those the data allow.
 const CHI2_1_95: f64 = 3.841_458_820_694_124;
+/// A mode follows the headspace only where the law moves its pitch by at least this share over
+/// the units' volumes (10 %, nearly two semitones): a drift smaller than that, however
+/// significant, is a fit's bias with its amplitude, not a bottle's pitch.
+const MIN_PITCH_CHANGE: f64 = 0.1;
 /// The grid of H, in steps of 2 % over [`GRID_DECADES`] decades around the volumes' span.
 const GRID_STEPS: usize = 351;
 const GRID_DECADES: f64 = 7.0;
@@ -28,14 +32,20 @@ pub struct ModeLaw {
     pub full_hz: f64,
     /// The units it comes from.
     pub units: usize,
+    /// How far the law moves the pitch over the units' volumes: the largest air over the least.
+    pub air_ratio: f64,
 }
 
 impl ModeLaw {
-    /// Whether the mode's frequency moves measurably with the headspace.
+    /// Whether the mode's frequency moves measurably and audibly with the headspace.
     pub fn follows(&self) -> bool {
-        self.exponent.abs() > Z_95 * self.exponent_error
+        self.exponent.abs() > Z_95 * self.exponent_error && self.pitch_change() >= MIN_PITCH_CHANGE
     }
 
+    /// The share by which the law moves the pitch over the units' volumes.
+    pub fn pitch_change(&self) -> f64 {
+        (self.exponent.abs() * self.air_ratio.ln()).exp() - 1.0
+    }
 }
 
 /// The law of a liquid's units.
@@ -85,11 +95,15 @@ fn line_at(points: &[(f64, f64)], headspace_ml: f64) -> Option<(Line, f64)> {
 
 fn mode_law(points: &[(f64, f64)], headspace_ml: f64, pocket_ml: f64) -> Option<ModeLaw> {
     let (line, _) = line_at(points, headspace_ml)?;
+    let (least, most) = points
+        .iter()
+        .fold((f64::INFINITY, 0f64), |(l, m), p| (l.min(p.0), m.max(p.0)));
     Some(ModeLaw {
         exponent: -line.slope,
         exponent_error: line.slope_error,
         full_hz: line.at((headspace_ml + pocket_ml).ln()).exp(),
         units: points.len(),
+        air_ratio: (headspace_ml + most) / (headspace_ml + least),
     })
 }
 
@@ -119,9 +133,9 @@ pub fn fit_law(points: [&[(f64, f64)]; 2], pocket_ml: f64) -> HeadspaceLaw {
         return law;
     };
     let data = points[leading];
-    let (lowest, highest) = data.iter().fold((f64::INFINITY, 0f64), |(l, h), p| {
-        (l.min(p.0), h.max(p.0))
-    });
+    let (lowest, highest) = data
+        .iter()
+        .fold((f64::INFINITY, 0f64), |(l, h), p| (l.min(p.0), h.max(p.0)));
     let span = (highest - lowest).max(highest).max(1e-3);
     let range = Constant::Headspace.range();
     let first = (span * 10f64.powf(-0.5 * GRID_DECADES)).max(range.min);
@@ -157,9 +171,12 @@ pub fn fit_law(points: [&[(f64, f64)]; 2], pocket_ml: f64) -> HeadspaceLaw {
 mod tests {
     use super::*;
 
+    /// Each glug's (C − V, f) of one mode.
+    type Points = Vec<(f64, f64)>;
+
     /// A Helmholtz mode (γ = ½) over a cavity of `h` ml, a pocket of 5 ml a glug, and a mode
     /// that stays put.
-    fn bottle(h: f64, glugs: usize) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+    fn bottle(h: f64, glugs: usize) -> (Points, Points) {
         let added: Vec<f64> = (1..=glugs).map(|i| 5.0 * i as f64).collect();
         // A small deterministic scatter, so that the lines have an error.
         let wobble = |i: usize| 1.0 + 0.004 * ((i * 7919) % 13) as f64 / 13.0 - 0.002;

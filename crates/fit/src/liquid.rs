@@ -376,18 +376,20 @@ fn check_headspace(estimates: &mut [Estimate], law: &HeadspaceLaw) {
         .enumerate()
     {
         let key = constant.quantity().scene_key;
-        let (Some(estimate), Some(mode)) = (estimates.iter_mut().find(|e| e.key == key), law.modes[k])
+        let (Some(estimate), Some(mode)) =
+            (estimates.iter_mut().find(|e| e.key == key), law.modes[k])
         else {
             continue;
         };
         if estimate.has_value() && !mode.follows() {
             estimate.in_model = false;
             estimate.note = Some(format!(
-                "f{} does not move measurably with the headspace (γ = {:.3} ± {:.3}): kept at 0, \
-                 the paper's constant frequency",
+                "f{} does not move measurably with the headspace (γ = {:.3} ± {:.3}, {:.1} % \
+                 over the units' volumes): kept at 0, the paper's constant frequency",
                 k + 1,
                 mode.exponent,
-                Z_95 * mode.exponent_error
+                Z_95 * mode.exponent_error,
+                100.0 * mode.pitch_change()
             ));
         }
     }

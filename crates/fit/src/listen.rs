@@ -10,15 +10,17 @@ use super::spectrum::Spectrum;
 
 /// The envelope's frame (s).
 const FRAME_S: f64 = 0.005;
-/// A glug's envelope rises by this factor (6 dB in energy) from the quietest frame since the last
-/// glug…
-const RISE: f64 = 4.0;
-/// …to at least this share of the loudest frame (−40 dB)…
-const ABOVE_LOUDEST: f64 = 1e-4;
-/// …and this many times the noise (20 dB: the quietest tenth of the frames that are not digital
-/// silence), a gate never set higher than [`NOISE_GATE_CAP`] of the loudest frame, so that a pour
-/// whose glugs never fall quiet keeps every glug…
-const ABOVE_NOISE: f64 = 100.0;
+/// A glug's envelope rises by this factor (3 dB in energy) from the quietest frame since the last
+/// glug's peak (a glug joining one that still rings may add little more)…
+const RISE: f64 = 2.0;
+/// …to at least this share of the loudest frame (−30 dB: what stands out of a pour, not the
+/// small bubbles and the codec's noise between its glugs)…
+const ABOVE_LOUDEST: f64 = 1e-3;
+/// …and this many times the noise (12 dB, as the fit's onsets ask: the noise the quietest tenth
+/// of the frames that are not digital silence), a gate never set higher than
+/// [`NOISE_GATE_CAP`] of the loudest frame, so that a pour whose glugs never fall quiet keeps
+/// every glug…
+const ABOVE_NOISE: f64 = 16.0;
 const NOISE_GATE_CAP: f64 = 1e-2;
 /// …above the loudest of the [`PRIOR_FRAMES`] frames before it by [`PRIOR_RISE`] (a decaying
 /// ring whose modes beat swells back to where it just was, a new glug rises past it)…
@@ -99,7 +101,7 @@ pub fn hear(samples: &[f32], sample_rate: f64, split_hz: f64) -> Heard {
 /// quietest since the last glug's peak, at least [`MIN_GLUG_S`] after it, each placed at the
 /// frame where its attack began. Until a glug's envelope has peaked and begun to fall, no new glug
 /// starts: its own attack and the modes that join it are part of it.
-fn glug_onsets(samples: &[f32], sample_rate: f64) -> Vec<usize> {
+pub(crate) fn glug_onsets(samples: &[f32], sample_rate: f64) -> Vec<usize> {
     let frame = ((FRAME_S * sample_rate) as usize).max(1);
     let energy: Vec<f64> = samples
         .chunks(frame)
@@ -170,7 +172,9 @@ fn low_pitch(samples: &[f32], sample_rate: f64, split_hz: f64) -> f64 {
         .chain(std::iter::repeat(Complex::new(0.0, 0.0)))
         .take(padded)
         .collect();
-    FftPlanner::new().plan_fft_forward(padded).process(&mut buffer);
+    FftPlanner::new()
+        .plan_fft_forward(padded)
+        .process(&mut buffer);
     let bin_hz = sample_rate / padded as f64;
     let (first, last) = (
         (LOWEST_PITCH_HZ / bin_hz).ceil() as usize,
@@ -277,9 +281,21 @@ mod tests {
         let fs = 44_100.0;
         let heard = hear(&glugs(9.0, 8, 2.0, fs), fs, 600.0);
         assert_eq!(heard.onsets_s.len(), 8, "{:?}", heard.onsets_s);
-        assert!((heard.rate_per_s / 9.0 - 1.0).abs() < 0.03, "{}", heard.rate_per_s);
-        assert!((heard.fall_over(8) / 2.0 - 1.0).abs() < 0.1, "{:?}", heard.pitch_hz);
-        assert!((0.02..0.5).contains(&heard.high_share), "{}", heard.high_share);
+        assert!(
+            (heard.rate_per_s / 9.0 - 1.0).abs() < 0.03,
+            "{}",
+            heard.rate_per_s
+        );
+        assert!(
+            (heard.fall_over(8) / 2.0 - 1.0).abs() < 0.1,
+            "{:?}",
+            heard.pitch_hz
+        );
+        assert!(
+            (0.02..0.5).contains(&heard.high_share),
+            "{}",
+            heard.high_share
+        );
         let dull = hear(&glugs(9.0, 8, 1.0, fs), fs, 600.0);
         assert!((dull.fall_over(8) - 1.0).abs() < 0.05);
     }

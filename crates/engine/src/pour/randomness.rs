@@ -72,10 +72,9 @@ impl UnitDraws {
         };
         // Skipped without the law, so that its frequencies are exactly the paper's.
         if config.headspace.is_active() {
-            let factors =
-                config
-                    .headspace
-                    .factors(volume_ml, config.capacity_ml, config.pocket_ml);
+            let factors = config
+                .headspace
+                .factors(volume_ml, config.capacity_ml, config.pocket_ml);
             for (f, factor) in shape.frequency_hz.iter_mut().zip(factors) {
                 *f *= factor;
             }
@@ -135,7 +134,10 @@ mod tests {
                 plain.next_pocket_ml(&still),
                 spreading.next_pocket_ml(&spread)
             );
-            let (a, b) = (plain.next_unit(&still, 300.0), spreading.next_unit(&spread, 300.0));
+            let (a, b) = (
+                plain.next_unit(&still, 300.0),
+                spreading.next_unit(&spread, 300.0),
+            );
             assert_eq!(
                 (a.frequency_hz, a.decay_per_s),
                 (b.frequency_hz, b.decay_per_s)

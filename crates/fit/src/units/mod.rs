@@ -15,10 +15,12 @@
 mod eq1;
 mod modes;
 mod phased;
+mod second_mode;
 mod window;
 
 use std::f64::consts::TAU;
 
+use super::listen::glug_onsets;
 use super::onsets::detect_onsets;
 use super::spectrum::{own_peaks, Spectrum};
 pub use modes::Modes;
@@ -422,6 +424,29 @@ impl Strides {
     }
 }
 
+/// A detected onset stands for a glug only within this of where the envelope shows one (s).
+const GLUG_MATCH_S: f64 = 0.025;
+
+/// The onsets (samples) that stand for a glug: for each glug the envelope shows (`glugs`), the
+/// detected onset nearest it within [`GLUG_MATCH_S`]. The detector places an onset to the
+/// sample but also rises where a glug's own modes beat or a second bubble joins it; the envelope
+/// tells a glug from its parts, so no glug is split into several units.
+fn one_per_glug(detected: &[usize], glugs: &[usize], fs: f64) -> Vec<usize> {
+    let reach = (GLUG_MATCH_S * fs) as usize;
+    let mut kept: Vec<usize> = glugs
+        .iter()
+        .filter_map(|&glug| {
+            detected
+                .iter()
+                .copied()
+                .filter(|&onset| onset.abs_diff(glug) <= reach)
+                .min_by_key(|&onset| onset.abs_diff(glug))
+        })
+        .collect();
+    kept.dedup();
+    kept
+}
+
 /// Finds and fits every unit of `samples` (DC removed) at `sample_rate`.
 pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
     let fs = sample_rate as f64;
@@ -435,7 +460,11 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
         [only] => ([only / RATIO, *only], true),
         _ => ([80.0, 300.0], true),
     };
-    let onsets = detect_onsets(samples, fs, start_hz[0]);
+    let onsets = one_per_glug(
+        &detect_onsets(samples, fs, start_hz[0]),
+        &glug_onsets(samples, fs),
+        fs,
+    );
     let mut residual = samples.to_vec();
     let mut units = Vec::with_capacity(onsets.len());
     let mut detected = Vec::with_capacity(onsets.len());
@@ -492,34 +521,44 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
 }
 
 /// The unit `span` holds: eq. 1 if it describes it, else a phased fit from its own peaks, else
-/// the same in the first part of the span; or why none does, with the best fit rejected.
+/// the same in the first part of the span; or why none does, with the best fit rejected. A unit
+/// kept with one component gets the short second mode its fit left out, where there is one (a
+/// unit rejected stays rejected: a second mode found in what a fit could not explain would make
+/// a babble of bubbles look like a glug).
 fn fit_unit(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<UnitFit, Failed> {
-    // The stronger component must lie at the strongest peak of the samples it was fitted to, read
-    // as the fit read them (every stride-th: a spectrum up to 8 samples a period of 1.3 times the
-    // highest start); a peak beyond that folds elsewhere and fails the check, and the fits from
-    // the unit's own peaks (found in every sample) then read at strides set by those peaks.
-    let at_peak = |unit: UnitFit| -> Result<UnitFit, Failed> {
-        let read: Vec<f64> = span.samples[..unit.window.1 - span.first]
-            .iter()
-            .step_by(unit.stride)
-            .copied()
-            .collect();
-        let rate = span.fs / unit.stride as f64;
-        let peak_hz = own_peaks(&read, rate).first().map_or(f64::NAN, |p| p.0);
-        let component_hz = unit.stronger().map_or(f64::NAN, |c| c.heard_hz);
-        let tolerance = (AT_PEAK_SHARE * peak_hz).max(rate / read.len() as f64);
-        if (component_hz - peak_hz).abs() <= tolerance {
-            Ok(unit)
-        } else {
-            Err(Box::new((
-                Rejection::OffPeak {
-                    component_hz,
-                    peak_hz,
-                },
-                Some(unit),
-            )))
-        }
-    };
+    fit_one_way(span, start_hz, strides).map(|unit| second_mode::with_second_mode(span, unit))
+}
+
+/// The stronger component of `unit` must lie at the strongest peak of the samples it was fitted
+/// to, read as the fit read them (every stride-th: a spectrum up to 8 samples a period of 1.3
+/// times the highest start); a peak beyond that folds elsewhere and fails the check, and the fits
+/// from the unit's own peaks (found in every sample) then read at strides set by those peaks.
+fn at_peak(span: &Span, unit: UnitFit) -> Result<UnitFit, Failed> {
+    let read: Vec<f64> = span.samples[..unit.window.1 - span.first]
+        .iter()
+        .step_by(unit.stride)
+        .copied()
+        .collect();
+    let rate = span.fs / unit.stride as f64;
+    let peak_hz = own_peaks(&read, rate).first().map_or(f64::NAN, |p| p.0);
+    let component_hz = unit.stronger().map_or(f64::NAN, |c| c.heard_hz);
+    let tolerance = (AT_PEAK_SHARE * peak_hz).max(rate / read.len() as f64);
+    if (component_hz - peak_hz).abs() <= tolerance {
+        Ok(unit)
+    } else {
+        Err(Box::new((
+            Rejection::OffPeak {
+                component_hz,
+                peak_hz,
+            },
+            Some(unit),
+        )))
+    }
+}
+
+/// [`fit_unit`] without the second mode.
+fn fit_one_way(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<UnitFit, Failed> {
+    let at_peak = |unit: UnitFit| at_peak(span, unit);
     let paper = eq1::fit(span, start_hz, strides)
         .map_err(|rejection| Box::new((rejection, None)))
         .and_then(at_peak);
