@@ -125,11 +125,27 @@ fn a_state_with_an_actuator_reloads_to_the_same_bytes_and_samples() {
     }
 }
 
-/// The state a fresh instance saved before actuators (written by the plugin at main e888c234).
+/// A state fixture of tests/fixtures/state.
+fn state_fixture(name: &str) -> Vec<u8> {
+    std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/state").join(name))
+        .unwrap()
+}
+
+/// The state a fresh instance saves today: written by the plugin once the headspace law's
+/// parameters came (issue 36; `SAKE_GLUG_WRITE_STATE=1` writes it anew, as a change of the
+/// state's format must be deliberate).
 fn todays_state() -> Vec<u8> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/state/v1-before-actuators.state");
-    std::fs::read(path).unwrap()
+    if std::env::var_os("SAKE_GLUG_WRITE_STATE").is_some() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/fixtures/state/v2-headspace-law.state");
+        std::fs::write(path, ClapInstance::new().save()).unwrap();
+    }
+    state_fixture("v2-headspace-law.state")
+}
+
+/// The state a fresh instance saved before actuators (written by the plugin at main e888c234).
+fn state_before_actuators() -> Vec<u8> {
+    state_fixture("v1-before-actuators.state")
 }
 
 #[test]
@@ -140,6 +156,11 @@ fn a_state_without_an_actuator_is_todays_and_clears_one() {
     assert_ne!(with_one.save(), todays_state());
     assert!(with_one.load(&todays_state()));
     assert_eq!(with_one.save(), todays_state(), "the actuator is gone");
+    // A state from before actuators and before the headspace law loads as today's fresh one: no
+    // actuator, the parameters added since at their defaults.
+    let mut with_one = with_actuator("lra", true);
+    assert!(with_one.load(&state_before_actuators()));
+    assert_eq!(with_one.save(), todays_state(), "an older state loads as today's");
     let mut fresh = fresh;
     assert_eq!(bounce(&mut with_one, 512), bounce(&mut fresh, 512));
 }

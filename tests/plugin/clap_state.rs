@@ -7,6 +7,7 @@ use std::path::Path;
 use serde_json::Value;
 
 use crate::clap_host::ClapInstance;
+use sake_glug_engine::HEADSPACE_LAW;
 
 /// The JSON inside saved bytes (the CLAP wrapper prefixes its length).
 fn json(bytes: &[u8]) -> Value {
@@ -50,7 +51,31 @@ fn a_state_saved_before_state_versions_loads_with_the_same_values() {
     let instance = ClapInstance::new();
     assert!(instance.load(&old));
     let now = json(&instance.save());
-    assert_eq!(now["params"], old_json["params"], "every parameter value");
+    let (now_params, old_params) = (
+        now["params"].as_object().unwrap(),
+        old_json["params"].as_object().unwrap(),
+    );
+    for (id, value) in old_params {
+        assert_eq!(&now_params[id], value, "parameter {id}");
+    }
+    // The parameters added since (the headspace law, MODEL.md §5.1) load at their defaults.
+    let added: Vec<&String> = now_params
+        .keys()
+        .filter(|id| !old_params.contains_key(*id))
+        .collect();
+    let law: Vec<&str> = HEADSPACE_LAW
+        .iter()
+        .map(|constant| constant.quantity().param_id)
+        .collect();
+    assert_eq!(added.len(), law.len(), "{added:?}");
+    for constant in HEADSPACE_LAW {
+        let id = constant.quantity().param_id;
+        assert_eq!(
+            now_params[id]["f32"].as_f64(),
+            Some(constant.range().default),
+            "{id}"
+        );
+    }
     for (field, value) in old_json["fields"].as_object().unwrap() {
         assert_eq!(&now["fields"][field], value, "field {field}");
     }

@@ -9,7 +9,7 @@ use crate::fuzz::checks::{assert_saved_state_valid, bytes_of, float_quantity, js
 use sake_glug_engine::config;
 
 /// Every parameter, by the name a host lists, with a value other than its default.
-const CHANGED: [(&str, &str); 17] = [
+const CHANGED: [(&str, &str); 20] = [
     ("Tilt", "131.25"),
     ("Viscosity", "0.123"),
     ("Fill level", "93.5"),
@@ -24,6 +24,9 @@ const CHANGED: [(&str, &str); 17] = [
     ("Timing spread", "0.2"),
     ("Frequency spread", "0.075"),
     ("Decay spread", "0.4"),
+    ("Headspace", "45.5"),
+    ("f1 headspace exponent", "0.5"),
+    ("f2 headspace exponent", "-0.25"),
     ("Seed", "123"),
     ("Drain mode", "Follow"),
     ("Output ceiling", "-0.5"),
@@ -153,7 +156,7 @@ fn a_float_out_of_range_loads_clamped_and_one_not_finite_as_the_default() {
         .filter(|(_, value)| value.get("f32").is_some())
         .map(|(id, _)| id.clone())
         .collect();
-    assert_eq!(floats.len(), 15, "every float parameter");
+    assert_eq!(floats.len(), 18, "every float parameter");
     // The saved f32, read back as one (JSON holds its shortest decimal).
     let f32_of = |value: serde_json::Value| value["f32"].as_f64().map(|v| v as f32);
     for id in &floats {
