@@ -127,8 +127,12 @@ fn a_state_with_an_actuator_reloads_to_the_same_bytes_and_samples() {
 
 /// A state fixture of tests/fixtures/state.
 fn state_fixture(name: &str) -> Vec<u8> {
-    std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/state").join(name))
-        .unwrap()
+    std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/fixtures/state")
+            .join(name),
+    )
+    .unwrap()
 }
 
 /// The state a fresh instance saves today: written by the plugin once the headspace law's
@@ -160,7 +164,11 @@ fn a_state_without_an_actuator_is_todays_and_clears_one() {
     // actuator, the parameters added since at their defaults.
     let mut with_one = with_actuator("lra", true);
     assert!(with_one.load(&state_before_actuators()));
-    assert_eq!(with_one.save(), todays_state(), "an older state loads as today's");
+    assert_eq!(
+        with_one.save(),
+        todays_state(),
+        "an older state loads as today's"
+    );
     let mut fresh = fresh;
     assert_eq!(bounce(&mut with_one, 512), bounce(&mut fresh, 512));
 }
