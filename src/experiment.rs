@@ -230,8 +230,12 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         expect(unused_mut, reason = "the player takes the samples")
     )]
     let mut rendered = render_stimuli(&spec, sample_rate).map_err(usage)?;
+    let practice = match spec.practice {
+        0 => String::new(),
+        count => format!(" after {count} practice trials"),
+    };
     println!(
-        "{} design, {} trials, order seed {seed}, equalize {} ({} Hz):",
+        "{} design, {} trials{practice}, order seed {seed}, equalize {} ({} Hz):",
         spec.design.name(),
         trials.len(),
         spec.equalize.name(),
@@ -262,7 +266,11 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
     let resumed = match (&args.log, args.resume) {
         (Some(log), true) => {
             let (log, done) = TrialLog::resume(log, &session).map_err(usage)?;
-            println!("Resuming after trial {done} of {}.", trials.len());
+            // Counted with the practice trials, which come first.
+            println!(
+                "Resuming after trial {done} of {}.",
+                trials.len() + spec.practice as usize
+            );
             Some((log, done))
         }
         _ => None,

@@ -157,6 +157,12 @@ pub struct Spec {
     pub channels: Channels,
     /// The stimuli; for the constant design the standard first, then the comparisons in order.
     pub stimuli: Vec<Stimulus>,
+    /// What the participant reads before the first trial.
+    pub instructions: Option<String>,
+    /// Practice trials played before the study's, logged as practice (not data).
+    pub practice: u32,
+    /// A pause after every this many of the study's trials, which the participant ends.
+    pub break_every: Option<u32>,
 }
 
 /// The masking noise is uniform white noise: its RMS is its peak over √3, and its peak may
@@ -208,6 +214,13 @@ impl Spec {
         let noise_dbfs: Option<f64> = optional(take("noise_dbfs")?, "noise_dbfs").map_err(bad)?;
         let actuator = optional(take(CHANNELS_ACTUATOR)?, CHANNELS_ACTUATOR).map_err(bad)?;
         let headphones = optional(take(CHANNELS_HEADPHONES)?, CHANNELS_HEADPHONES).map_err(bad)?;
+        let instructions: Option<String> =
+            optional(take("instructions")?, "instructions").map_err(bad)?;
+        let practice: u32 = optional(take("practice")?, "practice")
+            .map_err(bad)?
+            .unwrap_or(0);
+        let break_every: Option<u32> =
+            optional(take("break_every")?, "break_every").map_err(bad)?;
         let mut section = |key: &str| -> Result<Option<toml::Table>, StudyError> {
             optional(take(key)?, key).map_err(bad)
         };
@@ -230,6 +243,25 @@ impl Spec {
         }
         if repetitions == 0 {
             return Err(bad("`repetitions` = 0: it must be at least 1".into()));
+        }
+        if practice > MAX_PRACTICE {
+            return Err(bad(format!(
+                "`practice` = {practice}: at most {MAX_PRACTICE} practice trials"
+            )));
+        }
+        if break_every == Some(0) {
+            return Err(bad(
+                "`break_every` = 0: a pause after every 1 or more trials (leave it out for none)"
+                    .into(),
+            ));
+        }
+        if instructions
+            .as_deref()
+            .is_some_and(|text| text.trim().is_empty())
+        {
+            return Err(bad(
+                "`instructions` is empty: give the text, or leave the key out".into(),
+            ));
         }
         if let Some(level) = noise_dbfs {
             if !(MIN_NOISE_DBFS..=MAX_NOISE_DBFS).contains(&level) {
@@ -345,6 +377,9 @@ impl Spec {
             noise_dbfs,
             channels,
             stimuli,
+            instructions,
+            practice,
+            break_every,
         })
     }
 }
@@ -357,6 +392,9 @@ const CHANNELS_HEADPHONES: &str = "channels.headphones";
 /// asks of one participant (the paper's are 18 and 90), and a bound on what a session holds in
 /// memory and what its dry run writes (two files a trial).
 pub const MAX_TRIALS: u64 = 10_000;
+
+/// The most practice trials a session may have: practice is a few trials to learn the task.
+pub const MAX_PRACTICE: u32 = 100;
 
 /// Trials in a session of `design` with `stimuli` stimuli (the standard included) presented
 /// `repetitions` times: every ordered pair, or every comparison.

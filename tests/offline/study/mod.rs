@@ -4,6 +4,7 @@
 //! every user (`dry_run.rs`), hostile specs (`hostile_specs.rs`).
 
 mod dry_run;
+mod expectations;
 mod hostile_specs;
 mod log;
 
