@@ -351,13 +351,17 @@ fn estimate_text(estimate: &DiscriminationEstimate, design: DiscriminationDesign
         None => "empty (below chance)".into(),
     };
     format!(
-        "  {} of {} right: {:.3} (exact 95 % [{:.3}, {:.3}]); against chance p = {:.4}\n  d′ =          {} {interval}\n  {}\n",
+        "  {} of {} right: {:.3} (exact 95 % [{:.3}, {:.3}]); against chance {}\n  d′ = {} \
+         {interval}\n  {}\n",
         estimate.correct,
         estimate.trials,
         estimate.proportion,
         estimate.proportion_low,
         estimate.proportion_high,
-        estimate.p_value,
+        match estimate.p_value < 1e-4 {
+            true => "p < 0.0001".to_owned(),
+            false => format!("p = {:.4}", estimate.p_value),
+        },
         d_prime(estimate.d_prime),
         estimate.sentence(design),
     )
