@@ -58,6 +58,8 @@ pub struct LogRow {
     pub second_params: String,
     /// 1 for a practice trial (not data: the analyses leave it out), 0 for the study's.
     pub practice: u8,
+    /// 2AFC: 1 if the target was chosen, else 0 (empty for the other designs).
+    pub correct: Option<u8>,
 }
 
 impl LogRow {
@@ -342,18 +344,22 @@ fn check_row(
     // Compared as written: a level is the spec's number, read back exactly.
     let same_answer = row.answer == planned.answer
         && row.level == planned.level
-        && row.chose_comparison == planned.chose_comparison;
+        && row.chose_comparison == planned.chose_comparison
+        && row.correct == planned.correct;
     if !same_answer {
         return Err(format!(
-            "trial {}: answer {}, key {pressed}, level {:?}, chose_comparison {:?}; key \
-             {pressed} of this trial chooses {} (level {:?}, chose_comparison {:?})",
+            "trial {}: answer {}, key {pressed}, level {:?}, chose_comparison {:?}, correct \
+             {:?}; key {pressed} of this trial chooses {} (level {:?}, chose_comparison {:?}, \
+             correct {:?})",
             row.trial,
             shown(&row.answer),
             row.level,
             row.chose_comparison,
+            row.correct,
             shown(&planned.answer),
             planned.level,
-            planned.chose_comparison
+            planned.chose_comparison,
+            planned.correct
         ));
     }
     if !(row.rt_s.is_finite() && row.rt_s >= 0.0) {
@@ -388,6 +394,7 @@ pub fn header() -> Vec<String> {
             first_params: String::new(),
             second_params: String::new(),
             practice: 0,
+            correct: None,
         })
         .expect("a Vec never fails");
     let bytes = writer.into_inner().expect("a Vec never fails");

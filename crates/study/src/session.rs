@@ -107,10 +107,12 @@ impl StudySession<'_> {
             trial.second
         };
         let (level, chose_comparison) = match self.spec.design {
-            Design::Paired => (None, None),
+            Design::Paired | Design::TwoAfc => (None, None),
             // The standard is stimulus 0; the comparison is the other one.
             Design::Constant => (first.level.or(second.level), Some(u8::from(chosen != 0))),
         };
+        // 2AFC: the target is stimulus 0.
+        let correct = (self.spec.design == Design::TwoAfc).then_some(u8::from(chosen == 0));
         LogRow {
             participant: self.participant.to_owned(),
             trial: place.number,
@@ -130,6 +132,7 @@ impl StudySession<'_> {
             first_params: first.params.clone(),
             second_params: second.params.clone(),
             practice: u8::from(place.practice),
+            correct,
         }
     }
 

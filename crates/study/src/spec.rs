@@ -13,7 +13,7 @@ use sake_glug_io::read::{self, InputKind};
 use sake_glug_io::text::{cut_quotes, quoted};
 use sake_glug_render::{Scene, DEFAULT_SCENE, MAX_DURATION_S};
 
-/// The two designs of the paper's studies.
+/// The designs: the paper's two studies, and discrimination.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Design {
@@ -21,6 +21,10 @@ pub enum Design {
     Paired,
     /// A standard against comparison levels of one control or constant (§4.4).
     Constant,
+    /// Two stimuli, the `target` first in half the trials: which one is the target?
+    /// (two-alternative forced choice; `sake-glug analyze discrimination` reads its log).
+    #[serde(rename = "2afc")]
+    TwoAfc,
 }
 
 impl Design {
@@ -29,6 +33,7 @@ impl Design {
         match self {
             Design::Paired => "paired",
             Design::Constant => "constant",
+            Design::TwoAfc => "2afc",
         }
     }
 }
@@ -155,7 +160,8 @@ pub struct Spec {
     pub noise_dbfs: Option<f64>,
     /// The channel layout.
     pub channels: Channels,
-    /// The stimuli; for the constant design the standard first, then the comparisons in order.
+    /// The stimuli; for the constant design the standard first, then the comparisons in order;
+    /// for 2AFC the target first, then the other.
     pub stimuli: Vec<Stimulus>,
     /// What the participant reads before the first trial.
     pub instructions: Option<String>,
@@ -204,6 +210,7 @@ impl Spec {
         };
         let design: Design = required(take("design")?, "design").map_err(bad)?;
         let question: Option<String> = optional(take("question")?, "question").map_err(bad)?;
+        let target: Option<String> = optional(take("target")?, "target").map_err(bad)?;
         let duration_s: f64 = required(take("duration_s")?, "duration_s").map_err(bad)?;
         let gap_s: f64 = required(take("gap_s")?, "gap_s").map_err(bad)?;
         let repetitions: u32 = required(take("repetitions")?, "repetitions").map_err(bad)?;
@@ -286,7 +293,64 @@ impl Spec {
                 design.name()
             ))
         };
+        if target.is_some() && design != Design::TwoAfc {
+            return Err(misplaced("target"));
+        }
         let stimuli = match design {
+            Design::TwoAfc => {
+                for (key, value) in [
+                    ("stimulus", shared.is_some()),
+                    ("standard", standard.is_some()),
+                    ("comparisons", comparisons.is_some()),
+                ] {
+                    if value {
+                        return Err(misplaced(key));
+                    }
+                }
+                let named = named_stimuli.unwrap_or_default();
+                let names = || {
+                    let names: Vec<String> = named
+                        .keys()
+                        .map(|name| format!("`{}`", quoted(name)))
+                        .collect();
+                    names.join(", ")
+                };
+                if named.len() != 2 {
+                    return Err(bad(format!(
+                        "`stimuli` names {} stimulus(es) ({}): a 2AFC study has two",
+                        named.len(),
+                        names()
+                    )));
+                }
+                let target = target.as_deref().ok_or_else(|| {
+                    bad(format!(
+                        "missing field `target`: the stimulus the question asks for, one of {}",
+                        names()
+                    ))
+                })?;
+                if !named.contains_key(target) {
+                    return Err(bad(format!(
+                        "`target` = \"{}\" is not a stimulus; one of {}",
+                        quoted(target),
+                        names()
+                    )));
+                }
+                check_trials(design, 2, repetitions).map_err(bad)?;
+                // The target first, then the other.
+                let mut ordered: Vec<(String, toml::Value)> = named.into_iter().collect();
+                ordered.sort_by_key(|(name, _)| name != target);
+                ordered
+                    .into_iter()
+                    .map(|(name, value)| match value {
+                        toml::Value::Table(table) => stimulus(name, table, None),
+                        other => Err(bad(format!(
+                            "`{}`: invalid type: {}, expected a table",
+                            quoted(&keys::join("stimuli", &name)),
+                            other.type_str()
+                        ))),
+                    })
+                    .collect::<Result<Vec<_>, _>>()?
+            }
             Design::Paired => {
                 for (key, value) in [
                     ("stimulus", shared.is_some()),
@@ -365,10 +429,14 @@ impl Spec {
                 stimuli
             }
         };
+        let default_question = match design {
+            Design::TwoAfc => format!("Which one is `{}`?", stimuli[0].name),
+            Design::Paired | Design::Constant => QUESTION.into(),
+        };
         Ok(Spec {
             path: path.to_owned(),
             design,
-            question: question.unwrap_or_else(|| QUESTION.into()),
+            question: question.unwrap_or(default_question),
             duration_s,
             gap_s,
             repetitions,
@@ -403,6 +471,7 @@ fn trial_count(design: Design, stimuli: usize, repetitions: u32) -> u64 {
     let per_repetition = match design {
         Design::Paired => stimuli * stimuli.saturating_sub(1),
         Design::Constant => stimuli.saturating_sub(1),
+        Design::TwoAfc => 2,
     };
     per_repetition.saturating_mul(u64::from(repetitions))
 }
@@ -416,6 +485,7 @@ fn check_trials(design: Design, stimuli: usize, repetitions: u32) -> Result<(), 
     let what = match design {
         Design::Paired => format!("{} ordered pairs", trials / u64::from(repetitions)),
         Design::Constant => format!("{} comparisons", trials / u64::from(repetitions)),
+        Design::TwoAfc => "2 orders".into(),
     };
     Err(format!(
         "{what} × `repetitions` = {repetitions} make {trials} trials a session: at most \

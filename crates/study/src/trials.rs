@@ -1,5 +1,5 @@
-//! The trial order of a session: every ordered pair (paired) or every level with the standard
-//! first in half of its repetitions (constant), shuffled from a seed that mixes the spec's seed
+//! The trial order of a session: every ordered pair (paired), every level with the standard
+//! first in half of its repetitions (constant), or the target first in half the trials (2AFC), shuffled from a seed that mixes the spec's seed
 //! with the participant's ID, so one participant's order is the same on every run and resume.
 
 use rand::seq::SliceRandom;
@@ -66,6 +66,19 @@ fn design_trials(spec: &Spec) -> Vec<Trial> {
                         trials.push(Trial { first, second });
                     }
                 }
+            }
+        }
+        // The target is stimulus 0: first in half the trials, second in the other half.
+        Design::TwoAfc => {
+            for _ in 0..reps {
+                trials.push(Trial {
+                    first: 0,
+                    second: 1,
+                });
+                trials.push(Trial {
+                    first: 1,
+                    second: 0,
+                });
             }
         }
         Design::Constant => {
