@@ -119,12 +119,9 @@ impl Output {
     fn open(interface: &Interface, spec: &Spec) -> Result<Self, StudyError> {
         match interface {
             Interface::Jack { client_name } => JackOutput::open(client_name).map(Self::Jack),
-            Interface::Alsa { device } => AlsaOutput::open(
-                device,
-                spec.channels.count(),
-                spec.stimuli[0].scene.sample_rate,
-            )
-            .map(Self::Alsa),
+            Interface::Alsa { device } => {
+                AlsaOutput::open(device, spec.channels.count(), spec.sample_rate()).map(Self::Alsa)
+            }
         }
     }
 
@@ -205,9 +202,7 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
     #[cfg(feature = "audio")]
     let sample_rate = output
         .as_ref()
-        .map_or(spec.stimuli[0].scene.sample_rate, |output| {
-            output.sample_rate()
-        });
+        .map_or(spec.sample_rate(), |output| output.sample_rate());
     #[cfg(not(feature = "audio"))]
     let sample_rate = {
         if args.dry_run.is_none() {
@@ -222,7 +217,7 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         }
         // The interface means nothing without audio.
         let _ = interface;
-        spec.stimuli[0].scene.sample_rate
+        spec.sample_rate()
     };
 
     #[cfg_attr(

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
+use super::recording::Recording;
 use super::StudyError;
 use sake_glug_engine::{Constant, Control, Preset};
 use sake_glug_io::keys::{self, KeyedTable};
@@ -133,8 +134,17 @@ pub struct Stimulus {
     pub params: String,
     /// The comparison level, for the constant design's comparisons.
     pub level: Option<f64>,
-    /// The scene to render, lasting the spec's `duration_s`.
-    pub scene: Scene,
+    /// What it is played from.
+    pub source: Source,
+}
+
+/// What a stimulus is played from.
+#[derive(Debug, Clone)]
+pub enum Source {
+    /// A scene to render, lasting the spec's `duration_s`.
+    Scene(Box<Scene>),
+    /// A recording's excerpt of the spec's `duration_s` (`audio = "FILE.wav"`, `start_s`).
+    Recording(Recording),
 }
 
 /// A validated study spec.
@@ -171,6 +181,31 @@ pub struct Spec {
     pub break_every: Option<u32>,
 }
 
+impl Spec {
+    /// The rate a dry run writes, and an ALSA device is asked for: the first recording's, whose
+    /// samples are then played as they are; else the first scene's.
+    pub fn sample_rate(&self) -> u32 {
+        let recording = self
+            .stimuli
+            .iter()
+            .find_map(|stimulus| match &stimulus.source {
+                Source::Recording(recording) => Some(recording.sample_rate),
+                Source::Scene(_) => None,
+            });
+        let scene = || {
+            self.stimuli
+                .iter()
+                .find_map(|stimulus| match &stimulus.source {
+                    Source::Scene(scene) => Some(scene.sample_rate),
+                    Source::Recording(_) => None,
+                })
+        };
+        recording
+            .or_else(scene)
+            .expect("a spec has two stimuli or more")
+    }
+}
+
 /// The masking noise is uniform white noise: its RMS is its peak over √3, and its peak may
 /// not pass full scale, so its RMS level is at most −4.77 dBFS.
 pub const MAX_NOISE_DBFS: f64 = -4.771_212_547_196_624;
@@ -187,6 +222,9 @@ const QUESTION: &str = "Which one?";
 const PRESET: &str = "preset";
 const SCENE: &str = "scene";
 const MODEL: &str = "model";
+/// The keys of a recorded stimulus.
+const AUDIO: &str = "audio";
+const START_S: &str = "start_s";
 
 impl Spec {
     /// Reads and validates the spec at `path`; the scene and model files it names are found
@@ -590,6 +628,37 @@ fn build_stimulus(
         message,
     };
     let params = toml::Value::Table(table.clone()).to_string();
+    if let Some(audio) = table.remove(AUDIO) {
+        let toml::Value::String(file) = audio else {
+            return Err(bad(format!(
+                "`{AUDIO}`: invalid type: {}, expected a file name",
+                audio.type_str()
+            )));
+        };
+        let start_s = match table.remove(START_S) {
+            None => 0.0,
+            Some(value) => number(&value)
+                .ok_or_else(|| bad(format!("`{START_S}`: expected a number of seconds")))?,
+        };
+        if let Some(key) = table.keys().next() {
+            return Err(bad(format!(
+                "`{}`: a recording (`{AUDIO}`) takes `{START_S}` only, no scene key",
+                quoted(key)
+            )));
+        }
+        let recording = Recording::open(folder.join(&file), start_s).map_err(bad)?;
+        return Ok(Stimulus {
+            name,
+            params,
+            level,
+            source: Source::Recording(recording),
+        });
+    }
+    if table.contains_key(START_S) {
+        return Err(bad(format!(
+            "`{START_S}` belongs to a recording (`{AUDIO}` = \"FILE.wav\")"
+        )));
+    }
     let mut sources: Vec<(&str, toml::Value)> = [PRESET, SCENE, MODEL]
         .into_iter()
         .filter_map(|key| Some((key, table.remove(key)?)))
@@ -657,7 +726,7 @@ fn build_stimulus(
         name,
         params,
         level,
-        scene,
+        source: Source::Scene(Box::new(scene)),
     })
 }
 

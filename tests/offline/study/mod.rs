@@ -7,6 +7,7 @@ mod dry_run;
 mod expectations;
 mod hostile_specs;
 mod log;
+mod recorded;
 mod two_afc;
 
 use std::io::{BufRead, BufReader, Write};
