@@ -33,8 +33,8 @@ pub use log::{header as log_header, LogRow, TrialLog};
 pub use recording::{Recording, RECORDING_RATES_HZ};
 pub use session::{Place, Presented, Presenter, Silent, StudySession};
 pub use spec::{
-    level_keys, Channels, Design, Equalize, Source, Spec, Stimulus, MAX_NOISE_DBFS, MAX_PRACTICE,
-    MAX_TRIALS, MIN_NOISE_DBFS, STANDARD,
+    level_keys, Channels, Design, Discriminate, Equalize, Source, Spec, Stimulus, MAX_NOISE_DBFS,
+    MAX_PRACTICE, MAX_TRIALS, MIN_NOISE_DBFS, STANDARD,
 };
 pub use stimuli::{level_of, render_stimuli, Rendered};
 pub use trials::{order_seed, plan_practice, plan_trials, Trial};

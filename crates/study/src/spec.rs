@@ -206,6 +206,56 @@ impl Spec {
     }
 }
 
+/// How `sake-glug experiment --discriminate` sets up a 2AFC study of a recording against a
+/// model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Discriminate {
+    /// The recording (the target: "which one is the recording?").
+    pub recording: PathBuf,
+    /// The model file fitted to it.
+    pub model: PathBuf,
+    /// Where the recording's excerpt starts (s).
+    pub start_s: f64,
+    /// Each stimulus's length (s).
+    pub duration_s: f64,
+    /// Presentations of each order.
+    pub repetitions: u32,
+}
+
+impl Discriminate {
+    /// The spec file of the study: design 2AFC, the recording the target, the model with the
+    /// built-in pour's other keys, levels matched by RMS, half a second between the two.
+    pub fn spec_text(&self) -> String {
+        let path = |path: &Path| {
+            let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_owned());
+            toml::Value::String(absolute.to_string_lossy().into_owned())
+        };
+        let mut recording = toml::Table::new();
+        recording.insert(AUDIO.into(), path(&self.recording));
+        recording.insert(START_S.into(), toml::Value::Float(self.start_s));
+        // The model poured as the built-in scene pours.
+        let mut model = parse_table(DEFAULT_SCENE);
+        model.insert(MODEL.into(), path(&self.model));
+        let mut stimuli = toml::Table::new();
+        stimuli.insert("recording".into(), toml::Value::Table(recording));
+        stimuli.insert("model".into(), toml::Value::Table(model));
+        let mut spec = toml::Table::new();
+        let mut set = |key: &str, value: toml::Value| spec.insert(key.into(), value);
+        set("design", toml::Value::String(Design::TwoAfc.name().into()));
+        set("target", toml::Value::String("recording".into()));
+        set(
+            "question",
+            toml::Value::String("Which one is the recording?".into()),
+        );
+        set("duration_s", toml::Value::Float(self.duration_s));
+        set("gap_s", toml::Value::Float(0.5));
+        set("repetitions", toml::Value::Integer(self.repetitions.into()));
+        set("equalize", toml::Value::String(Equalize::Rms.name().into()));
+        set("stimuli", toml::Value::Table(stimuli));
+        toml::to_string(&spec).expect("a table of strings and numbers is TOML")
+    }
+}
+
 /// The masking noise is uniform white noise: its RMS is its peak over √3, and its peak may
 /// not pass full scale, so its RMS level is at most −4.77 dBFS.
 pub const MAX_NOISE_DBFS: f64 = -4.771_212_547_196_624;

@@ -11,8 +11,13 @@ use super::{log_rows, run};
 
 const RATE: u32 = 48_000;
 
-/// A 1 s mono float WAV: a decaying 300 Hz tone at `amplitude`, or what `sample` makes.
+/// A 1 s mono float WAV of what `sample` makes of the time.
 fn write_wav(path: &Path, rate: u32, sample: impl Fn(f64) -> f32) {
+    write_wav_of(path, rate, 1, sample);
+}
+
+/// A mono float WAV of `seconds`.
+fn write_wav_of(path: &Path, rate: u32, seconds: u32, sample: impl Fn(f64) -> f32) {
     let spec = hound::WavSpec {
         channels: 1,
         sample_rate: rate,
@@ -20,7 +25,7 @@ fn write_wav(path: &Path, rate: u32, sample: impl Fn(f64) -> f32) {
         sample_format: hound::SampleFormat::Float,
     };
     let mut writer = hound::WavWriter::create(path, spec).unwrap();
-    for n in 0..rate {
+    for n in 0..rate * seconds {
         writer
             .write_sample(sample(f64::from(n) / f64::from(rate)))
             .unwrap();
@@ -179,5 +184,62 @@ fn bad_recordings_are_refused_with_the_file_and_the_reason() {
     assert!(
         error.contains("`viscosity_c`: a recording (`audio`) takes `start_s` only"),
         "{error}"
+    );
+}
+
+/// `sake-glug experiment --discriminate RECORDING.wav MODEL.toml`: the two commands of a study
+/// of a fit, the session (here its dry run) and its analysis.
+#[test]
+fn a_recording_against_its_model_in_two_commands() {
+    let dir = tempfile::tempdir().unwrap();
+    write_wav_of(&dir.path().join("take.wav"), RATE, 3, |t| tone(t % 1.0));
+    // A model file as `sake-glug fit` writes one, of a liquid that glugs within the excerpt.
+    std::fs::write(dir.path().join("model.toml"), "viscosity_c = 0.1\n").unwrap();
+    let model = "model.toml";
+    let session = [
+        "--discriminate",
+        "take.wav",
+        model,
+        "--start-s",
+        "0.5",
+        "--repetitions",
+        "3",
+        "--participant",
+        "p1",
+        "--log",
+        "log.csv",
+        "--dry-run",
+        "dry",
+    ];
+    let output = run(dir.path(), &session, &format!("\n{}", "1\n".repeat(6)));
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.contains("2afc design, 6 trials"), "{stdout}");
+    assert!(stdout.contains("Which one is the recording?"), "{stdout}");
+    let analysed = std::process::Command::new(env!("CARGO_BIN_EXE_sake-glug"))
+        .current_dir(dir.path())
+        .args(["analyze", "discrimination", "log.csv"])
+        .output()
+        .unwrap();
+    assert!(analysed.status.success());
+    let report = String::from_utf8_lossy(&analysed.stdout);
+    assert!(
+        report.contains("6 trials") || report.contains("of 6 right"),
+        "{report}"
+    );
+
+    let mut triangle = session.to_vec();
+    triangle.extend(["--design", "triangle"]);
+    triangle.retain(|arg| !["--dry-run", "dry"].contains(arg));
+    let refused = run(dir.path(), &triangle, "");
+    assert_eq!(refused.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("--design: the runner plays `2afc`"),
+        "{stderr}"
     );
 }
