@@ -1,6 +1,7 @@
 //! `sake-glug analyze paired|constant LOG.csv…`: the paper's two studies from their trial logs,
 //! as tables on stdout or one JSON object (`--json`), and their figure (`--plot FILE.png`).
-//! `sake-glug analyze plan constant …`: a constant-stimuli design simulated before it is run.
+//! `sake-glug analyze discrimination LOG.csv…`: d′ of a triangle, 2AFC or ABX study.
+//! `sake-glug analyze plan constant|discrimination …`: a design simulated before it is run.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -9,10 +10,13 @@ use clap::{Args, Subcommand};
 use sake_glug_io::text::{printable, quoted};
 
 use sake_glug_analysis::{
-    analyze_constant_logs, analyze_paired_logs, constant_json, draw_constant_plot,
-    draw_paired_plot, paired_json, plan_constant, plan_json, AnalysisError, ChiSquareTest,
-    ConstantAnalysis, ConstantPlan, PairedAnalysis, Placement, PlanOutcome, PsychometricFit,
-    PsychometricOptions, MAX_RESAMPLES, POINT_PERCENTS,
+    analyze_constant_logs, analyze_discrimination_logs, analyze_paired_logs, constant_json,
+    discrimination_json, discrimination_plan_json, draw_constant_plot, draw_paired_plot,
+    paired_json, plan_constant, plan_discrimination, plan_json, AnalysisError, ChiSquareTest,
+    ConstantAnalysis, ConstantPlan, DiscriminationAnalysis, DiscriminationDesign,
+    DiscriminationEstimate, DiscriminationGoal, DiscriminationPlan, DiscriminationPlanOutcome,
+    PairedAnalysis, Placement, PlanOutcome, PsychometricFit, PsychometricOptions, MAX_RESAMPLES,
+    POINT_PERCENTS,
 };
 
 #[derive(Args, Debug)]
@@ -43,8 +47,19 @@ enum Design {
         #[arg(long, default_value_t = PsychometricOptions::default().max_lapse, value_name = "MAX")]
         lapse: f64,
     },
-    /// Plans a study: simulates its design with observers of a known curve, and says how wide
-    /// its intervals would be and how often they would hold the truth.
+    /// Discrimination (triangle, 2AFC, ABX): proportion correct, the test against chance, d′
+    /// under the design's decision model with its 95 % interval, pooled and per participant.
+    Discrimination {
+        /// The trial logs (CSV with a header), read together.
+        #[arg(required = true, value_name = "LOG.csv")]
+        logs: Vec<PathBuf>,
+        /// Prints one JSON object instead of tables.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Plans a study: simulates its design with observers of a known curve or d′, and says how
+    /// wide its intervals would be and how often they would hold the truth, or how many
+    /// participants it needs.
     Plan {
         #[command(subcommand)]
         design: PlanDesign,
@@ -55,6 +70,56 @@ enum Design {
 enum PlanDesign {
     /// Constant stimuli: each simulated study fitted as `analyze constant` fits a log.
     Constant(PlanConstantArgs),
+    /// Discrimination: the participants a study needs to show d′ above zero, or below a bound,
+    /// with a given power; each simulated study analysed as `analyze discrimination` does.
+    Discrimination(PlanDiscriminationArgs),
+}
+
+#[derive(Args, Debug)]
+struct PlanDiscriminationArgs {
+    /// The design: triangle, 2afc or abx.
+    #[arg(long, default_value = "triangle", value_parser = design_of)]
+    design: DiscriminationDesign,
+    /// The goal: show d′ below this bound (equivalence: the 95 % interval's upper end below
+    /// it). Without it, the goal is to show d′ above zero (the test against chance).
+    #[arg(long, allow_hyphen_values = true, value_name = "D")]
+    below: Option<f64>,
+    /// The simulated observers' d′ (default 0 with --below: people who cannot tell them apart).
+    #[arg(long = "d-prime", allow_hyphen_values = true, value_name = "D")]
+    d_prime: Option<f64>,
+    /// The standard deviation of the participants' d′ around --d-prime.
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        allow_hyphen_values = true,
+        value_name = "D"
+    )]
+    spread: f64,
+    /// Trials each participant answers.
+    #[arg(long = "trials-each", default_value_t = 12, value_name = "N")]
+    trials_each: u32,
+    /// The power wanted (0.8 is 80 %).
+    #[arg(long, default_value_t = 0.8, allow_hyphen_values = true)]
+    power: f64,
+    /// Studies simulated at each size tried.
+    #[arg(long, default_value_t = 1000, value_name = "N")]
+    studies: u32,
+    /// Seed of the simulation (the same seed gives the same figures).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Prints one JSON object instead of the table.
+    #[arg(long)]
+    json: bool,
+}
+
+fn design_of(name: &str) -> Result<DiscriminationDesign, String> {
+    DiscriminationDesign::from_name(name).ok_or_else(|| {
+        format!(
+            "`{}` is not a discrimination design: one of {}",
+            quoted(name),
+            DiscriminationDesign::names()
+        )
+    })
 }
 
 #[derive(Args, Debug)]
@@ -114,6 +179,15 @@ pub fn run(args: AnalyzeArgs) -> ExitCode {
         Design::Plan {
             design: PlanDesign::Constant(args),
         } => return plan(args),
+        Design::Plan {
+            design: PlanDesign::Discrimination(args),
+        } => return plan_discrimination_run(args),
+        Design::Discrimination { logs, json } => {
+            analyze_discrimination_logs(&logs).map(|analysis| match json {
+                true => discrimination_json(&analysis).to_string(),
+                false => discrimination_text(&analysis),
+            })
+        }
         Design::Paired { common } => analyze_paired_logs(&common.logs).and_then(|analysis| {
             if let Some(path) = &common.plot {
                 draw_paired_plot(&analysis, path)?;
@@ -185,6 +259,127 @@ fn plan(args: PlanConstantArgs) -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// Exit status 0 when simulated, 2 for an argument refused (named as its option).
+fn plan_discrimination_run(args: PlanDiscriminationArgs) -> ExitCode {
+    let goal = match args.below {
+        Some(bound) => DiscriminationGoal::Below(bound),
+        None => DiscriminationGoal::AboveZero,
+    };
+    let plan = DiscriminationPlan {
+        design: args.design,
+        goal,
+        d_prime: args.d_prime.unwrap_or(0.0),
+        spread: args.spread,
+        trials_each: args.trials_each,
+        power: args.power,
+        studies: args.studies,
+        seed: args.seed,
+    };
+    match plan_discrimination(&plan) {
+        Ok(outcome) => {
+            match args.json {
+                true => println!("{}", discrimination_plan_json(&outcome)),
+                false => println!("{}", discrimination_plan_text(&outcome)),
+            }
+            ExitCode::SUCCESS
+        }
+        Err(error) => {
+            eprintln!("error: --{}: {}", error.argument, error.message);
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn discrimination_plan_text(outcome: &DiscriminationPlanOutcome) -> String {
+    let plan = &outcome.plan;
+    let goal = match plan.goal {
+        DiscriminationGoal::AboveZero => {
+            "show d′ above zero (the one-sided exact test against chance at 5 %)".to_owned()
+        }
+        DiscriminationGoal::Below(bound) => {
+            format!("show d′ < {bound} (the 95 % interval's upper end below it)")
+        }
+    };
+    let mut text = format!(
+        "{}\nobservers: d′ = {} (spread {}), proportion correct {:.4}\ngoal: {goal} with \
+         {:.0} % power\n{} trials a participant; {} studies a size, seed {}\n\n\
+         participants  trials  power (95 % interval)\n",
+        plan.design.decision_model(),
+        plan.d_prime,
+        plan.spread,
+        outcome.proportion_correct,
+        100.0 * plan.power,
+        plan.trials_each,
+        plan.studies,
+        plan.seed,
+    );
+    for size in &outcome.tried {
+        text += &format!(
+            "{:>12}  {:>6}  {:.1} % ({:.1} … {:.1} %)\n",
+            size.participants,
+            size.trials,
+            100.0 * size.power,
+            100.0 * size.power_low,
+            100.0 * size.power_high
+        );
+    }
+    text += &match outcome.needed {
+        Some(size) => format!(
+            "\nneeded: {} participants × {} trials = {} trials (power {:.1} %)",
+            size.participants,
+            plan.trials_each,
+            size.trials,
+            100.0 * size.power
+        ),
+        None => format!(
+            "\nnot reached with {} participants: more trials each, or a larger bound",
+            outcome.tried.last().map_or(0, |size| size.participants)
+        ),
+    };
+    text
+}
+
+fn estimate_text(estimate: &DiscriminationEstimate, design: DiscriminationDesign) -> String {
+    let d_prime = |d: f64| match d.is_finite() {
+        true => format!("{d:.3}"),
+        false => "∞".into(),
+    };
+    let interval = match estimate.d_prime_interval {
+        Some((low, high)) => format!("[{}, {}]", d_prime(low), d_prime(high)),
+        None => "empty (below chance)".into(),
+    };
+    format!(
+        "  {} of {} right: {:.3} (exact 95 % [{:.3}, {:.3}]); against chance {}\n  d′ = {} \
+         {interval}\n  {}\n",
+        estimate.correct,
+        estimate.trials,
+        estimate.proportion,
+        estimate.proportion_low,
+        estimate.proportion_high,
+        match estimate.p_value < 1e-4 {
+            true => "p < 0.0001".to_owned(),
+            false => format!("p = {:.4}", estimate.p_value),
+        },
+        d_prime(estimate.d_prime),
+        estimate.sentence(design),
+    )
+}
+
+fn discrimination_text(analysis: &DiscriminationAnalysis) -> String {
+    let design = analysis.design;
+    let mut text = format!(
+        "{}; chance {:.3}; d′ intervals: profile likelihood, 95 %\n\nall participants\n",
+        design.decision_model(),
+        design.chance()
+    );
+    text += &estimate_text(&analysis.pooled, design);
+    for (name, estimate) in &analysis.participants {
+        text += &format!("\n{}\n", printable(name));
+        text += &estimate_text(estimate, design);
+    }
+    text.trim_end().to_owned()
 }
 
 fn plan_text(outcome: &PlanOutcome) -> String {

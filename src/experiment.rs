@@ -8,8 +8,8 @@ use clap::{Args, ValueEnum};
 use sake_glug_io::text::{printable, quoted};
 
 use sake_glug_study::{
-    order_seed, plan_trials, render_stimuli, write_dry_run, Equalize, Silent, Spec, StudyError,
-    StudySession, TrialLog,
+    order_seed, plan_trials, render_stimuli, write_dry_run, Discriminate, Equalize, Silent, Spec,
+    StudyError, StudySession, TrialLog,
 };
 #[cfg(feature = "audio")]
 use sake_glug_study::{AlsaOutput, Channels, JackOutput, Presenter};
@@ -22,7 +22,31 @@ const ALSA_DEVICE: &str = "default";
 #[derive(Args, Debug)]
 pub struct ExperimentArgs {
     /// The study's spec file (see experiments/README.md).
-    spec: PathBuf,
+    #[arg(required_unless_present = "discriminate")]
+    spec: Option<PathBuf>,
+    /// Without a spec file: a 2AFC study of a recording against the model fitted to it ("which
+    /// one is the recording?"), the recording's excerpt and the model's render level-matched by
+    /// RMS, each order --repetitions times.
+    #[arg(
+        long,
+        num_args = 2,
+        value_names = ["RECORDING.wav", "MODEL.toml"],
+        conflicts_with = "spec"
+    )]
+    discriminate: Option<Vec<PathBuf>>,
+    /// With --discriminate: the design (2afc; triangle and abx are analysed, not yet played).
+    #[arg(long, requires = "discriminate", value_name = "DESIGN")]
+    design: Option<String>,
+    /// With --discriminate: each stimulus's length (s) [default: 2].
+    #[arg(long = "duration-s", requires = "discriminate", value_name = "S")]
+    duration_s: Option<f64>,
+    /// With --discriminate: where the recording's excerpt starts (s) [default: 0].
+    #[arg(long = "start-s", requires = "discriminate", value_name = "S")]
+    start_s: Option<f64>,
+    /// With --discriminate: presentations of each order (the recording first, then second)
+    /// [default: 10].
+    #[arg(long, requires = "discriminate", value_name = "N")]
+    repetitions: Option<u32>,
     /// The participant's ID: with the spec's seed it fixes the trial order.
     #[arg(long)]
     participant: String,
@@ -119,12 +143,9 @@ impl Output {
     fn open(interface: &Interface, spec: &Spec) -> Result<Self, StudyError> {
         match interface {
             Interface::Jack { client_name } => JackOutput::open(client_name).map(Self::Jack),
-            Interface::Alsa { device } => AlsaOutput::open(
-                device,
-                spec.channels.count(),
-                spec.stimuli[0].scene.sample_rate,
-            )
-            .map(Self::Alsa),
+            Interface::Alsa { device } => {
+                AlsaOutput::open(device, spec.channels.count(), spec.sample_rate()).map(Self::Alsa)
+            }
         }
     }
 
@@ -168,11 +189,49 @@ fn usage(error: StudyError) -> (u8, StudyError) {
     (2, error)
 }
 
+/// The study's spec: its file, or the one --discriminate makes; and the path messages name.
+fn load_spec(args: &ExperimentArgs) -> Result<(PathBuf, Spec), StudyError> {
+    let Some(files) = &args.discriminate else {
+        let path = args
+            .spec
+            .clone()
+            .expect("clap requires a spec or --discriminate");
+        return Spec::load(&path).map(|spec| (path, spec));
+    };
+    let path = PathBuf::from("--discriminate");
+    match args.design.as_deref().unwrap_or("2afc") {
+        "2afc" => {}
+        "triangle" | "abx" => {
+            return Err(StudyError::Spec {
+                path,
+                message: "--design: the runner plays `2afc`; triangle and ABX trials (three \
+                          stimuli) are analysed by `sake-glug analyze discrimination` but not \
+                          played yet"
+                    .into(),
+            })
+        }
+        other => {
+            return Err(StudyError::Spec {
+                path,
+                message: format!("--design `{}`: `2afc`", quoted(other)),
+            })
+        }
+    }
+    let study = Discriminate {
+        recording: files[0].clone(),
+        model: files[1].clone(),
+        start_s: args.start_s.unwrap_or(0.0),
+        duration_s: args.duration_s.unwrap_or(2.0),
+        repetitions: args.repetitions.unwrap_or(10),
+    };
+    Spec::parse(&study.spec_text(), &path).map(|spec| (path, spec))
+}
+
 fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
-    let mut spec = Spec::load(&args.spec).map_err(usage)?;
+    let (spec_path, mut spec) = load_spec(&args).map_err(usage)?;
     if args.participant.trim().is_empty() || args.participant.chars().any(char::is_control) {
         return Err(usage(StudyError::Spec {
-            path: args.spec.clone(),
+            path: spec_path.clone(),
             message: "--participant: give a non-empty ID without control characters".into(),
         }));
     }
@@ -185,7 +244,7 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
     }
     spec.channels.check(spec.noise_dbfs).map_err(|message| {
         usage(StudyError::Spec {
-            path: args.spec.clone(),
+            path: spec_path.clone(),
             message,
         })
     })?;
@@ -205,9 +264,7 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
     #[cfg(feature = "audio")]
     let sample_rate = output
         .as_ref()
-        .map_or(spec.stimuli[0].scene.sample_rate, |output| {
-            output.sample_rate()
-        });
+        .map_or(spec.sample_rate(), |output| output.sample_rate());
     #[cfg(not(feature = "audio"))]
     let sample_rate = {
         if args.dry_run.is_none() {
@@ -222,7 +279,7 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         }
         // The interface means nothing without audio.
         let _ = interface;
-        spec.stimuli[0].scene.sample_rate
+        spec.sample_rate()
     };
 
     #[cfg_attr(
@@ -230,8 +287,12 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         expect(unused_mut, reason = "the player takes the samples")
     )]
     let mut rendered = render_stimuli(&spec, sample_rate).map_err(usage)?;
+    let practice = match spec.practice {
+        0 => String::new(),
+        count => format!(" after {count} practice trials"),
+    };
     println!(
-        "{} design, {} trials, order seed {seed}, equalize {} ({} Hz):",
+        "{} design, {} trials{practice}, order seed {seed}, equalize {} ({} Hz):",
         spec.design.name(),
         trials.len(),
         spec.equalize.name(),
@@ -262,7 +323,11 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
     let resumed = match (&args.log, args.resume) {
         (Some(log), true) => {
             let (log, done) = TrialLog::resume(log, &session).map_err(usage)?;
-            println!("Resuming after trial {done} of {}.", trials.len());
+            // Counted with the practice trials, which come first.
+            println!(
+                "Resuming after trial {done} of {}.",
+                trials.len() + spec.practice as usize
+            );
             Some((log, done))
         }
         _ => None,

@@ -12,7 +12,8 @@ The offline renderer of the ``sake-glug`` command line, for Python::
 - :func:`render_tables` renders the same samples with the glug data: one row per unit and the
   bottle's state at a fixed rate, the tables of ``sake-glug render --units/--state``;
 - :func:`fit` fits a model to a session's recordings (``sake-glug fit``), and
-  :func:`analyze_paired` / :func:`analyze_constant` analyse a study's trial logs
+  :func:`analyze_paired` / :func:`analyze_constant` / :func:`analyze_discrimination`
+  analyse a study's trial logs
   (``sake-glug analyze … --json``), each returning its numbers as a dict;
 - :func:`presets` lists the presets of the plugin's menu;
 - :class:`SakeGlugError` (a ``ValueError``) carries the command line's message for whatever it
@@ -27,7 +28,14 @@ from typing import Any, Dict, List, NamedTuple
 
 import numpy as np
 
-from ._sake_glug import SakeGlugError, analyze_constant, analyze_paired, fit, render
+from ._sake_glug import (
+    SakeGlugError,
+    analyze_constant,
+    analyze_discrimination,
+    analyze_paired,
+    fit,
+    render,
+)
 from ._sake_glug import presets as _presets
 from ._sake_glug import render_tables as _render_tables
 
@@ -36,6 +44,7 @@ __all__ = [
     "SakeGlugError",
     "Tables",
     "analyze_constant",
+    "analyze_discrimination",
     "analyze_paired",
     "fit",
     "presets",

@@ -9,6 +9,7 @@ __all__ = [
     "SakeGlugError",
     "Tables",
     "analyze_constant",
+    "analyze_discrimination",
     "analyze_paired",
     "fit",
     "presets",
@@ -100,6 +101,14 @@ def fit(session: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
 def analyze_paired(logs: List[Union[str, "os.PathLike[str]"]]) -> Dict[str, Any]:
     """The paired-comparison analysis of trial logs, as `sake-glug analyze paired --json`.
     Ctrl-C returns at once (the analysis runs on in the background, its result dropped)."""
+
+def analyze_discrimination(logs: List[Union[str, "os.PathLike[str]"]]) -> Dict[str, Any]:
+    """The discrimination analysis of trial logs (triangle, 2AFC or ABX), as `sake-glug analyze
+    discrimination --json`: "trials", "correct", "proportion" with its exact interval
+    ("proportion_low", "proportion_high"), the one-sided "p_value" against chance, "d_prime"
+    with its profile-likelihood interval ("d_prime_low", "d_prime_high": None where infinite or
+    the interval is empty) and the plain "sentence", pooled and under "participants". Ctrl-C
+    returns at once (the analysis runs on in the background, its result dropped)."""
 
 def analyze_constant(
     logs: List[Union[str, "os.PathLike[str]"]],

@@ -20,8 +20,8 @@ use pyo3::types::{PyDict, PyInt, PyString};
 
 use sake_glug_actuator::ActuatorProfile;
 use sake_glug_analysis::{
-    analyze_constant_logs, analyze_paired_logs, constant_json, paired_json, PsychometricOptions,
-    MAX_RESAMPLES,
+    analyze_constant_logs, analyze_discrimination_logs, analyze_paired_logs, constant_json,
+    discrimination_json, paired_json, PsychometricOptions, MAX_RESAMPLES,
 };
 use sake_glug_engine::{Preset, UnitOnset, Voicing, PRESETS};
 use sake_glug_fit::{fit_json, fit_session, FitSession};
@@ -475,6 +475,18 @@ fn analyze_constant<'py>(
     Ok(pythonize::pythonize(py, &constant_json(&analysis))?)
 }
 
+/// The discrimination analysis of trial logs (`sake-glug analyze discrimination --json`):
+/// triangle, 2AFC or ABX; the proportion correct with its exact interval, the one-sided test
+/// against chance, d′ under the design's decision model with its profile-likelihood interval
+/// (None where infinite or empty) and the plain "sentence", pooled and per participant, as a
+/// dict. Ctrl-C returns at once.
+#[pyfunction]
+fn analyze_discrimination(py: Python<'_>, logs: Vec<PathBuf>) -> PyResult<Bound<'_, PyAny>> {
+    let analysis = interruptible(py, move || analyze_discrimination_logs(&logs))?
+        .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
+    Ok(pythonize::pythonize(py, &discrimination_json(&analysis))?)
+}
+
 /// Every preset as (id, name, description, scene): the id that render(preset=...) and
 /// `sake-glug render --preset` take, the name the plugin's menu shows, what it is for,
 /// and its scene file (TOML), in menu order.
@@ -504,6 +516,7 @@ fn _sake_glug(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(fit, module)?)?;
     module.add_function(wrap_pyfunction!(analyze_paired, module)?)?;
     module.add_function(wrap_pyfunction!(analyze_constant, module)?)?;
+    module.add_function(wrap_pyfunction!(analyze_discrimination, module)?)?;
     module.add_function(wrap_pyfunction!(presets, module)?)?;
     module.add("SakeGlugError", module.py().get_type::<SakeGlugError>())?;
     Ok(())

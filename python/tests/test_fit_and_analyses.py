@@ -1,4 +1,4 @@
-"""fit(), analyze_paired() and analyze_constant(): the numbers of `sake-glug fit` and
+"""fit(), analyze_paired(), analyze_constant() and analyze_discrimination(): the numbers of `sake-glug fit` and
 `sake-glug analyze … --json` for the same inputs."""
 
 import json
@@ -56,6 +56,22 @@ def test_the_constant_analysis_is_the_command_lines(cli, tmp_path):
     analysis = sake_glug.analyze_constant([log], resamples=200, seed=4)
     assert analysis == json.loads(done.stdout)
     assert set(analysis["points"]) == {"25", "50", "75"}
+
+
+def test_the_discrimination_analysis_is_the_command_lines(cli, tmp_path):
+    log = tmp_path / "triangle.csv"
+    chance = random.Random(3)
+    rows = ["participant,trial,design,correct"]
+    for participant in range(3):
+        for trial in range(12):
+            rows.append(f"p{participant},{trial + 1},triangle,{int(chance.random() < 0.6)}")
+    log.write_text("\n".join(rows) + "\n")
+    done = run_cli(cli, "analyze", "discrimination", str(log), "--json")
+    assert done.returncode == 0, done.stderr
+    analysis = sake_glug.analyze_discrimination([log])
+    assert analysis == json.loads(done.stdout)
+    assert analysis["design"] == "triangle" and analysis["trials"] == 36
+    assert set(analysis["participants"]) == {"p0", "p1", "p2"}
 
 
 def test_a_bad_log_raises_the_command_lines_message(cli, tmp_path):

@@ -6,6 +6,7 @@
 
 mod bad_logs;
 mod constant;
+mod discrimination;
 mod hostile_logs;
 mod paired;
 mod plan;

@@ -4,8 +4,9 @@
 use serde_json::{json, Map, Value};
 
 use super::{
-    ChiSquareTest, ConstantAnalysis, PairedAnalysis, Placement, PlanOutcome, PointEstimate,
-    PsychometricFit, POINT_PERCENTS,
+    ChiSquareTest, ConstantAnalysis, DiscriminationAnalysis, DiscriminationDesign,
+    DiscriminationEstimate, DiscriminationPlanOutcome, PairedAnalysis, Placement, PlanOutcome,
+    PointEstimate, PsychometricFit, POINT_PERCENTS,
 };
 
 fn test_json(test: Option<ChiSquareTest>) -> Value {
@@ -123,5 +124,67 @@ pub fn plan_json(outcome: &PlanOutcome) -> Value {
         "fitted": outcome.fitted,
         "unfitted": outcome.unfitted,
         "points": points,
+    })
+}
+
+/// A d′ as JSON: a number, or `null` when infinite (every answer right).
+fn d_prime_json(d_prime: f64) -> Value {
+    match d_prime.is_finite() {
+        true => json!(d_prime),
+        false => Value::Null,
+    }
+}
+
+fn estimate_json(estimate: &DiscriminationEstimate, design: DiscriminationDesign) -> Value {
+    let (low, high) = match estimate.d_prime_interval {
+        Some((low, high)) => (d_prime_json(low), d_prime_json(high)),
+        None => (Value::Null, Value::Null),
+    };
+    json!({
+        "trials": estimate.trials,
+        "correct": estimate.correct,
+        "proportion": estimate.proportion,
+        "proportion_low": estimate.proportion_low,
+        "proportion_high": estimate.proportion_high,
+        "p_value": estimate.p_value,
+        "told_apart": estimate.told_apart(),
+        "d_prime": d_prime_json(estimate.d_prime),
+        "d_prime_low": low,
+        "d_prime_high": high,
+        "interval_empty": estimate.d_prime_interval.is_none(),
+        "sentence": estimate.sentence(design),
+    })
+}
+
+/// `sake-glug analyze discrimination --json` (and Python's `analyze_discrimination`): the
+/// design, its chance and decision model, the pooled estimate (trials, correct, proportion with
+/// its exact interval, the one-sided p value, d′ with its profile-likelihood interval, `null`
+/// where infinite or empty, the sentence) and each participant's.
+pub fn discrimination_json(analysis: &DiscriminationAnalysis) -> Value {
+    let design = analysis.design;
+    let participants: Map<String, Value> = analysis
+        .participants
+        .iter()
+        .map(|(name, estimate)| (name.clone(), estimate_json(estimate, design)))
+        .collect();
+    let mut object = estimate_json(&analysis.pooled, design);
+    object["design"] = json!(design.name());
+    object["chance"] = json!(design.chance());
+    object["decision_model"] = json!(design.decision_model());
+    object["interval"] = json!("profile likelihood, 95 %");
+    object["participants"] = Value::Object(participants);
+    object
+}
+
+/// `sake-glug analyze plan discrimination --json`: the plan as given, the observers'
+/// proportion correct, every size tried (participants, trials, studies that showed the goal,
+/// the power with its 95 % interval) and the size needed (`null` if none within the bound).
+pub fn discrimination_plan_json(outcome: &DiscriminationPlanOutcome) -> Value {
+    json!({
+        "design": "plan discrimination",
+        "plan": outcome.plan,
+        "proportion_correct": outcome.proportion_correct,
+        "tried": outcome.tried,
+        "needed": outcome.needed,
     })
 }

@@ -2,7 +2,8 @@
 //! analysis names are read (a log holds many more: the runner logs every stimulus parameter).
 //! A cell the runner marked as text for spreadsheets (a leading `'`) is read as the text it was.
 //! A trial is counted once: a file named twice, or a participant's trial number found twice
-//! (where the logs have a `trial` column), is refused with both places.
+//! (where the logs have a `trial` column), is refused with both places. A practice trial (a
+//! row whose `practice` column, where the logs have one, is 1) is no data, and is left out.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -15,6 +16,8 @@ use sake_glug_io::text::{from_csv_cell, quoted};
 const PARTICIPANT: &str = "participant";
 /// The column that numbers a participant's trials, read where a log has it.
 const TRIAL: &str = "trial";
+/// The column that marks a practice trial (1), read where a log has it.
+const PRACTICE: &str = "practice";
 
 /// One row of a log: where it is, and the fields of the columns asked for, trimmed, in the order
 /// asked for.
@@ -124,10 +127,14 @@ fn read_file<const N: usize>(
         })?;
     }
     let trial_column = column(TRIAL);
+    let practice_column = column(PRACTICE);
     for record in reader.records() {
         let record = record.map_err(|error| row_error(&name, &error, 0))?;
         let line = record.position().map_or(0, |position| position.line());
         let field = |index: usize| from_csv_cell(record.get(index).unwrap_or("").trim()).to_owned();
+        if practice_column.is_some_and(|index| field(index) == "1") {
+            continue;
+        }
         let fields = indices.map(field);
         if let Some(trial) = trial_column.map(field).filter(|trial| !trial.is_empty()) {
             let key = (fields[0].clone(), trial);

@@ -283,14 +283,14 @@ pub fn plan_constant(plan: &ConstantPlan) -> Result<PlanOutcome, PlanError> {
     })
 }
 
-fn sorted(values: &[f64]) -> Vec<f64> {
+pub(crate) fn sorted(values: &[f64]) -> Vec<f64> {
     let mut values = values.to_vec();
     values.sort_by(f64::total_cmp);
     values
 }
 
 /// The `q` quantile of sorted `values`, linear between order statistics; NaN when empty.
-fn quantile(values: &[f64], q: f64) -> f64 {
+pub(crate) fn quantile(values: &[f64], q: f64) -> f64 {
     if values.is_empty() {
         return f64::NAN;
     }
@@ -302,7 +302,7 @@ fn quantile(values: &[f64], q: f64) -> f64 {
 
 /// The exact (Clopper-Pearson) 95 % interval of a proportion of `successes` in `trials`, from
 /// the beta distribution's quantiles; (NaN, NaN) without trials.
-fn clopper_pearson(successes: u32, trials: u32) -> (f64, f64) {
+pub(crate) fn clopper_pearson(successes: u32, trials: u32) -> (f64, f64) {
     if trials == 0 {
         return (f64::NAN, f64::NAN);
     }

@@ -16,6 +16,7 @@ mod jack_out;
 mod log;
 #[cfg(feature = "audio")]
 mod mix;
+mod recording;
 mod session;
 mod spec;
 mod stimuli;
@@ -29,13 +30,14 @@ pub use dry_run::{write_dry_run, TRIAL_LIST};
 #[cfg(feature = "audio")]
 pub use jack_out::{JackOutput, JackPlayer};
 pub use log::{header as log_header, LogRow, TrialLog};
-pub use session::{Presented, Presenter, Silent, StudySession};
+pub use recording::{Recording, RECORDING_RATES_HZ};
+pub use session::{Place, Presented, Presenter, Silent, StudySession};
 pub use spec::{
-    level_keys, Channels, Design, Equalize, Spec, Stimulus, MAX_NOISE_DBFS, MAX_TRIALS,
-    MIN_NOISE_DBFS, STANDARD,
+    level_keys, Channels, Design, Discriminate, Equalize, Source, Spec, Stimulus, MAX_NOISE_DBFS,
+    MAX_PRACTICE, MAX_TRIALS, MIN_NOISE_DBFS, STANDARD,
 };
 pub use stimuli::{level_of, render_stimuli, Rendered};
-pub use trials::{order_seed, plan_trials, Trial};
+pub use trials::{order_seed, plan_practice, plan_trials, Trial};
 
 /// Why a study could not run, or stopped.
 #[derive(Debug, thiserror::Error)]

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::session::StudySession;
+use super::session::{Place, StudySession};
 use super::StudyError;
 use sake_glug_io::append::open_to_append;
 use sake_glug_io::text::{csv_cell, cut_quotes, from_csv_cell, quoted};
@@ -56,6 +56,10 @@ pub struct LogRow {
     pub first_params: String,
     /// The second stimulus as the spec defines it.
     pub second_params: String,
+    /// 1 for a practice trial (not data: the analyses leave it out), 0 for the study's.
+    pub practice: u8,
+    /// 2AFC: 1 if the target was chosen, else 0 (empty for the other designs).
+    pub correct: Option<u8>,
 }
 
 impl LogRow {
@@ -196,6 +200,7 @@ impl TrialLog {
                 format!("its columns are not a trial log's ({})", header().join(",")),
             ));
         }
+        let places = session.places();
         let mut done = 0;
         for record in reader.deserialize::<LogRow>() {
             let row = record
@@ -205,7 +210,7 @@ impl TrialLog {
                 })?
                 .read_back();
             let line = 2 + done as u64;
-            check_row(&row, done, session).map_err(|what| {
+            check_row(&row, done, &places, session).map_err(|what| {
                 bad(
                     line,
                     format!(
@@ -274,9 +279,14 @@ impl TrialLog {
     }
 }
 
-/// Whether `row` is what `session` plans as its trial `index` (0-based), with one of its two
-/// answers; else what differs, for the message.
-fn check_row(row: &LogRow, index: usize, session: &StudySession) -> Result<(), String> {
+/// Whether `row` is what `session` plans at its place `index` (0-based, of `places`), with one
+/// of its two answers; else what differs, for the message.
+fn check_row(
+    row: &LogRow,
+    index: usize,
+    places: &[Place],
+    session: &StudySession,
+) -> Result<(), String> {
     let shown = |text: &str| format!("`{}`", quoted(text));
     if row.participant != session.participant {
         return Err(format!("participant {}", shown(&row.participant)));
@@ -290,9 +300,21 @@ fn check_row(row: &LogRow, index: usize, session: &StudySession) -> Result<(), S
             session.seed
         ));
     }
-    let Some(&trial) = session.trials.get(index) else {
+    let Some(&place) = places.get(index) else {
         return Err(format!("trial {}, past the session's last", row.trial));
     };
+    if row.practice != u8::from(place.practice) {
+        return Err(format!(
+            "row {}: practice {}, where this session plans {}",
+            index + 1,
+            row.practice,
+            if place.practice {
+                "a practice trial (1)"
+            } else {
+                "a trial of the study (0)"
+            }
+        ));
+    }
     let pressed = match row.pressed {
         1 | 2 => row.pressed,
         other => {
@@ -302,7 +324,7 @@ fn check_row(row: &LogRow, index: usize, session: &StudySession) -> Result<(), S
             ))
         }
     };
-    let planned = session.planned_row(index, trial, pressed);
+    let planned = session.planned_row(place, pressed);
     let same_trial = row.trial == planned.trial
         && row.first == planned.first
         && row.second == planned.second
@@ -322,18 +344,22 @@ fn check_row(row: &LogRow, index: usize, session: &StudySession) -> Result<(), S
     // Compared as written: a level is the spec's number, read back exactly.
     let same_answer = row.answer == planned.answer
         && row.level == planned.level
-        && row.chose_comparison == planned.chose_comparison;
+        && row.chose_comparison == planned.chose_comparison
+        && row.correct == planned.correct;
     if !same_answer {
         return Err(format!(
-            "trial {}: answer {}, key {pressed}, level {:?}, chose_comparison {:?}; key \
-             {pressed} of this trial chooses {} (level {:?}, chose_comparison {:?})",
+            "trial {}: answer {}, key {pressed}, level {:?}, chose_comparison {:?}, correct \
+             {:?}; key {pressed} of this trial chooses {} (level {:?}, chose_comparison {:?}, \
+             correct {:?})",
             row.trial,
             shown(&row.answer),
             row.level,
             row.chose_comparison,
+            row.correct,
             shown(&planned.answer),
             planned.level,
-            planned.chose_comparison
+            planned.chose_comparison,
+            planned.correct
         ));
     }
     if !(row.rt_s.is_finite() && row.rt_s >= 0.0) {
@@ -367,6 +393,8 @@ pub fn header() -> Vec<String> {
             second_onset_frame: None,
             first_params: String::new(),
             second_params: String::new(),
+            practice: 0,
+            correct: None,
         })
         .expect("a Vec never fails");
     let bytes = writer.into_inner().expect("a Vec never fails");

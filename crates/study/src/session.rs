@@ -6,8 +6,9 @@ use std::time::Instant;
 use super::log::{LogRow, TrialLog};
 use super::spec::{Design, Spec};
 use super::stimuli::Rendered;
-use super::trials::Trial;
+use super::trials::{plan_practice, Trial};
 use super::StudyError;
+use sake_glug_io::text::printable;
 
 /// When a trial's stimuli played.
 #[derive(Debug, Clone, Copy)]
@@ -55,11 +56,47 @@ pub struct StudySession<'a> {
     pub rendered: &'a [Rendered],
 }
 
+/// A place in a session: its practice trials first, then the study's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Place {
+    /// The trial played there.
+    pub trial: Trial,
+    /// Whether it is a practice trial (logged as practice, not data).
+    pub practice: bool,
+    /// Its number among its kind's trials, from 1 (practice and study counted apart).
+    pub number: usize,
+}
+
 impl StudySession<'_> {
-    /// The row of trial `index` (0-based) as the plan fixes it once key `pressed` (1 or 2) is
+    /// The spec's practice trials for this participant, played before [`Self::trials`].
+    pub fn practice(&self) -> Vec<Trial> {
+        plan_practice(self.spec, self.seed)
+    }
+
+    /// Every place of the session in order: the practice trials, then the study's.
+    pub fn places(&self) -> Vec<Place> {
+        let practice = self
+            .practice()
+            .into_iter()
+            .enumerate()
+            .map(|(index, trial)| Place {
+                trial,
+                practice: true,
+                number: index + 1,
+            });
+        let study = self.trials.iter().enumerate().map(|(index, &trial)| Place {
+            trial,
+            practice: false,
+            number: index + 1,
+        });
+        practice.chain(study).collect()
+    }
+
+    /// The row of the trial at `place` as the plan fixes it once key `pressed` (1 or 2) is
     /// answered: everything but the response time and the onset frames, which the run fills in
     /// (and [`TrialLog::resume`] checks a logged row against).
-    pub fn planned_row(&self, index: usize, trial: Trial, pressed: u8) -> LogRow {
+    pub fn planned_row(&self, place: Place, pressed: u8) -> LogRow {
+        let trial = place.trial;
         let (first, second) = (
             &self.spec.stimuli[trial.first],
             &self.spec.stimuli[trial.second],
@@ -70,13 +107,15 @@ impl StudySession<'_> {
             trial.second
         };
         let (level, chose_comparison) = match self.spec.design {
-            Design::Paired => (None, None),
+            Design::Paired | Design::TwoAfc => (None, None),
             // The standard is stimulus 0; the comparison is the other one.
             Design::Constant => (first.level.or(second.level), Some(u8::from(chosen != 0))),
         };
+        // 2AFC: the target is stimulus 0.
+        let correct = (self.spec.design == Design::TwoAfc).then_some(u8::from(chosen == 0));
         LogRow {
             participant: self.participant.to_owned(),
-            trial: index + 1,
+            trial: place.number,
             design: self.spec.design.name().to_owned(),
             first: first.name.clone(),
             second: second.name.clone(),
@@ -92,12 +131,17 @@ impl StudySession<'_> {
             second_onset_frame: None,
             first_params: first.params.clone(),
             second_params: second.params.clone(),
+            practice: u8::from(place.practice),
+            correct,
         }
     }
 
-    /// Presents the trials from number `from` (0-based) on, once a first line (Enter) comes from
-    /// `input`, reading each answer from it (a line `1` or `2`; anything else asks again) and appending it to `log` before the next
-    /// trial. Prompts go to `prompt`. Ends with [`StudyError::InputClosed`] if `input` ends first.
+    /// Presents the session from place `from` (0-based, practice trials first) on, once a first
+    /// line (Enter) comes from `input` after the spec's instructions, reading each answer from it
+    /// (a line `1` or `2`; anything else asks again) and appending it to `log` before the next
+    /// trial. After every `break_every` of the study's trials (not after the last) a pause waits
+    /// for a line. Prompts go to `prompt`. Ends with [`StudyError::InputClosed`] if `input` ends
+    /// first.
     pub fn run(
         &self,
         from: usize,
@@ -106,7 +150,9 @@ impl StudySession<'_> {
         input: &mut impl BufRead,
         prompt: &mut impl Write,
     ) -> Result<(), StudyError> {
-        let total = self.trials.len();
+        let places = self.places();
+        let total = places.len();
+        let (practice, study) = (total - self.trials.len(), self.trials.len());
         let say = |prompt: &mut dyn Write, text: std::fmt::Arguments| {
             // A prompt that cannot be shown is no reason to lose the session.
             let _ = prompt.write_fmt(text).and_then(|()| prompt.flush());
@@ -124,22 +170,37 @@ impl StudySession<'_> {
         };
         let mut line = String::new();
         if from < total {
+            if let Some(instructions) = &self.spec.instructions {
+                // The spec's text, its control characters shown escaped, line by line.
+                for text in instructions.lines() {
+                    say(prompt, format_args!("{}\n", printable(text)));
+                }
+            }
             // The participant (and whoever connects the audio) starts the session.
             say(prompt, format_args!("Press Enter to begin.\n"));
             read_line(input, &mut line, from)?;
         }
-        for (index, &trial) in self.trials.iter().enumerate().skip(from) {
+        for (position, place) in places.iter().enumerate().skip(from) {
+            if !place.practice && place.number == 1 && practice > 0 {
+                say(prompt, format_args!("Practice over: the study begins.\n"));
+            }
+            let kind = if place.practice {
+                "Practice trial"
+            } else {
+                "Trial"
+            };
+            let of = if place.practice { practice } else { study };
             say(
                 prompt,
-                format_args!("Trial {}/{total}: listen…\n", index + 1),
+                format_args!("{kind} {}/{of}: listen…\n", place.number),
             );
-            let presented = presenter.present(trial)?;
+            let presented = presenter.present(place.trial)?;
             say(
                 prompt,
                 format_args!("{} 1 (the first) or 2 (the second): ", self.spec.question),
             );
             let pressed = loop {
-                read_line(input, &mut line, index)?;
+                read_line(input, &mut line, position)?;
                 match line.trim() {
                     "1" => break 1u8,
                     "2" => break 2u8,
@@ -150,10 +211,24 @@ impl StudySession<'_> {
                 rt_s: presented.ended.elapsed().as_secs_f64(),
                 first_onset_frame: presented.onset_frames.map(|(first, _)| first),
                 second_onset_frame: presented.onset_frames.map(|(_, second)| second),
-                ..self.planned_row(index, trial, pressed)
+                ..self.planned_row(*place, pressed)
             })?;
+            let pause = self.spec.break_every.is_some_and(|every| {
+                !place.practice && place.number % every as usize == 0 && place.number < study
+            });
+            if pause {
+                say(
+                    prompt,
+                    format_args!(
+                        "Break ({} of {study} trials done): press Enter when you are ready to go \
+                         on.\n",
+                        place.number
+                    ),
+                );
+                read_line(input, &mut line, position + 1)?;
+            }
         }
-        say(prompt, format_args!("Done: {total} trials. Thank you.\n"));
+        say(prompt, format_args!("Done: {study} trials. Thank you.\n"));
         Ok(())
     }
 }

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
+use super::recording::Recording;
 use super::StudyError;
 use sake_glug_engine::{Constant, Control, Preset};
 use sake_glug_io::keys::{self, KeyedTable};
@@ -13,7 +14,7 @@ use sake_glug_io::read::{self, InputKind};
 use sake_glug_io::text::{cut_quotes, quoted};
 use sake_glug_render::{Scene, DEFAULT_SCENE, MAX_DURATION_S};
 
-/// The two designs of the paper's studies.
+/// The designs: the paper's two studies, and discrimination.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Design {
@@ -21,6 +22,10 @@ pub enum Design {
     Paired,
     /// A standard against comparison levels of one control or constant (§4.4).
     Constant,
+    /// Two stimuli, the `target` first in half the trials: which one is the target?
+    /// (two-alternative forced choice; `sake-glug analyze discrimination` reads its log).
+    #[serde(rename = "2afc")]
+    TwoAfc,
 }
 
 impl Design {
@@ -29,6 +34,7 @@ impl Design {
         match self {
             Design::Paired => "paired",
             Design::Constant => "constant",
+            Design::TwoAfc => "2afc",
         }
     }
 }
@@ -128,8 +134,17 @@ pub struct Stimulus {
     pub params: String,
     /// The comparison level, for the constant design's comparisons.
     pub level: Option<f64>,
-    /// The scene to render, lasting the spec's `duration_s`.
-    pub scene: Scene,
+    /// What it is played from.
+    pub source: Source,
+}
+
+/// What a stimulus is played from.
+#[derive(Debug, Clone)]
+pub enum Source {
+    /// A scene to render, lasting the spec's `duration_s`.
+    Scene(Box<Scene>),
+    /// A recording's excerpt of the spec's `duration_s` (`audio = "FILE.wav"`, `start_s`).
+    Recording(Recording),
 }
 
 /// A validated study spec.
@@ -155,8 +170,90 @@ pub struct Spec {
     pub noise_dbfs: Option<f64>,
     /// The channel layout.
     pub channels: Channels,
-    /// The stimuli; for the constant design the standard first, then the comparisons in order.
+    /// The stimuli; for the constant design the standard first, then the comparisons in order;
+    /// for 2AFC the target first, then the other.
     pub stimuli: Vec<Stimulus>,
+    /// What the participant reads before the first trial.
+    pub instructions: Option<String>,
+    /// Practice trials played before the study's, logged as practice (not data).
+    pub practice: u32,
+    /// A pause after every this many of the study's trials, which the participant ends.
+    pub break_every: Option<u32>,
+}
+
+impl Spec {
+    /// The rate a dry run writes, and an ALSA device is asked for: the first recording's, whose
+    /// samples are then played as they are; else the first scene's.
+    pub fn sample_rate(&self) -> u32 {
+        let recording = self
+            .stimuli
+            .iter()
+            .find_map(|stimulus| match &stimulus.source {
+                Source::Recording(recording) => Some(recording.sample_rate),
+                Source::Scene(_) => None,
+            });
+        let scene = || {
+            self.stimuli
+                .iter()
+                .find_map(|stimulus| match &stimulus.source {
+                    Source::Scene(scene) => Some(scene.sample_rate),
+                    Source::Recording(_) => None,
+                })
+        };
+        recording
+            .or_else(scene)
+            .expect("a spec has two stimuli or more")
+    }
+}
+
+/// How `sake-glug experiment --discriminate` sets up a 2AFC study of a recording against a
+/// model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Discriminate {
+    /// The recording (the target: "which one is the recording?").
+    pub recording: PathBuf,
+    /// The model file fitted to it.
+    pub model: PathBuf,
+    /// Where the recording's excerpt starts (s).
+    pub start_s: f64,
+    /// Each stimulus's length (s).
+    pub duration_s: f64,
+    /// Presentations of each order.
+    pub repetitions: u32,
+}
+
+impl Discriminate {
+    /// The spec file of the study: design 2AFC, the recording the target, the model with the
+    /// built-in pour's other keys, levels matched by RMS, half a second between the two.
+    pub fn spec_text(&self) -> String {
+        let path = |path: &Path| {
+            let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_owned());
+            toml::Value::String(absolute.to_string_lossy().into_owned())
+        };
+        let mut recording = toml::Table::new();
+        recording.insert(AUDIO.into(), path(&self.recording));
+        recording.insert(START_S.into(), toml::Value::Float(self.start_s));
+        // The model poured as the built-in scene pours.
+        let mut model = parse_table(DEFAULT_SCENE);
+        model.insert(MODEL.into(), path(&self.model));
+        let mut stimuli = toml::Table::new();
+        stimuli.insert("recording".into(), toml::Value::Table(recording));
+        stimuli.insert("model".into(), toml::Value::Table(model));
+        let mut spec = toml::Table::new();
+        let mut set = |key: &str, value: toml::Value| spec.insert(key.into(), value);
+        set("design", toml::Value::String(Design::TwoAfc.name().into()));
+        set("target", toml::Value::String("recording".into()));
+        set(
+            "question",
+            toml::Value::String("Which one is the recording?".into()),
+        );
+        set("duration_s", toml::Value::Float(self.duration_s));
+        set("gap_s", toml::Value::Float(0.5));
+        set("repetitions", toml::Value::Integer(self.repetitions.into()));
+        set("equalize", toml::Value::String(Equalize::Rms.name().into()));
+        set("stimuli", toml::Value::Table(stimuli));
+        toml::to_string(&spec).expect("a table of strings and numbers is TOML")
+    }
 }
 
 /// The masking noise is uniform white noise: its RMS is its peak over √3, and its peak may
@@ -175,6 +272,9 @@ const QUESTION: &str = "Which one?";
 const PRESET: &str = "preset";
 const SCENE: &str = "scene";
 const MODEL: &str = "model";
+/// The keys of a recorded stimulus.
+const AUDIO: &str = "audio";
+const START_S: &str = "start_s";
 
 impl Spec {
     /// Reads and validates the spec at `path`; the scene and model files it names are found
@@ -198,6 +298,7 @@ impl Spec {
         };
         let design: Design = required(take("design")?, "design").map_err(bad)?;
         let question: Option<String> = optional(take("question")?, "question").map_err(bad)?;
+        let target: Option<String> = optional(take("target")?, "target").map_err(bad)?;
         let duration_s: f64 = required(take("duration_s")?, "duration_s").map_err(bad)?;
         let gap_s: f64 = required(take("gap_s")?, "gap_s").map_err(bad)?;
         let repetitions: u32 = required(take("repetitions")?, "repetitions").map_err(bad)?;
@@ -208,6 +309,13 @@ impl Spec {
         let noise_dbfs: Option<f64> = optional(take("noise_dbfs")?, "noise_dbfs").map_err(bad)?;
         let actuator = optional(take(CHANNELS_ACTUATOR)?, CHANNELS_ACTUATOR).map_err(bad)?;
         let headphones = optional(take(CHANNELS_HEADPHONES)?, CHANNELS_HEADPHONES).map_err(bad)?;
+        let instructions: Option<String> =
+            optional(take("instructions")?, "instructions").map_err(bad)?;
+        let practice: u32 = optional(take("practice")?, "practice")
+            .map_err(bad)?
+            .unwrap_or(0);
+        let break_every: Option<u32> =
+            optional(take("break_every")?, "break_every").map_err(bad)?;
         let mut section = |key: &str| -> Result<Option<toml::Table>, StudyError> {
             optional(take(key)?, key).map_err(bad)
         };
@@ -230,6 +338,25 @@ impl Spec {
         }
         if repetitions == 0 {
             return Err(bad("`repetitions` = 0: it must be at least 1".into()));
+        }
+        if practice > MAX_PRACTICE {
+            return Err(bad(format!(
+                "`practice` = {practice}: at most {MAX_PRACTICE} practice trials"
+            )));
+        }
+        if break_every == Some(0) {
+            return Err(bad(
+                "`break_every` = 0: a pause after every 1 or more trials (leave it out for none)"
+                    .into(),
+            ));
+        }
+        if instructions
+            .as_deref()
+            .is_some_and(|text| text.trim().is_empty())
+        {
+            return Err(bad(
+                "`instructions` is empty: give the text, or leave the key out".into(),
+            ));
         }
         if let Some(level) = noise_dbfs {
             if !(MIN_NOISE_DBFS..=MAX_NOISE_DBFS).contains(&level) {
@@ -254,7 +381,64 @@ impl Spec {
                 design.name()
             ))
         };
+        if target.is_some() && design != Design::TwoAfc {
+            return Err(misplaced("target"));
+        }
         let stimuli = match design {
+            Design::TwoAfc => {
+                for (key, value) in [
+                    ("stimulus", shared.is_some()),
+                    ("standard", standard.is_some()),
+                    ("comparisons", comparisons.is_some()),
+                ] {
+                    if value {
+                        return Err(misplaced(key));
+                    }
+                }
+                let named = named_stimuli.unwrap_or_default();
+                let names = || {
+                    let names: Vec<String> = named
+                        .keys()
+                        .map(|name| format!("`{}`", quoted(name)))
+                        .collect();
+                    names.join(", ")
+                };
+                if named.len() != 2 {
+                    return Err(bad(format!(
+                        "`stimuli` names {} stimulus(es) ({}): a 2AFC study has two",
+                        named.len(),
+                        names()
+                    )));
+                }
+                let target = target.as_deref().ok_or_else(|| {
+                    bad(format!(
+                        "missing field `target`: the stimulus the question asks for, one of {}",
+                        names()
+                    ))
+                })?;
+                if !named.contains_key(target) {
+                    return Err(bad(format!(
+                        "`target` = \"{}\" is not a stimulus; one of {}",
+                        quoted(target),
+                        names()
+                    )));
+                }
+                check_trials(design, 2, repetitions).map_err(bad)?;
+                // The target first, then the other.
+                let mut ordered: Vec<(String, toml::Value)> = named.into_iter().collect();
+                ordered.sort_by_key(|(name, _)| name != target);
+                ordered
+                    .into_iter()
+                    .map(|(name, value)| match value {
+                        toml::Value::Table(table) => stimulus(name, table, None),
+                        other => Err(bad(format!(
+                            "`{}`: invalid type: {}, expected a table",
+                            quoted(&keys::join("stimuli", &name)),
+                            other.type_str()
+                        ))),
+                    })
+                    .collect::<Result<Vec<_>, _>>()?
+            }
             Design::Paired => {
                 for (key, value) in [
                     ("stimulus", shared.is_some()),
@@ -333,10 +517,14 @@ impl Spec {
                 stimuli
             }
         };
+        let default_question = match design {
+            Design::TwoAfc => format!("Which one is `{}`?", stimuli[0].name),
+            Design::Paired | Design::Constant => QUESTION.into(),
+        };
         Ok(Spec {
             path: path.to_owned(),
             design,
-            question: question.unwrap_or_else(|| QUESTION.into()),
+            question: question.unwrap_or(default_question),
             duration_s,
             gap_s,
             repetitions,
@@ -345,6 +533,9 @@ impl Spec {
             noise_dbfs,
             channels,
             stimuli,
+            instructions,
+            practice,
+            break_every,
         })
     }
 }
@@ -358,6 +549,9 @@ const CHANNELS_HEADPHONES: &str = "channels.headphones";
 /// memory and what its dry run writes (two files a trial).
 pub const MAX_TRIALS: u64 = 10_000;
 
+/// The most practice trials a session may have: practice is a few trials to learn the task.
+pub const MAX_PRACTICE: u32 = 100;
+
 /// Trials in a session of `design` with `stimuli` stimuli (the standard included) presented
 /// `repetitions` times: every ordered pair, or every comparison.
 fn trial_count(design: Design, stimuli: usize, repetitions: u32) -> u64 {
@@ -365,6 +559,7 @@ fn trial_count(design: Design, stimuli: usize, repetitions: u32) -> u64 {
     let per_repetition = match design {
         Design::Paired => stimuli * stimuli.saturating_sub(1),
         Design::Constant => stimuli.saturating_sub(1),
+        Design::TwoAfc => 2,
     };
     per_repetition.saturating_mul(u64::from(repetitions))
 }
@@ -378,6 +573,7 @@ fn check_trials(design: Design, stimuli: usize, repetitions: u32) -> Result<(), 
     let what = match design {
         Design::Paired => format!("{} ordered pairs", trials / u64::from(repetitions)),
         Design::Constant => format!("{} comparisons", trials / u64::from(repetitions)),
+        Design::TwoAfc => "2 orders".into(),
     };
     Err(format!(
         "{what} × `repetitions` = {repetitions} make {trials} trials a session: at most \
@@ -482,6 +678,37 @@ fn build_stimulus(
         message,
     };
     let params = toml::Value::Table(table.clone()).to_string();
+    if let Some(audio) = table.remove(AUDIO) {
+        let toml::Value::String(file) = audio else {
+            return Err(bad(format!(
+                "`{AUDIO}`: invalid type: {}, expected a file name",
+                audio.type_str()
+            )));
+        };
+        let start_s = match table.remove(START_S) {
+            None => 0.0,
+            Some(value) => number(&value)
+                .ok_or_else(|| bad(format!("`{START_S}`: expected a number of seconds")))?,
+        };
+        if let Some(key) = table.keys().next() {
+            return Err(bad(format!(
+                "`{}`: a recording (`{AUDIO}`) takes `{START_S}` only, no scene key",
+                quoted(key)
+            )));
+        }
+        let recording = Recording::open(folder.join(&file), start_s).map_err(bad)?;
+        return Ok(Stimulus {
+            name,
+            params,
+            level,
+            source: Source::Recording(recording),
+        });
+    }
+    if table.contains_key(START_S) {
+        return Err(bad(format!(
+            "`{START_S}` belongs to a recording (`{AUDIO}` = \"FILE.wav\")"
+        )));
+    }
     let mut sources: Vec<(&str, toml::Value)> = [PRESET, SCENE, MODEL]
         .into_iter()
         .filter_map(|key| Some((key, table.remove(key)?)))
@@ -549,7 +776,7 @@ fn build_stimulus(
         name,
         params,
         level,
-        scene,
+        source: Source::Scene(Box::new(scene)),
     })
 }
 

@@ -1,6 +1,7 @@
-//! The stimuli rendered once each by the offline renderer, and matched in level (MODEL.md §15).
+//! The stimuli rendered once each by the offline renderer (or read, for a recording), and matched
+//! in level (MODEL.md §15).
 
-use super::spec::{Equalize, Spec};
+use super::spec::{Equalize, Source, Spec};
 use super::StudyError;
 use sake_glug_io::text::{printable, quoted};
 use sake_glug_render::{available_bytes, human_bytes, render_scene, RenderError};
@@ -48,21 +49,29 @@ pub fn render_stimuli(spec: &Spec, sample_rate: u32) -> Result<Vec<Rendered>, St
             name: quoted(&stimulus.name),
             message,
         };
-        let scene = stimulus
-            .scene
-            .clone()
-            .with_sample_rate(sample_rate as f64)
-            .map_err(|error| fail(error.to_string()))?;
         let mut samples = buffers.pop().expect("one buffer a stimulus");
-        render_scene(
-            &scene,
-            |block| {
-                samples.extend_from_slice(block);
-                Ok::<(), RenderError>(())
-            },
-            &mut |_: u64| {},
-        )
-        .map_err(|error| fail(error.to_string()))?;
+        match &stimulus.source {
+            Source::Recording(recording) => {
+                samples = recording
+                    .excerpt(spec.duration_s, sample_rate)
+                    .map_err(fail)?;
+            }
+            Source::Scene(scene) => {
+                let scene = (**scene)
+                    .clone()
+                    .with_sample_rate(sample_rate as f64)
+                    .map_err(|error| fail(error.to_string()))?;
+                render_scene(
+                    &scene,
+                    |block| {
+                        samples.extend_from_slice(block);
+                        Ok::<(), RenderError>(())
+                    },
+                    &mut |_: u64| {},
+                )
+                .map_err(|error| fail(error.to_string()))?;
+            }
+        }
         rendered.push(Rendered {
             level: level_of(spec.equalize, &samples),
             samples,

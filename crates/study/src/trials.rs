@@ -1,5 +1,5 @@
-//! The trial order of a session: every ordered pair (paired) or every level with the standard
-//! first in half of its repetitions (constant), shuffled from a seed that mixes the spec's seed
+//! The trial order of a session: every ordered pair (paired), every level with the standard
+//! first in half of its repetitions (constant), or the target first in half the trials (2AFC), shuffled from a seed that mixes the spec's seed
 //! with the participant's ID, so one participant's order is the same on every run and resume.
 
 use rand::seq::SliceRandom;
@@ -34,6 +34,27 @@ pub fn order_seed(spec_seed: u64, participant: &str) -> u64 {
 /// (an odd one left goes to the standard first for every other level, so the whole session
 /// stays balanced within one trial). The list is then shuffled from `seed`.
 pub fn plan_trials(spec: &Spec, seed: u64) -> Vec<Trial> {
+    let mut trials = design_trials(spec);
+    trials.shuffle(&mut Xoshiro256PlusPlus::seed_from_u64(seed));
+    trials
+}
+
+/// The spec's `practice` trials, played before the study's: the design's trials shuffled from
+/// a seed of their own (the order seed with its bits flipped, so the practice order is not the
+/// study's beginning), taken in turn and begun again when `practice` is more than there are.
+pub fn plan_practice(spec: &Spec, seed: u64) -> Vec<Trial> {
+    let mut trials = design_trials(spec);
+    trials.shuffle(&mut Xoshiro256PlusPlus::seed_from_u64(!seed));
+    trials
+        .iter()
+        .copied()
+        .cycle()
+        .take(spec.practice as usize)
+        .collect()
+}
+
+/// The design's trials before shuffling.
+fn design_trials(spec: &Spec) -> Vec<Trial> {
     let count = spec.stimuli.len();
     let reps = spec.repetitions as usize;
     let mut trials = Vec::new();
@@ -45,6 +66,19 @@ pub fn plan_trials(spec: &Spec, seed: u64) -> Vec<Trial> {
                         trials.push(Trial { first, second });
                     }
                 }
+            }
+        }
+        // The target is stimulus 0: first in half the trials, second in the other half.
+        Design::TwoAfc => {
+            for _ in 0..reps {
+                trials.push(Trial {
+                    first: 0,
+                    second: 1,
+                });
+                trials.push(Trial {
+                    first: 1,
+                    second: 0,
+                });
             }
         }
         Design::Constant => {
@@ -67,6 +101,5 @@ pub fn plan_trials(spec: &Spec, seed: u64) -> Vec<Trial> {
             }
         }
     }
-    trials.shuffle(&mut Xoshiro256PlusPlus::seed_from_u64(seed));
     trials
 }

@@ -4,8 +4,11 @@
 //! every user (`dry_run.rs`), hostile specs (`hostile_specs.rs`).
 
 mod dry_run;
+mod expectations;
 mod hostile_specs;
 mod log;
+mod recorded;
+mod two_afc;
 
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};

@@ -1,0 +1,245 @@
+//! Recorded stimuli (`audio = "FILE.wav"`, `start_s`): the spec's `duration_s` of the file from
+//! `start_s`, read through the one reader, level-matched with the others, the same samples at
+//! every presentation; refused with the file and the reason when too short, silent, clipped, at
+//! a rate no interface plays, at another rate than the interface's, or not a WAV.
+
+use std::path::Path;
+
+use sake_glug_study::{level_of, render_stimuli, Equalize, Source, Spec};
+
+use super::{log_rows, run};
+
+const RATE: u32 = 48_000;
+
+/// A 1 s mono float WAV of what `sample` makes of the time.
+fn write_wav(path: &Path, rate: u32, sample: impl Fn(f64) -> f32) {
+    write_wav_of(path, rate, 1, sample);
+}
+
+/// A mono float WAV of `seconds`.
+fn write_wav_of(path: &Path, rate: u32, seconds: u32, sample: impl Fn(f64) -> f32) {
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: rate,
+        bits_per_sample: 32,
+        sample_format: hound::SampleFormat::Float,
+    };
+    let mut writer = hound::WavWriter::create(path, spec).unwrap();
+    for n in 0..rate * seconds {
+        writer
+            .write_sample(sample(f64::from(n) / f64::from(rate)))
+            .unwrap();
+    }
+    writer.finalize().unwrap();
+}
+
+fn tone(t: f64) -> f32 {
+    (0.6 * (-3.0 * t).exp() * (2.0 * std::f64::consts::PI * 300.0 * t).sin()) as f32
+}
+
+fn recorded_spec(extra: &str) -> String {
+    format!(
+        r#"
+design = "2afc"
+target = "recording"
+duration_s = 0.3
+gap_s = 0.1
+repetitions = 2
+seed = 1
+equalize = "rms"
+[stimuli.recording]
+audio = "take.wav"
+start_s = 0.2
+{extra}
+[stimuli.model]
+preset = "water"
+"#
+    )
+}
+
+fn load(dir: &Path, text: &str) -> Result<Spec, String> {
+    let path = dir.join("study.toml");
+    std::fs::write(&path, text).unwrap();
+    Spec::load(&path).map_err(|error| error.to_string())
+}
+
+#[test]
+fn a_recording_is_its_excerpt_level_matched_at_the_interfaces_rate() {
+    let dir = tempfile::tempdir().unwrap();
+    write_wav(&dir.path().join("take.wav"), RATE, tone);
+    let spec = load(dir.path(), &recorded_spec("")).unwrap();
+    assert!(matches!(spec.stimuli[0].source, Source::Recording(_)));
+    assert_eq!(spec.sample_rate(), RATE);
+    let rendered = render_stimuli(&spec, RATE).unwrap();
+    let recording = &rendered[0];
+    assert_eq!(recording.samples.len(), (0.3 * f64::from(RATE)) as usize);
+    // The file's samples from 0.2 s, times the stimulus's gain.
+    let gain = 10f64.powf(recording.gain_db / 20.0);
+    for (index, &sample) in recording.samples.iter().enumerate() {
+        let original = tone(f64::from(9600 + index as u32) / f64::from(RATE));
+        assert!(
+            (f64::from(sample) - f64::from(original) * gain).abs() < 1e-6,
+            "sample {index}"
+        );
+    }
+    let levels: Vec<f64> = rendered
+        .iter()
+        .map(|stimulus| level_of(Equalize::Rms, &stimulus.samples))
+        .collect();
+    assert!((levels[0] / levels[1] - 1.0).abs() < 1e-4, "{levels:?}");
+}
+
+#[test]
+fn a_dry_run_plays_the_same_recorded_samples_at_every_presentation() {
+    let dir = tempfile::tempdir().unwrap();
+    write_wav(&dir.path().join("take.wav"), RATE, tone);
+    std::fs::write(dir.path().join("study.toml"), recorded_spec("")).unwrap();
+    let output = run(
+        dir.path(),
+        &[
+            "study.toml",
+            "--participant",
+            "p1",
+            "--log",
+            "log.csv",
+            "--dry-run",
+            "dry",
+        ],
+        &format!("\n{}", "2\n".repeat(4)),
+    );
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let files: Vec<_> = std::fs::read_dir(dir.path().join("dry"))
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .filter(|path| path.to_string_lossy().ends_with("-recording.wav"))
+        .collect();
+    assert_eq!(files.len(), 4, "two trials of each order");
+    let first = std::fs::read(&files[0]).unwrap();
+    for file in &files {
+        assert_eq!(std::fs::read(file).unwrap(), first, "{}", file.display());
+        let reader = hound::WavReader::open(file).unwrap();
+        assert_eq!(reader.spec().sample_rate, RATE);
+    }
+    assert_eq!(log_rows(&dir.path().join("log.csv")).len(), 4);
+}
+
+#[test]
+fn bad_recordings_are_refused_with_the_file_and_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path();
+    write_wav(&folder.join("take.wav"), RATE, tone);
+    // Too short: 0.2 s + 0.3 s of a 1 s file is fine; from 0.8 s it is not.
+    let spec = load(
+        folder,
+        &recorded_spec("").replace("start_s = 0.2", "start_s = 0.8"),
+    )
+    .unwrap();
+    let error = render_stimuli(&spec, RATE).unwrap_err().to_string();
+    assert!(
+        error.contains("take.wav") && error.contains("too short"),
+        "{error}"
+    );
+    // Another rate than the interface's.
+    let spec = load(folder, &recorded_spec("")).unwrap();
+    let error = render_stimuli(&spec, 44_100).unwrap_err().to_string();
+    assert!(
+        error.contains("take.wav: at 48000 Hz, and the interface plays 44100 Hz"),
+        "{error}"
+    );
+    // Silent, clipped.
+    write_wav(&folder.join("take.wav"), RATE, |_| 0.0);
+    let spec = load(folder, &recorded_spec("")).unwrap();
+    let error = render_stimuli(&spec, RATE).unwrap_err().to_string();
+    assert!(error.contains("take.wav: the excerpt is silent"), "{error}");
+    write_wav(&folder.join("take.wav"), RATE, |t| {
+        (4.0 * tone(t)).clamp(-1.0, 1.0)
+    });
+    let spec = load(folder, &recorded_spec("")).unwrap();
+    let error = render_stimuli(&spec, RATE).unwrap_err().to_string();
+    assert!(
+        error.contains("take.wav: the excerpt is clipped"),
+        "{error}"
+    );
+    // A rate no interface plays, refused as the spec is read.
+    write_wav(&folder.join("take.wav"), 4_000, tone);
+    let error = load(folder, &recorded_spec("")).unwrap_err();
+    assert!(
+        error.contains("stimulus `recording`")
+            && error.contains("at 4000 Hz, a rate no interface plays"),
+        "{error}"
+    );
+    // Not a WAV; missing; a scene key beside `audio`.
+    std::fs::write(folder.join("take.wav"), "not audio").unwrap();
+    let error = load(folder, &recorded_spec("")).unwrap_err();
+    assert!(error.contains("take.wav: not a WAV file"), "{error}");
+    std::fs::remove_file(folder.join("take.wav")).unwrap();
+    let error = load(folder, &recorded_spec("")).unwrap_err();
+    assert!(error.contains("take.wav"), "{error}");
+    write_wav(&folder.join("take.wav"), RATE, tone);
+    let error = load(folder, &recorded_spec("viscosity_c = 0.5")).unwrap_err();
+    assert!(
+        error.contains("`viscosity_c`: a recording (`audio`) takes `start_s` only"),
+        "{error}"
+    );
+}
+
+/// `sake-glug experiment --discriminate RECORDING.wav MODEL.toml`: the two commands of a study
+/// of a fit, the session (here its dry run) and its analysis.
+#[test]
+fn a_recording_against_its_model_in_two_commands() {
+    let dir = tempfile::tempdir().unwrap();
+    write_wav_of(&dir.path().join("take.wav"), RATE, 3, |t| tone(t % 1.0));
+    // A model file as `sake-glug fit` writes one, of a liquid that glugs within the excerpt.
+    std::fs::write(dir.path().join("model.toml"), "viscosity_c = 0.1\n").unwrap();
+    let model = "model.toml";
+    let session = [
+        "--discriminate",
+        "take.wav",
+        model,
+        "--start-s",
+        "0.5",
+        "--repetitions",
+        "3",
+        "--participant",
+        "p1",
+        "--log",
+        "log.csv",
+        "--dry-run",
+        "dry",
+    ];
+    let output = run(dir.path(), &session, &format!("\n{}", "1\n".repeat(6)));
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.contains("2afc design, 6 trials"), "{stdout}");
+    assert!(stdout.contains("Which one is the recording?"), "{stdout}");
+    let analysed = std::process::Command::new(env!("CARGO_BIN_EXE_sake-glug"))
+        .current_dir(dir.path())
+        .args(["analyze", "discrimination", "log.csv"])
+        .output()
+        .unwrap();
+    assert!(analysed.status.success());
+    let report = String::from_utf8_lossy(&analysed.stdout);
+    assert!(
+        report.contains("6 trials") || report.contains("of 6 right"),
+        "{report}"
+    );
+
+    let mut triangle = session.to_vec();
+    triangle.extend(["--design", "triangle"]);
+    triangle.retain(|arg| !["--dry-run", "dry"].contains(arg));
+    let refused = run(dir.path(), &triangle, "");
+    assert_eq!(refused.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("--design: the runner plays `2afc`"),
+        "{stderr}"
+    );
+}
