@@ -155,16 +155,23 @@ fn a_ramp_to_its_own_value_and_a_ramp_of_no_samples_are_steps() {
 
 #[test]
 fn a_model_files_text_plays_as_the_renderers_model() {
-    let text = std::fs::read_to_string("tests/fixtures/models/fitted.toml").unwrap();
-    let model = ModelFile::parse("fitted", &text).unwrap();
+    for name in ["fitted", "falling-pitch"] {
+        a_model_plays_as_the_renderers(name);
+    }
+}
+
+/// The model `tests/fixtures/models/<name>.toml` through the C library and the renderer.
+fn a_model_plays_as_the_renderers(name: &str) {
+    let text = std::fs::read_to_string(format!("tests/fixtures/models/{name}.toml")).unwrap();
+    let model = ModelFile::parse(name, &text).unwrap();
     let seed = 77;
     let scene_text = format!("seed = {seed}\n{DEFAULT_SCENE}");
     let scene = Scene::parse_with_model(&scene_text, std::path::Path::new(""), &model).unwrap();
     let (expected, expected_units) = offline(&scene);
     let live = Live::create(48_000.0, Some(&text), seed).unwrap();
     let (samples, units) = builtin_pour(&live, 48_000, 4096);
-    assert_same_samples(&samples, &expected, "the fitted model");
-    assert_same_units(&units, &expected_units, "the fitted model");
+    assert_same_samples(&samples, &expected, name);
+    assert_same_units(&units, &expected_units, name);
     // The seed matters: another gives other glugs.
     let other = Live::create(48_000.0, Some(&text), seed + 1).unwrap();
     assert_ne!(builtin_pour(&other, 48_000, 4096).0, expected);

@@ -156,7 +156,7 @@ fn state_before_actuators() -> Vec<u8> {
 fn a_state_without_an_actuator_is_todays_and_clears_one() {
     let fresh = ClapInstance::new();
     assert_eq!(fresh.save(), todays_state());
-    let mut with_one = with_actuator("lra", true);
+    let with_one = with_actuator("lra", true);
     assert_ne!(with_one.save(), todays_state());
     assert!(with_one.load(&todays_state()));
     assert_eq!(with_one.save(), todays_state(), "the actuator is gone");

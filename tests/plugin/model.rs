@@ -22,7 +22,14 @@ const SCENE: &str = "seed = 7\nduration_s = 2.0\n\
                      tilt_deg = [[0.0, 90.0], [0.5, 90.0], [0.5, 135.0]]\n";
 
 fn fitted() -> ModelFile {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/models/fitted.toml");
+    model_fixture("fitted")
+}
+
+/// `tests/fixtures/models/<name>.toml`.
+fn model_fixture(name: &str) -> ModelFile {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/models")
+        .join(format!("{name}.toml"));
     ModelFile::load(&path).unwrap()
 }
 
@@ -61,7 +68,16 @@ fn bounce(instance: &mut ClapInstance, block: usize) -> Vec<f32> {
 
 #[test]
 fn a_bounce_with_a_model_in_the_state_is_the_render_with_that_model() {
-    let model = fitted();
+    // The fitted model, and one whose pitch follows its headspace (MODEL.md §5.1), which the
+    // editor loads through the headspace law's parameters.
+    for name in ["fitted", "falling-pitch"] {
+        a_bounce_plays(&model_fixture(name));
+    }
+}
+
+/// A bounce with `model` in the state is the render with it, at host blocks of 64 and 4096.
+fn a_bounce_plays(model: &ModelFile) {
+    let model = model.clone();
     let scene = Scene::parse_with_model(SCENE, Path::new(""), &model).unwrap();
     let (expected, _) = render_scene_to_vec(&scene).unwrap();
     assert_eq!(expected.len(), TOTAL);
