@@ -286,11 +286,6 @@ typedef struct {
   double b2_per_s;
 } SakeGlugUnit;
 
-/**
- * Every control, in the engine's order.
- */
-#define SakeGlugControl_ALL { SakeGlugControl_Tilt, SakeGlugControl_Viscosity, SakeGlugControl_Fill, SakeGlugControl_PourTime, SakeGlugControl_Gain, }
-
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus

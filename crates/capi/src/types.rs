@@ -68,7 +68,10 @@ pub enum SakeGlugControl {
 }
 
 impl SakeGlugControl {
-    /// Every control, in the engine's order.
+    /// Every control, in the engine's order. (Rust's only: cbindgen wrote it into the header as
+    /// a macro naming the variants by their Rust names, which C does not know.)
+    ///
+    /// cbindgen:ignore
     pub const ALL: [SakeGlugControl; 5] = [
         SakeGlugControl::Tilt,
         SakeGlugControl::Viscosity,
