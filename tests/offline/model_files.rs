@@ -128,6 +128,28 @@ fn a_model_holds_only_the_bottle_and_the_liquid() {
         let message = error.to_string();
         assert!(message.contains(key), "{text}: {message}");
     }
+    // A model key in the wrong section, or in none, is named where it belongs (issue 40).
+    for (text, expected) in [
+        (
+            "capacity_ml = 500",
+            "`capacity_ml` is not a model key here: did you mean `[bottle] capacity_ml`?",
+        ),
+        (
+            "[glug]\npocket_ml = 4",
+            "`glug.pocket_ml` is not a model key here: did you mean `[bottle] pocket_ml`?",
+        ),
+        (
+            "rest = [[0.0, 1.0], [90.0, 0.5]]",
+            "`rest` is not a model key here: did you mean `[curves] rest`?",
+        ),
+    ] {
+        let error = ModelFile::parse("m", text).unwrap_err();
+        assert!(
+            matches!(error, ModelFileError::Misplaced { .. }),
+            "{text}: {error:?}"
+        );
+        assert_eq!(error.to_string(), expected);
+    }
     for (text, expected) in [
         ("[glug]\nf1_hz = -1.0", "`glug.f1_hz` = -1 is out of range"),
         ("viscosity_c = 1.5", "`viscosity_c` = 1.5 is out of range"),

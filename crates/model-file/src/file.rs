@@ -32,6 +32,16 @@ pub enum ModelFileError {
         /// What such keys are.
         what: &'static str,
     },
+    /// A model key written in the wrong section (or in none): the key it names elsewhere.
+    #[error("`{key}` is not a model key here: did you mean `[{section}] {name}`?")]
+    Misplaced {
+        /// The key, as written.
+        key: String,
+        /// The section it belongs in…
+        section: String,
+        /// …and its name there.
+        name: String,
+    },
     /// A value the model cannot take: out of range, V0 not below the capacity, or no curve.
     #[error(transparent)]
     Value(#[from] ValueError),
@@ -97,9 +107,16 @@ impl ModelFile {
                         .map_err(|source| ValueError::Curve { key, source })?;
                 }
                 None => {
-                    return Err(ModelFileError::NotAModelKey {
-                        key: printable(key).into_owned(),
-                        what: "automation, takes, [midi] and the render's settings",
+                    return Err(match misplaced(key) {
+                        Some((section, name)) => ModelFileError::Misplaced {
+                            key: printable(key).into_owned(),
+                            section: section.to_owned(),
+                            name: name.to_owned(),
+                        },
+                        None => ModelFileError::NotAModelKey {
+                            key: printable(key).into_owned(),
+                            what: "automation, takes, [midi] and the render's settings",
+                        },
                     })
                 }
             }
@@ -166,6 +183,25 @@ fn model_key(key: &str) -> Option<ModelKey> {
             .map(|&curve| ModelKey::Curve(curve))
     };
     controls.or_else(constants).or_else(curves)
+}
+
+/// The section and name of the model key that `key` names in another of the model's sections or
+/// in none (`capacity_ml` for `[bottle] capacity_ml`), if one does. A key of a scene's own
+/// sections (`[output] drain`) is a scene's, not a misplaced model key.
+fn misplaced(key: &str) -> Option<(&'static str, &'static str)> {
+    let model_keys = || {
+        Constant::ALL
+            .iter()
+            .map(|constant| constant.quantity().scene_key)
+            .chain(Curve::ALL.iter().map(|curve| curve.scene_key()))
+            .filter_map(|scene_key| scene_key.split_once('.'))
+    };
+    let name = match key.split_once('.') {
+        None => key,
+        Some((section, name)) if model_keys().any(|(model, _)| model == section) => name,
+        Some(_) => return None,
+    };
+    model_keys().find(|&(_, scene_name)| scene_name == name)
 }
 
 /// Every key of `table`, a section's keys as `section.name` (scene files nest no deeper), in the
