@@ -29,7 +29,8 @@ pub struct RenderArgs {
     scenes: Vec<PathBuf>,
     #[arg(short, long = "output", value_name = "FILE", value_parser = output, help = format!(
         "A file to write; its extension picks the format ({}), or NAME:FILE names it ({}). \
-         Repeat for several files from the same render. Default: pour.wav",
+         Repeat for several files from the same render. Default: pour.wav (with --fidelity: no \
+         file)",
         OutputFormat::extensions(),
         OutputFormat::names()
     ))]
@@ -420,7 +421,9 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
             return Err("several scenes need --out-dir DIR (each writes DIR/<name>.<ext>)".into());
         }
         let mut outputs = args.outputs.clone();
-        if outputs.is_empty() {
+        // A report alone (--fidelity) writes no audio unless asked to: pour.wav is the default
+        // of a render, not of a measurement (issue 40).
+        if outputs.is_empty() && !args.fidelity {
             outputs.push(Output {
                 format: OutputFormat::WAV,
                 path: PathBuf::from("pour.wav"),
@@ -593,7 +596,11 @@ fn summary(job: &Job, report: &RenderReport, outside: &[PathBuf]) -> String {
         summary.units,
         20.0 * (summary.peak.max(1e-12) as f64).log10(),
         summary.realtime_factor(),
-        files.join(", ")
+        if files.is_empty() {
+            "no file written (a report alone)".to_owned()
+        } else {
+            files.join(", ")
+        }
     ) + &outside_note(outside)
 }
 

@@ -46,6 +46,30 @@ fn with_no_scene_it_renders_the_default_pour_to_pour_wav() {
     }
 }
 
+/// A report alone writes no audio (issue 40: `--fidelity` without `-o` once overwrote
+/// ./pour.wav); with `-o` it writes what it is asked to.
+#[test]
+fn a_fidelity_report_alone_writes_no_file() {
+    let directory = tempfile::tempdir().unwrap();
+    std::fs::write(directory.path().join("pour.wav"), b"mine").unwrap();
+    let output = sake_glug(directory.path(), &["render", "--fidelity"]);
+    assert!(output.status.success());
+    assert!(String::from_utf8_lossy(&output.stdout).starts_with("| format |"));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("no file written"), "{stderr}");
+    assert_eq!(files_in(directory.path()), ["pour.wav"]);
+    assert_eq!(
+        std::fs::read(directory.path().join("pour.wav")).unwrap(),
+        b"mine"
+    );
+    let asked = sake_glug(
+        directory.path(),
+        &["render", "--fidelity", "-o", "asked.wav"],
+    );
+    assert!(asked.status.success());
+    assert_eq!(files_in(directory.path()), ["asked.wav", "pour.wav"]);
+}
+
 #[test]
 fn integer_formats_and_sample_rate_override_are_written_as_asked() {
     let directory = tempfile::tempdir().unwrap();
