@@ -59,7 +59,7 @@ fn a_slow_rate_silence_and_no_glugs_are_refused() {
     write_wav(&wav, &vec![0.25; 25_000], 25_000);
     assert_has(
         &session_error(folder.path(), session),
-        &["recording[0].audio", "silent"],
+        &["recording[0].audio", "silent (peak 0 after"],
     );
     let mut noise = vec![0.0f32; 50_000];
     add_noise(&mut noise, 0.01, 5);

@@ -143,6 +143,11 @@ fn a_good_session_writes_the_model_the_report_and_the_plot_and_the_model_renders
     );
     let report = std::fs::read_to_string(dir.join("fit.md")).unwrap();
     assert!(report.contains("glug.f1_hz"), "{report}");
+    // A negative intercept reads as a subtraction, not "+ -0.19" (issue 40).
+    assert!(
+        report.contains("Amplitude law (fig. 7): Asum = ") && !report.contains("+ -"),
+        "{report}"
+    );
     let png = std::fs::read(dir.join("fit.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"), "fit.png is no PNG");
     // The model plays, and its glugs are the fitted ones: fitted again, f1 and f2 agree.

@@ -128,8 +128,15 @@ fn curve_or_default(
 ) -> Option<Vec<(f64, f64)>> {
     let key = curve.scene_key();
     if tilts < 2 {
+        // What each curve is read from, so that two counts from one clip do not look at odds.
+        let what = match curve {
+            Curve::Drain => "an outflow rate (a weight log, or the glug count)",
+            Curve::Rest => "a rest level (a weight log that shows where the pour stopped)",
+            Curve::Submerged => "a submerged level",
+        };
         warnings.push(format!(
-            "`{key}` needs recordings at several tilts ({tilts} measured): kept at its default"
+            "`{key}` needs recordings at several tilts, each with {what}: {tilts} tilt(s) have \
+             one, so it is kept at its default"
         ));
         return None;
     }

@@ -103,8 +103,9 @@ pub enum FitError {
     },
     /// A recording with nothing in it.
     #[error(
-        "`{key}`: {} is silent (peak {peak:e} after its offset is removed)",
-        shown(path)
+        "`{key}`: {} is silent (peak {} after its offset is removed)",
+        shown(path),
+        peak_text(*peak)
     )]
     Silent {
         /// The key naming it.
@@ -225,5 +226,14 @@ impl std::fmt::Display for SampleFault {
                  any other sample: a corrupt sample, not a glug"
             ),
         }
+    }
+}
+
+/// A silent recording's peak as a reader reads it: 0, or its level in dBFS.
+fn peak_text(peak: f64) -> String {
+    if peak > 0.0 {
+        format!("{:.1} dBFS", 20.0 * peak.log10())
+    } else {
+        "0".to_owned()
     }
 }

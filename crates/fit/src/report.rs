@@ -123,9 +123,10 @@ pub fn report_markdown(fit: &SessionFit) -> String {
                 );
             let _ = writeln!(
                 out,
-                "\nAmplitude law (fig. 7): Asum = {} · V + {} (R² = {:.3}), {zero}.",
+                "\nAmplitude law (fig. 7): Asum = {} · V {} {} (R² = {:.3}), {zero}.",
                 sig(law.slope),
-                sig(law.intercept),
+                if law.intercept < 0.0 { "−" } else { "+" },
+                sig(law.intercept.abs()),
                 law.r_squared,
             );
         }
