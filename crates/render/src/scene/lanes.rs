@@ -3,7 +3,6 @@
 
 use std::path::Path;
 
-use super::validate::check;
 use super::{InputFile, SceneError};
 use crate::automation::{Automation, CsvLaneRef, LaneSpec};
 use sake_glug_device::axis::Axis;
@@ -70,7 +69,7 @@ pub(super) fn automation(
 ) -> Result<Automation, SceneError> {
     let automation = value.unwrap_or(Automation::Constant(range.default));
     for value in automation.values() {
-        check(key, value, range)?;
+        range.check(key, value)?;
     }
     if let Automation::Points(points) = &automation {
         let mut previous = 0.0;
