@@ -206,7 +206,10 @@ def test_c_example_builds_through_pkg_config(install, cli_pour, tmp_path):
     run(["cc", *map(str, sorted((REPO / "examples" / "c").glob("*.c"))), *flags, "-o", str(program)], env=install.env)
     # It links the installed library by its soname, which the loader finds there.
     needed = run(["ldd", str(program)], env=install.env)
-    assert re.search(rf"libsake_glug\.so\.\d+ => {re.escape(str(install.lib_dir))}/", needed), needed
+    found = re.search(r"(libsake_glug\.so\.\d+) => (\S+)", needed)
+    assert found, needed
+    # (/lib is /usr/lib on a merged-/usr system.)
+    assert Path(found[2]).resolve() == (install.lib_dir / found[1]).resolve(), needed
     out = tmp_path / "pour.wav"
     run([str(program), str(out)], env=install.env)
     assert_bit_identical(read_f32(out), cli_pour, f"{install}'s C library")
@@ -294,11 +297,11 @@ def test_auditwheel_accepts_the_wheel_as_manylinux():
     wheel = the_wheel()
     shown = run([str(auditwheel), "show", str(wheel)])
     print(shown)
-    policy = re.search(r'consistent with the following platform tag:\s*"([^"]+)"', shown)
+    policy = re.search(r'consistent\s+with\s+the\s+following\s+platform\s+tag:\s*"([^"]+)"', shown)
     assert policy, shown
     # The wheel is tagged with the policy auditwheel finds it meets: a manylinux one.
     assert policy.group(1).startswith("manylinux_"), policy.group(1)
-    assert wheel.name.endswith(f"{policy.group(1)}.whl") or policy.group(1) in wheel.name, (wheel.name, policy.group(1))
+    assert wheel.name.endswith(f"-{policy.group(1)}.whl"), (wheel.name, policy.group(1))
 
 
 def test_every_product_reports_the_workspace_version(wheel_venv):

@@ -210,7 +210,9 @@ fn third_party(notices: &Path) -> anyhow::Result<()> {
         }
         args.push(ABOUT_TEMPLATE);
         let section = output_of(Command::new(cargo()).args(&args)).with_context(|| {
-            format!("cargo-about on {manifest} (`cargo install --locked cargo-about`)")
+            format!(
+                "cargo-about on {manifest} (`cargo install --locked cargo-about --features cli`)"
+            )
         })?;
         text.push_str(&format!("\n## {product}\n\n{section}"));
     }
@@ -417,6 +419,17 @@ fn debian_package(root: &Path, out: &Path) -> anyhow::Result<PathBuf> {
     write(
         &debian.join("triggers"),
         "activate-noawait ldconfig\n",
+        0o644,
+    )?;
+    // What a package built against the library depends on (dpkg-shlibdeps reads it): this
+    // package, from this version on, for the library of this soname.
+    let soname = soname(&root.join(&layout.lib).join(SHARED_LIBRARY))?;
+    let (name, abi) = soname
+        .split_once(".so.")
+        .with_context(|| format!("the soname {soname} has no version"))?;
+    write(
+        &debian.join("shlibs"),
+        &format!("{name} {abi} {PACKAGE} (>= {VERSION})\n"),
         0o644,
     )?;
     let mut sums = String::new();
