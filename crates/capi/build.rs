@@ -1,6 +1,6 @@
 //! The shared library's soname, `libsake_glug.so.<ABI>`: a program linked against it asks for
 //! the interface it was built with, and a library of another interface can be installed beside.
-//! The ABI version is read from src/types.rs, where it is declared for the header.
+//! The ABI version is read from crates/capi/src/types.rs, where it is declared for the header.
 
 fn main() {
     println!("cargo:rerun-if-changed=src/types.rs");

@@ -588,7 +588,7 @@ fn tarball(root: &Path, stem: &str, out: &Path) -> anyhow::Result<PathBuf> {
 }
 
 /// The soname the C library was linked with (crates/capi/build.rs), read from its ELF header.
-fn soname(library: &Path) -> anyhow::Result<String> {
+pub fn soname(library: &Path) -> anyhow::Result<String> {
     let dynamic = output_of(Command::new("objdump").arg("-p").arg(library))?;
     dynamic
         .lines()

@@ -244,7 +244,17 @@ fn build_standalone() -> nice_plug_xtask::Result<()> {
 /// The C library (crates/capi): target/release/libsake_glug.so and libsake_glug.a, for
 /// include/sake_glug.h.
 fn build_c_library() -> nice_plug_xtask::Result<()> {
-    cargo(&["build", "--release", "--package", "sake-glug-c"])
+    cargo(&["build", "--release", "--package", "sake-glug-c"])?;
+    // A program linked with -lsake_glug asks the loader for the soname (crates/capi/build.rs),
+    // so it is linked to beside the library, as an installed library's is.
+    let library = target_dir().join("release/libsake_glug.so");
+    let soname = dist::soname(&library)?;
+    let link = library.with_file_name(&soname);
+    if link.symlink_metadata().is_ok() {
+        std::fs::remove_file(&link)?;
+    }
+    std::os::unix::fs::symlink("libsake_glug.so", link)?;
+    Ok(())
 }
 
 /// The Python package as a manylinux wheel in <target dir>/wheels, built by maturin from the
