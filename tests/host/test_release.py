@@ -321,3 +321,10 @@ def test_every_product_reports_the_workspace_version(wheel_venv):
     wrong = {where: version for where, version in reported.items() if version != VERSION}
     assert not wrong, f"the workspace is {VERSION}; these differ: {wrong}"
 
+
+def test_readme_and_changelog_name_this_version():
+    readme = (REPO / "README.md").read_text()
+    for artefact in (DEB.name, TARBALL.name, f"sake_glug-{VERSION}-"):
+        assert artefact in readme, f"README.md's install section does not name {artefact}"
+    releases = re.findall(r"^## \[(\d[^\]]*)\]", (REPO / "CHANGELOG.md").read_text(), re.M)
+    assert releases[:1] == [VERSION], f"CHANGELOG.md's newest release is {releases[:1]}, not {VERSION}"
