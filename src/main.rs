@@ -5,6 +5,7 @@ mod accuracy;
 mod analyze;
 mod experiment;
 mod fit;
+mod generate;
 mod measure_actuator;
 mod parameters;
 mod presets;
@@ -50,6 +51,9 @@ enum Command {
     /// Measures an actuator's response on a JACK server (stepped sines out, its accelerometer
     /// in) and writes its profile: see MODEL.md §18.1.
     MeasureActuator(measure_actuator::MeasureActuatorArgs),
+    /// The man pages and shell completions of a release (for `cargo xtask dist`).
+    #[command(hide = true)]
+    Generate(generate::GenerateArgs),
 }
 
 /// A `--sample-rate` as a scene's `sample_rate` is checked (in range, whole), refused by the
@@ -76,5 +80,6 @@ fn main() -> ExitCode {
         Command::Analyze(args) => analyze::run(args),
         Command::Experiment(args) => experiment::run(args),
         Command::MeasureActuator(args) => measure_actuator::run(args),
+        Command::Generate(args) => generate::run(args),
     }
 }

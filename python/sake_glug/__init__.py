@@ -17,7 +17,8 @@ The offline renderer of the ``sake-glug`` command line, for Python::
   (``sake-glug analyze … --json``), each returning its numbers as a dict;
 - :func:`presets` lists the presets of the plugin's menu;
 - :class:`SakeGlugError` (a ``ValueError``) carries the command line's message for whatever it
-  refuses.
+  refuses;
+- ``__version__`` is the release's version, the one ``sake-glug --version`` prints.
 
 No argument crashes the interpreter: a dict scene that contains itself or nests deeper than 32
 levels is refused, a render that cannot fit in memory is refused with the figure, and Ctrl-C
@@ -30,6 +31,7 @@ import numpy as np
 
 from ._sake_glug import (
     SakeGlugError,
+    __version__,
     analyze_constant,
     analyze_discrimination,
     analyze_paired,
@@ -43,6 +45,7 @@ __all__ = [
     "Preset",
     "SakeGlugError",
     "Tables",
+    "__version__",
     "analyze_constant",
     "analyze_discrimination",
     "analyze_paired",

@@ -8,6 +8,7 @@ __all__ = [
     "Preset",
     "SakeGlugError",
     "Tables",
+    "__version__",
     "analyze_constant",
     "analyze_discrimination",
     "analyze_paired",
@@ -19,6 +20,9 @@ __all__ = [
 
 _Scene = Union[str, "os.PathLike[str]", Mapping[str, Any], None]
 _Actuator = Union[str, "os.PathLike[str]", None]
+
+__version__: str
+"""The release's version, the one ``sake-glug --version`` prints."""
 
 class SakeGlugError(ValueError):
     """A scene, preset or sample rate that Sake Glug refuses, with the command line's message."""

@@ -519,5 +519,7 @@ fn _sake_glug(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(analyze_discrimination, module)?)?;
     module.add_function(wrap_pyfunction!(presets, module)?)?;
     module.add("SakeGlugError", module.py().get_type::<SakeGlugError>())?;
+    // The workspace's version, which every product reports.
+    module.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -28,12 +28,16 @@ const FOLDERS: [&str; 15] = [
     "python/",
     ".ci/",
 ];
-const FILES: [&str; 5] = [
+const FILES: [&str; 9] = [
     "README.md",
     "Cargo.toml",
     "Cargo.lock",
     "bundler.toml",
     "rustfmt.toml",
+    "LICENSE",
+    "CHANGELOG.md",
+    "about.toml",
+    "about.hbs",
 ];
 
 /// The folders whose Rust sources' comments are read.

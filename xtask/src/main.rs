@@ -26,6 +26,9 @@
 //!   as a regression the ordinary tests replay; summarised in docs/fuzzing.md.
 //! - `cargo xtask wheel`: the Python package (python/) as a wheel in target/wheels/, built by
 //!   maturin from the virtual environment.
+//! - `cargo xtask dist`: the release in target/dist/ (the Debian package, the tarball with its
+//!   install.sh, the wheel, THIRD-PARTY.md), packed from the release builds that `cargo xtask
+//!   test` makes (built first if they are not; see dist.rs).
 //!
 //! Each product is built with only its features: the bundles with `editor` (which brings
 //! `plugin`), the command line with `cli`, the standalone app with `standalone`, so none compiles
@@ -34,6 +37,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod dist;
 mod paper;
 mod screenshots;
 
@@ -96,17 +100,26 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             build_standalone()?;
             // The C library that the examples of examples/ link (tests/host/test_capi.py).
             build_c_library()?;
+            build_wheel()?;
+            // The release packed from those builds, for the host tests to install and check.
+            dist()?;
             host_tests()?;
             python_tests()
         }
+        Some("dist") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            require_standalone("cargo xtask dist")?;
+            // The builds of `cargo xtask test`, with the same features: nothing is built twice.
+            build_bundles()?;
+            build_cli_with("ogg,audio")?;
+            build_standalone()?;
+            build_c_library()?;
+            build_wheel()?;
+            dist()
+        }
         Some("wheel") => {
             nice_plug_xtask::chdir_workspace_root()?;
-            let python = venv(PYTHON_REQUIREMENTS)?;
-            // maturin puts the wheel in <target dir>/wheels.
-            run_in_venv(
-                &maturin_of(&python),
-                &["build", "--release", "-m", "python/Cargo.toml"],
-            )
+            build_wheel()
         }
         Some("docs") if args.get(1).is_some_and(|arg| arg == "paper") => {
             nice_plug_xtask::chdir_workspace_root()?;
@@ -231,7 +244,42 @@ fn build_standalone() -> nice_plug_xtask::Result<()> {
 /// The C library (crates/capi): target/release/libsake_glug.so and libsake_glug.a, for
 /// include/sake_glug.h.
 fn build_c_library() -> nice_plug_xtask::Result<()> {
-    cargo(&["build", "--release", "--package", "sake-glug-c"])
+    cargo(&["build", "--release", "--package", "sake-glug-c"])?;
+    // A program linked with -lsake_glug asks the loader for the soname (crates/capi/build.rs),
+    // so it is linked to beside the library, as an installed library's is.
+    let library = target_dir().join("release/libsake_glug.so");
+    let soname = dist::soname(&library)?;
+    let link = library.with_file_name(&soname);
+    if link.symlink_metadata().is_ok() {
+        std::fs::remove_file(&link)?;
+    }
+    std::os::unix::fs::symlink("libsake_glug.so", link)?;
+    Ok(())
+}
+
+/// The Python package as a manylinux wheel in <target dir>/wheels, built by maturin from the
+/// virtual environment (one release build, in the workspace's target directory).
+fn build_wheel() -> nice_plug_xtask::Result<()> {
+    let python = venv(PYTHON_REQUIREMENTS)?;
+    run_in_venv(
+        &maturin_of(&python),
+        &["build", "--release", "-m", "python/Cargo.toml"],
+    )
+}
+
+/// The release packed into target/dist/ from what the build made; says how long it took.
+fn dist() -> nice_plug_xtask::Result<()> {
+    let started = std::time::Instant::now();
+    let built = dist::Built::under(&target_dir())?;
+    for artefact in dist::dist(&built, &target_dir().join("dist"))? {
+        println!(
+            "dist: {} ({} bytes)",
+            artefact.display(),
+            artefact.metadata()?.len()
+        );
+    }
+    println!("dist: packed in {:.1} s", started.elapsed().as_secs_f64());
+    Ok(())
 }
 
 /// The release command line alone, with its default features.
@@ -843,12 +891,18 @@ fn host_tests() -> nice_plug_xtask::Result<()> {
 /// What building the Python package needs besides pip (maturin).
 const PYTHON_REQUIREMENTS: &str = "python/requirements.txt";
 
-/// The Python package built (one release build, in the workspace's target directory) and
-/// installed into the virtual environment, then its tests, which compare it with the release CLI
-/// (pytest and NumPy come with the host tests' requirements).
+/// The release's wheel (target/dist, as `dist` packed it) installed into the virtual
+/// environment, then the package's tests, which compare it with the release CLI (pytest and
+/// NumPy come with the host tests' requirements).
 fn python_tests() -> nice_plug_xtask::Result<()> {
     let python = venv(PYTHON_REQUIREMENTS)?;
-    // Without pip's build isolation: maturin comes from the requirements, not from the network.
+    let built = dist::Built::under(&target_dir())?;
+    let wheel = target_dir().join("dist").join(
+        built
+            .wheel
+            .file_name()
+            .ok_or_else(|| anyhow::anyhow!("the wheel has no name"))?,
+    );
     run_in_venv(
         &python,
         &[
@@ -856,10 +910,9 @@ fn python_tests() -> nice_plug_xtask::Result<()> {
             "pip",
             "install",
             "--quiet",
-            "--no-build-isolation",
             "--force-reinstall",
             "--no-deps",
-            "./python",
+            &wheel.to_string_lossy(),
         ],
     )?;
     run_in_venv(&python, &["-m", "pytest", "python/tests", "-q"])

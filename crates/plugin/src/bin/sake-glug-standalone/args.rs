@@ -10,7 +10,7 @@ use sake_glug_plugin::{DEFAULT_AXIS, DEFAULT_OSC_INTERFACE};
 
 /// Sake Glug's own options of the standalone app (the wrapper's follow).
 #[derive(Debug, Parser)]
-#[command(name = "sake-glug-standalone", disable_help_flag = true)]
+#[command(name = "sake-glug-standalone", version, disable_help_flag = true)]
 pub struct AppArgs {
     /// Listen for OSC on this UDP port: /sakeglug/tilt, /viscosity, /fill, /refill, and the
     /// gravity vectors of GyrOSC, TouchOSC and Sensors2OSC.

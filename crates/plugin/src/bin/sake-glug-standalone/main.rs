@@ -9,6 +9,7 @@
 //! - `--osc-bind ADDRESS`: the address OSC listens on, 127.0.0.1 (this computer only) unless
 //!   asked (`0.0.0.0`: every network interface);
 //! - `--osc-axis AXIS`: the sensor axis from the bottle's base to its mouth (`+y` by default);
+//! - `--version` (`-V`): print the version and quit;
 //! - `--no-editor`: no window (no display needed); quit with Ctrl-C, SIGTERM or SIGHUP;
 //! - `--model MODEL.toml`: play a model file's bottle and liquid (MODEL.md §12.1); a model that
 //!   is refused ends the app at once (status 2) with the reason;
@@ -40,6 +41,14 @@ const AUDIO_LOST_AFTER: Duration = Duration::from_secs(1);
 
 fn main() -> ExitCode {
     let (own, wrapper_args) = args::split(std::env::args());
+    // The wrapper knows no version; a release's products all report the workspace's.
+    if wrapper_args
+        .iter()
+        .any(|arg| arg == "--version" || arg == "-V")
+    {
+        println!("sake-glug-standalone {}", env!("CARGO_PKG_VERSION"));
+        return ExitCode::SUCCESS;
+    }
     let options = match args::parse(&own) {
         Ok(options) => options,
         Err(error) => error.exit(),
