@@ -41,6 +41,11 @@ SCENE_KEYS = {
     "f2": ("glug", "f2_hz"),
     "B1": ("glug", "b1_per_s"),
     "B2": ("glug", "b2_per_s"),
+    # The headspace law (MODEL.md §5.1): only a preset that follows it names them; the others
+    # leave them at their defaults.
+    "Headspace": ("bottle", "headspace_ml"),
+    "f1 headspace exponent": ("glug", "f1_headspace_exponent"),
+    "f2 headspace exponent": ("glug", "f2_headspace_exponent"),
 }
 
 # The IDs the plugin saves its parameters under (crates/plugin/src/params.rs).
@@ -53,6 +58,9 @@ PARAMETER_IDS = {
     "f2": "f2",
     "B1": "b1",
     "B2": "b2",
+    "Headspace": "headsp",
+    "f1 headspace exponent": "f1exp",
+    "f2 headspace exponent": "f2exp",
 }
 
 # A user's changes before picking a preset: the preset must undo them.
@@ -76,8 +84,9 @@ def presets() -> list[tuple[str, dict[str, float]]]:
         for parameter, keys in SCENE_KEYS.items():
             value = scene
             for key in keys:
-                value = value[key]
-            values[parameter] = float(value)
+                value = value.get(key) if isinstance(value, dict) else None
+            if value is not None:
+                values[parameter] = float(value)
         found.append((name, values))
     return found
 
