@@ -8,8 +8,8 @@ use clap::{Args, ValueEnum};
 use sake_glug_io::text::{printable, quoted};
 
 use sake_glug_study::{
-    order_seed, plan_trials, render_stimuli, write_dry_run, Discriminate, Equalize, Silent, Spec,
-    StudyError, StudySession, TrialLog,
+    check_dry_run_folder, order_seed, plan_trials, render_stimuli, write_dry_run, Discriminate,
+    Equalize, Silent, Spec, StudyError, StudySession, TrialLog,
 };
 #[cfg(feature = "audio")]
 use sake_glug_study::{AlsaOutput, Channels, JackOutput, Presenter};
@@ -251,6 +251,12 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
     // Refused before the audio and the renders: the log is created or reopened after them.
     if let Some(log) = &args.log {
         TrialLog::check_path(log, args.resume).map_err(usage)?;
+    }
+    // So is a dry run's folder that holds anything (a resumed one keeps the folder it wrote).
+    if let Some(dir) = &args.dry_run {
+        if !(args.resume && dir.join(sake_glug_study::TRIAL_LIST).exists()) {
+            check_dry_run_folder(dir).map_err(usage)?;
+        }
     }
     let seed = order_seed(spec.seed, &args.participant);
     let trials = plan_trials(&spec, seed);

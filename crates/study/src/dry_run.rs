@@ -22,14 +22,9 @@ pub const TRIAL_LIST: &str = "trials.csv";
 /// `data`): a stimulus's file is this and 4 bytes a sample.
 const WAV_HEADER_BYTES: u64 = 100;
 
-/// Writes `session`'s files into the folder `dir`, which must not exist or be empty. Each
-/// stimulus is written once and every trial's file is a hard link to it (a copy where the
-/// file system has none), so a long session takes the room of its stimuli alone.
-pub fn write_dry_run(
-    dir: &Path,
-    session: &StudySession,
-    sample_rate: u32,
-) -> Result<Vec<PathBuf>, StudyError> {
+/// Whether the folder `dir` can take a dry run: it does not exist or is empty, and names a
+/// folder. Checked before anything is rendered (issue 40), and again as the files are written.
+pub fn check_dry_run_folder(dir: &Path) -> Result<(), StudyError> {
     let folder_error = |message: String| StudyError::DryRunFolder {
         path: dir.to_owned(),
         message,
@@ -48,6 +43,22 @@ pub fn write_dry_run(
     if dir.file_name().is_none() {
         return Err(folder_error("it names no folder".into()));
     }
+    Ok(())
+}
+
+/// Writes `session`'s files into the folder `dir`, which must not exist or be empty. Each
+/// stimulus is written once and every trial's file is a hard link to it (a copy where the
+/// file system has none), so a long session takes the room of its stimuli alone.
+pub fn write_dry_run(
+    dir: &Path,
+    session: &StudySession,
+    sample_rate: u32,
+) -> Result<Vec<PathBuf>, StudyError> {
+    check_dry_run_folder(dir)?;
+    let folder_error = |message: String| StudyError::DryRunFolder {
+        path: dir.to_owned(),
+        message,
+    };
     let parent = match dir.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),

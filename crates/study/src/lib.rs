@@ -26,7 +26,7 @@ use std::path::PathBuf;
 
 #[cfg(feature = "audio")]
 pub use alsa_out::{AlsaOutput, AlsaPlayer};
-pub use dry_run::{write_dry_run, TRIAL_LIST};
+pub use dry_run::{check_dry_run_folder, write_dry_run, TRIAL_LIST};
 #[cfg(feature = "audio")]
 pub use jack_out::{JackOutput, JackPlayer};
 pub use log::{header as log_header, LogRow, TrialLog};

@@ -167,6 +167,13 @@ fn the_dry_run_writes_each_trials_stimuli_and_the_list() {
         .unwrap();
     assert_eq!(again.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&again.stderr).contains("not an empty folder"));
+    // Refused before anything was rendered (issue 40): the levels it prints once the stimuli
+    // are rendered never came.
+    assert!(
+        !String::from_utf8_lossy(&again.stdout).contains("trials"),
+        "{}",
+        String::from_utf8_lossy(&again.stdout)
+    );
     assert_eq!(log_rows(&dir.path().join("dry/trials.csv")), list);
     assert!(
         !dir.path().join("l.csv").exists(),
