@@ -10,7 +10,7 @@ use sake_glug_engine::Control;
 use sake_glug_io::keys;
 use sake_glug_render::{render_scene_to_vec, Scene};
 
-use super::listen::{hear, log_spectral_distance, Heard};
+use super::listen::{hear, Heard};
 use super::recording::RecordingFit;
 use super::session_fit::SessionFit;
 use super::spectrum::Spectrum;
@@ -20,6 +20,8 @@ use super::units::Modes;
 pub const COMPARED_BAND_HZ: (f64, f64) = (50.0, 1000.0);
 /// Each bin is averaged with its neighbours within this distance (Hz).
 const SMOOTHING_HZ: f64 = 25.0;
+/// The log-spectral distance's band (Hz): wide enough for a bubble's bright mode.
+pub const DISTANCE_BAND_HZ: (f64, f64) = (50.0, 4000.0);
 /// The longest render compared (s): the recording's first seconds, as its fit keeps them.
 pub const RENDER_S: f64 = super::recording::EXCERPT_S;
 /// The default bottle: a scene of nothing but the tilt of a model file.
@@ -57,8 +59,13 @@ impl Comparison {
 
 /// The smoothed dB spectrum of `spectrum` at each of its bins within the compared band.
 pub fn smoothed_db(spectrum: &Spectrum) -> Vec<(f64, f64)> {
+    smoothed_db_in(spectrum, COMPARED_BAND_HZ)
+}
+
+/// The smoothed dB spectrum of `spectrum` at each of its bins within `band` (Hz): each bin
+/// averaged in power with its neighbours within [`SMOOTHING_HZ`].
+fn smoothed_db_in(spectrum: &Spectrum, (low, high): (f64, f64)) -> Vec<(f64, f64)> {
     let reach = (SMOOTHING_HZ / spectrum.bin_hz).round() as usize;
-    let (low, high) = COMPARED_BAND_HZ;
     let last = spectrum.power.len().saturating_sub(1);
     (0..spectrum.power.len())
         .filter(|&bin| (low..=high).contains(&spectrum.hz(bin)))
@@ -70,13 +77,13 @@ pub fn smoothed_db(spectrum: &Spectrum) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// The correlation of the smoothed dB spectra of `recording` and `model` over the band (the
-/// model's read at the recording's bins, linearly between its own).
-pub fn spectral_correlation(recording: &Spectrum, model: &Spectrum) -> f64 {
-    let ours = smoothed_db(recording);
-    let theirs = smoothed_db(model);
+/// The smoothed dB spectra of `ours` and `theirs` within `band` as pairs at `ours`'s bins (the
+/// second read there, linearly between its own); None where either has too few bins.
+fn paired_db(ours: &Spectrum, theirs: &Spectrum, band: (f64, f64)) -> Option<Vec<(f64, f64)>> {
+    let ours = smoothed_db_in(ours, band);
+    let theirs = smoothed_db_in(theirs, band);
     if ours.len() < 3 || theirs.len() < 2 {
-        return f64::NAN;
+        return None;
     }
     let at = |hz: f64| {
         let after = theirs
@@ -85,8 +92,35 @@ pub fn spectral_correlation(recording: &Spectrum, model: &Spectrum) -> f64 {
         let ((f0, v0), (f1, v1)) = (theirs[after - 1], theirs[after]);
         v0 + (v1 - v0) * ((hz - f0) / (f1 - f0)).clamp(0.0, 1.0)
     };
-    let pairs: Vec<(f64, f64)> = ours.iter().map(|&(hz, db)| (db, at(hz))).collect();
-    pearson(&pairs)
+    Some(ours.iter().map(|&(hz, db)| (db, at(hz))).collect())
+}
+
+/// The correlation of the smoothed dB spectra of `recording` and `model` over the band (the
+/// model's read at the recording's bins, linearly between its own).
+pub fn spectral_correlation(recording: &Spectrum, model: &Spectrum) -> f64 {
+    paired_db(recording, model, COMPARED_BAND_HZ).map_or(f64::NAN, |pairs| pearson(&pairs))
+}
+
+/// The log-spectral distance of two spectra (dB): the RMS difference of their smoothed dB
+/// spectra over [`DISTANCE_BAND_HZ`] (its top at most 45 % of `sample_rate`), each less its mean
+/// there (so that level is not counted), the second read at the first's bins.
+pub fn log_spectral_distance(ours: &Spectrum, theirs: &Spectrum, sample_rate: f64) -> f64 {
+    let band = (
+        DISTANCE_BAND_HZ.0,
+        DISTANCE_BAND_HZ.1.min(0.45 * sample_rate),
+    );
+    let Some(pairs) = paired_db(ours, theirs, band) else {
+        return f64::NAN;
+    };
+    let n = pairs.len() as f64;
+    let mean_a = pairs.iter().map(|p| p.0).sum::<f64>() / n;
+    let mean_b = pairs.iter().map(|p| p.1).sum::<f64>() / n;
+    (pairs
+        .iter()
+        .map(|(x, y)| ((x - mean_a) - (y - mean_b)).powi(2))
+        .sum::<f64>()
+        / n)
+        .sqrt()
 }
 
 /// Pearson's correlation of the pairs.

@@ -2,7 +2,8 @@
 //! (MODEL.md §13, "How close a model sounds"): its glugs by a plain onset detector of its own
 //! (an energy envelope's rises, not the fit's detector, so that a render and a recording are read
 //! alike), their rate, each glug's low pitch, and the share of its energy above a split between
-//! the bottle's two modes; and the log-spectral distance between two pours.
+//! the bottle's two modes. (The log-spectral distance between two pours is
+//! [`super::compare::log_spectral_distance`].)
 
 use rustfft::{num_complex::Complex, FftPlanner};
 
@@ -35,10 +36,6 @@ const ATTACK_FRAMES: usize = 4;
 const PITCH_SPAN_S: f64 = 0.06;
 /// The lowest pitch read (Hz).
 const LOWEST_PITCH_HZ: f64 = 30.0;
-/// The log-spectral distance's band (Hz; its top at most 45 % of the rate).
-pub const DISTANCE_BAND_HZ: (f64, f64) = (50.0, 4000.0);
-/// Its spectra are smoothed over this many Hz either side.
-const DISTANCE_SMOOTHING_HZ: f64 = 25.0;
 
 /// What a listener hears of one pour.
 #[derive(Debug, Clone, PartialEq)]
@@ -212,48 +209,6 @@ pub fn high_share(samples: &[f32], sample_rate: f64, split_hz: f64) -> f64 {
     }
 }
 
-/// The log-spectral distance of two spectra (dB): the RMS difference of their smoothed dB
-/// spectra over [`DISTANCE_BAND_HZ`], each less its mean there (so that level is not counted),
-/// the second read at the first's bins.
-pub fn log_spectral_distance(ours: &Spectrum, theirs: &Spectrum, sample_rate: f64) -> f64 {
-    let top = DISTANCE_BAND_HZ.1.min(0.45 * sample_rate);
-    let band = (DISTANCE_BAND_HZ.0, top);
-    let a = smoothed(ours, band);
-    let b = smoothed(theirs, band);
-    if a.len() < 3 || b.len() < 2 {
-        return f64::NAN;
-    }
-    let at = |hz: f64| {
-        let after = b.partition_point(|p| p.0 < hz).clamp(1, b.len() - 1);
-        let ((f0, v0), (f1, v1)) = (b[after - 1], b[after]);
-        v0 + (v1 - v0) * ((hz - f0) / (f1 - f0)).clamp(0.0, 1.0)
-    };
-    let pairs: Vec<(f64, f64)> = a.iter().map(|&(hz, db)| (db, at(hz))).collect();
-    let n = pairs.len() as f64;
-    let mean_a = pairs.iter().map(|p| p.0).sum::<f64>() / n;
-    let mean_b = pairs.iter().map(|p| p.1).sum::<f64>() / n;
-    (pairs
-        .iter()
-        .map(|(x, y)| ((x - mean_a) - (y - mean_b)).powi(2))
-        .sum::<f64>()
-        / n)
-        .sqrt()
-}
-
-/// The spectrum in dB within `band`, each bin averaged in power with its neighbours.
-fn smoothed(spectrum: &Spectrum, band: (f64, f64)) -> Vec<(f64, f64)> {
-    let reach = (DISTANCE_SMOOTHING_HZ / spectrum.bin_hz).round() as usize;
-    let last = spectrum.power.len().saturating_sub(1);
-    (0..spectrum.power.len())
-        .filter(|&bin| (band.0..=band.1).contains(&spectrum.hz(bin)))
-        .map(|bin| {
-            let around = &spectrum.power[bin.saturating_sub(reach)..=(bin + reach).min(last)];
-            let mean = around.iter().sum::<f64>() / around.len() as f64;
-            (spectrum.hz(bin), 10.0 * mean.max(1e-30).log10())
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -305,7 +260,8 @@ mod tests {
         let fs = 22_050.0;
         let (a, b) = (glugs(9.0, 8, 2.0, fs), glugs(9.0, 8, 1.0, fs));
         let (sa, sb) = (Spectrum::of(&a, fs), Spectrum::of(&b, fs));
-        assert!(log_spectral_distance(&sa, &sa, fs) < 1e-9);
-        assert!(log_spectral_distance(&sa, &sb, fs) > 1.0);
+        let distance = crate::compare::log_spectral_distance;
+        assert!(distance(&sa, &sa, fs) < 1e-9);
+        assert!(distance(&sa, &sb, fs) > 1.0);
     }
 }
