@@ -5,7 +5,7 @@
 //! line's frequency one pocket below full (V_ref = C − b).
 
 use super::stats::Line;
-use sake_glug_engine::Constant;
+use sake_glug_engine::{Constant, Headspace};
 
 /// The z of a two-sided 95 % normal interval: an exponent is heard where its line's slope lies
 /// further than this many standard errors from 0.
@@ -60,8 +60,6 @@ pub struct HeadspaceLaw {
     pub headspace_heard: bool,
     /// Each mode's line (None: fewer than 3 units with a volume).
     pub modes: [Option<ModeLaw>; 2],
-    /// The pocket b the frequencies are quoted one pocket below full with (ml).
-    pub pocket_ml: f64,
 }
 
 impl HeadspaceLaw {
@@ -70,14 +68,14 @@ impl HeadspaceLaw {
         self.modes.iter().flatten().any(ModeLaw::follows)
     }
 
-    /// The factor of mode `k`'s frequency at `added_ml` (C − V) under the law as written into the
-    /// model: 1 for a mode that does not follow.
-    pub fn factor(&self, k: usize, added_ml: f64) -> f64 {
-        match self.modes[k] {
-            Some(mode) if mode.follows() => ((self.headspace_ml + self.pocket_ml)
-                / (self.headspace_ml + added_ml))
-                .powf(mode.exponent),
-            _ => 1.0,
+    /// The law as written into the model, for the engine's own reading of it: an exponent of 0
+    /// for a mode that does not follow.
+    pub fn model(&self) -> Headspace {
+        Headspace {
+            headspace_ml: self.headspace_ml,
+            exponent: self
+                .modes
+                .map(|mode| mode.filter(ModeLaw::follows).map_or(0.0, |m| m.exponent)),
         }
     }
 }
@@ -127,7 +125,6 @@ pub fn fit_law(points: [&[(f64, f64)]; 2], pocket_ml: f64) -> HeadspaceLaw {
         allowed_ml: None,
         headspace_heard: false,
         modes: at_default,
-        pocket_ml,
     };
     let Some(leading) = leading else {
         return law;
@@ -205,7 +202,7 @@ mod tests {
         let first_hz = 200.0 * (6.0f64 / 11.0).sqrt();
         assert!((mode.full_hz / first_hz - 1.0).abs() < 0.02, "{law:?}");
         assert!(!law.modes[1].unwrap().follows(), "{law:?}");
-        assert_eq!(law.factor(1, 50.0), 1.0);
+        assert_eq!(law.model().exponent[1], 0.0);
     }
 
     #[test]

@@ -188,14 +188,18 @@ fn unit_estimates(units: &[FittedUnit], capacity_ml: f64, pocket_ml: f64) -> Vec
             .filter(|v| v.is_finite())
             .collect::<Vec<_>>()
     };
-    let law = headspace_law(units, capacity_ml, pocket_ml);
-    // Where a mode follows the headspace, its spread is the scatter around the law, over the
-    // units whose volume places them on it.
+    let points = pitch_points(units, capacity_ml);
+    let law = fit_law([&points[0], &points[1]], pocket_ml);
+    // Where a mode follows the headspace, its spread is the scatter around the law (as the
+    // engine reads it), over the units whose volume places them on it.
+    let model = law.model();
     let f = [0, 1].map(|k| {
         if law.heard() {
-            pitch_points(units, capacity_ml)[k]
+            points[k]
                 .iter()
-                .map(|&(added_ml, hz)| hz / law.factor(k, added_ml))
+                .map(|&(added_ml, hz)| {
+                    hz / model.factors(capacity_ml - added_ml, capacity_ml, pocket_ml)[k]
+                })
                 .collect()
         } else {
             of(&|u| u.fit.frequency_hz[k])
