@@ -1,7 +1,7 @@
 //! `sake-glug parameters`: every control and model constant as the engine's tables declare it
 //! (plugin parameter id, scene key, name, range, the step a parameter snaps to, default), as the
-//! Markdown table the README shows; a constant the plugin has no parameter for shows as set by
-//! scenes only. `cargo xtask docs` writes it there; a test checks the README holds it.
+//! Markdown table the guide shows (docs/guide/sound-designer.md); a constant the plugin has no parameter for shows as set by
+//! scenes only. `cargo xtask docs` writes it there; a test checks the guide holds it.
 
 use std::process::ExitCode;
 

@@ -9,7 +9,7 @@ Tilt automation bounced from a MIDI track and compared with the offline renderer
   offset past the cycle, at its last sample), the value normalised in f32 and snapped to the
   knob's step, and the engine plays the decimal the knob shows.
 - Against the offline render of the ramp itself the bounce differs: glugs move. The test
-  measures how much and checks README.md's figures are these (SAKE_GLUG_WRITE_DOCS=1 rewrites
+  measures how much and checks the guide's figures are these (docs/guide/sound-designer.md) (SAKE_GLUG_WRITE_DOCS=1 rewrites
   them).
 
 Needs Ardour 7 (Debian `ardour`), `cargo xtask bundle sake_glug --release` and the release CLI.
@@ -246,13 +246,13 @@ def test_a_ramped_tilt_bounces_to_the_offline_render_of_what_ardour_delivered(
     true_ramp = offline(tmp_path, "ramp", "[[0.0, 0.0], [0.5, 0.0], [0.5, 90.0], [1.0, 135.0]]")
     assert first_sound(bounced) != first_sound(true_ramp)
     figures = ramp_figures(bounced, true_ramp, cycle, steps)
-    readme = REPO / "README.md"
-    text = readme.read_text()
+    page = REPO / "docs" / "guide" / "sound-designer.md"
+    text = page.read_text()
     block = re.compile(
         r"<!-- generated:vst3-ramps:begin -->\n.*?<!-- generated:vst3-ramps:end -->", re.S
     )
     if os.environ.get("SAKE_GLUG_WRITE_DOCS") == "1":
-        readme.write_text(block.sub(lambda _: figures, text))
+        page.write_text(block.sub(lambda _: figures, text))
     else:
         found = block.search(text)
-        assert found and found.group(0) == figures, f"README.md's figures are not these:\n{figures}"
+        assert found and found.group(0) == figures, f"{page}'s figures are not these:\n{figures}"

@@ -1,5 +1,5 @@
 """The built VST3, loaded in a real host (pedalboard), renders exactly the samples of the offline
-renderer for the same scene (every sample identical, as README.md says), at several host buffer
+renderer for the same scene (every sample identical, as the guide says), at several host buffer
 sizes.
 
 Needs `cargo xtask bundle sake_glug --release` and `cargo build --release --bin sake-glug`.

@@ -13,13 +13,13 @@ mod determinism;
 mod every_input;
 mod files;
 mod fuzz;
+mod guide;
 // FIFOs, devices and links as Unix makes them.
 #[cfg(unix)]
 mod inputs;
 mod memory;
 mod model_files;
 mod presets;
-mod readme;
 mod research_fuzz;
 mod scene_files;
 mod study;

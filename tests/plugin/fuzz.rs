@@ -159,7 +159,7 @@ fn fuzz_plugin_state_bytes() {
     );
 }
 
-/// The decoder's 14-bit tilt, written out again from the README's table.
+/// The decoder's 14-bit tilt, written out again from the guide's table (docs/guide/tilt-device.md).
 fn tilt_of(msb: u8, lsb: u8) -> f64 {
     (msb as f64 * 128.0 + lsb as f64) / 16383.0 * 180.0
 }

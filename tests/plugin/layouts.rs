@@ -1,6 +1,6 @@
 //! The output layouts a host can choose: stereo (the default) and mono, both carrying the same
 //! signal (MODEL.md §6). Chosen here as a CLAP host does, through `clap.audio-ports-config`
-//! before activation. (pedalboard cannot ask a generator for mono: README "Mono output".)
+//! before activation. (pedalboard cannot ask a generator for mono: docs/guide/sound-designer.md, "Mono or stereo".)
 
 use crate::clap_host::ClapInstance;
 

@@ -81,6 +81,76 @@ fn every_repository_path_named_exists() {
     );
 }
 
+/// A link to a heading (`page.md#anchor`, or `#anchor` within a page) finds it: every heading of
+/// README.md and docs/ is an anchor as GitHub makes it (lower case, spaces to hyphens, other
+/// punctuation left out), and the pages link to one another by those.
+#[test]
+fn every_link_between_pages_resolves_to_its_heading() {
+    let (mut broken, mut checked) = (Vec::new(), 0);
+    for line in prose().iter().filter(|line| line.file.ends_with(".md")) {
+        for (target, anchor) in link_anchors(&line.text) {
+            checked += 1;
+            let page = if target.is_empty() {
+                PathBuf::from(&line.file)
+            } else {
+                Path::new(&line.file)
+                    .parent()
+                    .unwrap_or(Path::new(""))
+                    .join(target)
+            };
+            let headings = headings(&read(&page));
+            if !headings.iter().any(|heading| anchor_of(heading) == anchor) {
+                broken.push(format!(
+                    "{}:{}: {}#{anchor} has no such heading",
+                    line.file,
+                    line.number,
+                    page.display()
+                ));
+            }
+        }
+    }
+    assert!(
+        checked > 0,
+        "no link to a heading found: the scan is broken"
+    );
+    assert!(broken.is_empty(), "{}", broken.join("\n"));
+}
+
+/// The headings of a Markdown page, outside its fenced code.
+fn headings(page: &str) -> Vec<String> {
+    let mut fenced = false;
+    let mut found = Vec::new();
+    for line in page.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+        } else if !fenced && line.starts_with('#') {
+            found.push(line.trim_start_matches('#').trim().to_owned());
+        }
+    }
+    found
+}
+
+/// A heading's anchor as GitHub makes it.
+fn anchor_of(heading: &str) -> String {
+    heading
+        .to_lowercase()
+        .chars()
+        .filter(|c| c.is_alphanumeric() || matches!(c, ' ' | '-' | '_'))
+        .map(|c| if c == ' ' { '-' } else { c })
+        .collect()
+}
+
+/// The local links of a Markdown line that name a heading, as (page, anchor); the page is empty
+/// for a heading of the same page.
+fn link_anchors(text: &str) -> impl Iterator<Item = (&str, &str)> {
+    text.split("](").skip(1).filter_map(|rest| {
+        let target = rest.split(')').next()?;
+        let (page, anchor) = target.split_once('#')?;
+        (!page.contains("://") && (page.is_empty() || page.ends_with(".md")))
+            .then_some((page, anchor))
+    })
+}
+
 /// A fixture git ignores passes every local run and is missing from every clone (the real
 /// recordings were, behind `*.wav`): nothing under tests/fixtures may be ignored and untracked.
 #[test]

@@ -159,7 +159,7 @@ fn xtask() -> nice_plug_xtask::Result<()> {
                 &target_dir().join("release/sake-glug-standalone"),
                 &target_dir().join("screenshots"),
             )?;
-            replace_block("README.md", "editor-cpu", &format!("{cpu}.\n"))
+            replace_block(SOUND_DESIGNER_PAGE, "editor-cpu", &format!("{cpu}.\n"))
         }
         _ => nice_plug_xtask::main(),
     }
@@ -356,17 +356,17 @@ fn docs() -> nice_plug_xtask::Result<()> {
     if !status.success() {
         anyhow::bail!("writing presets/vst3 through the plugin test failed ({status})");
     }
-    // The README's table of parameters, from the engine's tables.
+    // The guide's table of parameters, from the engine's tables.
     let parameters = output(&cli(), &["parameters"])?;
-    replace_block("README.md", "parameters", &parameters)?;
-    // The README's table of what each format keeps of the default pour, measured.
+    replace_block(SOUND_DESIGNER_PAGE, "parameters", &parameters)?;
+    // The guide's table of what each format keeps of the default pour, measured.
     let measured = target_dir().join("fidelity-pour.wav");
     let fidelity = output(
         &cli(),
         &["render", "--fidelity", "-o", &measured.to_string_lossy()],
     )?;
-    replace_block("README.md", "fidelity", &fidelity)?;
-    // The README's example of the pour plot: the default scene.
+    replace_block(HAPTIC_DESIGNER_PAGE, "fidelity", &fidelity)?;
+    // The guide's example of the pour plot: the default scene.
     let clip = target_dir().join("pour-plot.haptic");
     run(
         &cli(),
@@ -463,7 +463,7 @@ fn pictures_not_regenerated(started: std::time::SystemTime) -> nice_plug_xtask::
     Ok(())
 }
 
-/// The README's figures of a ramp in a VST3 host, measured by the Ardour host test (which
+/// The guide's figures of a ramp in a VST3 host, measured by the Ardour host test (which
 /// rewrites them when asked to); skipped, with a line saying so, where Ardour is not installed.
 fn vst3_ramp_figures() -> nice_plug_xtask::Result<()> {
     let has_ardour = Command::new("ardour7-lua")
@@ -473,7 +473,7 @@ fn vst3_ramp_figures() -> nice_plug_xtask::Result<()> {
     let python = ".venv/bin/python";
     if !has_ardour || !Path::new(python).exists() {
         println!(
-            "README.md: vst3-ramps kept: it needs Ardour 7 (`sudo apt-get install ardour`) and \
+            "docs/guide/sound-designer.md: vst3-ramps kept: it needs Ardour 7 (`sudo apt-get install ardour`) and \
              the host tests' .venv (`cargo xtask test` makes it)"
         );
         return Ok(());
@@ -486,7 +486,7 @@ fn vst3_ramp_figures() -> nice_plug_xtask::Result<()> {
     if !status.success() {
         anyhow::bail!("measuring the VST3 ramp in Ardour failed ({status})");
     }
-    println!("README.md: vst3-ramps regenerated");
+    println!("{SOUND_DESIGNER_PAGE}: vst3-ramps regenerated");
     Ok(())
 }
 
@@ -860,6 +860,10 @@ fn files_in(folder: &Path) -> nice_plug_xtask::Result<Vec<PathBuf>> {
 }
 
 /// Replaces the text between `<!-- generated:NAME:begin -->` and `<!-- generated:NAME:end -->`.
+/// The guide's pages that hold blocks the code writes (`<!-- generated:NAME:begin -->`).
+const SOUND_DESIGNER_PAGE: &str = "docs/guide/sound-designer.md";
+const HAPTIC_DESIGNER_PAGE: &str = "docs/guide/haptic-designer.md";
+
 fn replace_block(file: &str, name: &str, content: &str) -> nice_plug_xtask::Result<()> {
     let text = std::fs::read_to_string(file)?;
     let begin = format!("<!-- generated:{name}:begin -->\n");

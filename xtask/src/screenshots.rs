@@ -7,7 +7,7 @@
 //! and settled, then `docs/editor-pouring.png` once a phone's gravity vector, sent over OSC on
 //! loopback, has tilted the bottle to 135° and the scope shows the glugs. It also measures the
 //! app's CPU time over 10 s idle and 10 s pouring (printed by thread; nothing is asserted on it),
-//! and returns a sentence on it for the README.
+//! and returns a sentence on it for the guide (docs/guide/sound-designer.md).
 //!
 //! Every process started here is stopped when this returns, also on error.
 

@@ -156,7 +156,7 @@ pub struct Quantity {
     /// The plugin parameter's stable id (saved states and automation depend on it); empty for a
     /// constant that scenes set but the plugin has no parameter for.
     pub param_id: &'static str,
-    /// What it is, in a few words (the README's table of parameters).
+    /// What it is, in a few words (the guide's table of parameters).
     pub note: &'static str,
     /// The allowed range and the default.
     pub range: Range,

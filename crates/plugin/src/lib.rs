@@ -40,7 +40,7 @@ use sake_glug_device::midi::{MidiInput, MidiMap};
 /// cost. VST3 has no raw CCs: nice-plug would register 16 × 130 hidden MIDI-mapping parameters
 /// for them (2,097 in all, 51 s to load in pedalboard, an assertion per parameter in Carla), so
 /// the VST3 export takes note-ons only and the device reaches Tilt by the host's MIDI learn
-/// (README, "Connect your tilt device").
+/// (docs/guide/tilt-device.md).
 pub struct SakeGlugPlugin<const RAW_MIDI: bool> {
     params: Arc<GlugParams>,
     feed: Arc<Feed>,

@@ -2,7 +2,7 @@
 //! each file read back as its format declares ([`ReadBack`], in the format's own file) and held
 //! against the model's own glugs: where its onsets fall, how far its envelope strays from the
 //! felt envelope, what carries the viscosity c, how big it is, and which platform limits it
-//! met. `sake-glug render --fidelity` prints it; the README's table is its output. Nothing here
+//! met. `sake-glug render --fidelity` prints it; the guide's table (docs/guide/haptic-designer.md) is its output. Nothing here
 //! knows a format by name: the table of formats says everything. With an actuator profile
 //! (`--actuator`, MODEL.md §18) it adds the c the device delivers, with and without the
 //! compensation.
@@ -272,7 +272,7 @@ fn envelope_error_db(
     (!errors.is_empty()).then(|| errors.iter().sum::<f64>() / errors.len() as f64)
 }
 
-/// The measurements as the Markdown table the README shows; with an actuator profile, two more
+/// The measurements as the Markdown table the guide shows; with an actuator profile, two more
 /// columns: the c its device delivers without and with the compensation.
 pub fn fidelity_table(rows: &[Fidelity]) -> String {
     let on_device = rows.iter().any(|row| row.delivered_c.is_some());

@@ -53,7 +53,7 @@ pub struct GlugEditor {
 }
 
 /// A file's path, typed or pasted (a file dialog would need GTK's development files or a
-/// desktop portal's D-Bus stack: see the README), and why its last load was refused.
+/// desktop portal's D-Bus stack: see docs/guide/sound-designer.md), and why its last load was refused.
 #[derive(Debug, Default)]
 pub struct PathField {
     /// The path as typed.

@@ -1,5 +1,5 @@
 //! "Load model…": a model file's path, typed or pasted (a file dialog would need GTK's
-//! development files or a desktop portal's D-Bus stack: see the README), loaded with a button.
+//! development files or a desktop portal's D-Bus stack: see docs/guide/sound-designer.md), loaded with a button.
 //! Loading sets the model's constants and controls through the host, one gesture per parameter,
 //! as the preset menu does, and keeps the model in the state; Clear takes it out.
 
