@@ -1,7 +1,8 @@
 //! `cargo xtask`: nice-plug's bundler, plus the project's two everyday jobs.
 //!
 //! - `cargo xtask pour`: build the plugin bundles, the CLI, the C library and the standalone app,
-//!   and render the built-in scene to `pour.wav`. Without the app's libraries (pkg-config's `alsa` and `jack`) it
+//!   and render the built-in scene to `pour.wav`. The CLI plays studies (its `audio`) wherever the
+//!   app can be built. Without the app's libraries (pkg-config's `alsa` and `jack`) it
 //!   skips the app and ends with one line naming the `apt-get install` that adds them.
 //! - `cargo xtask test`: every test: formatting and lints, the Rust suites, then the bundles in a
 //!   real VST3 host and the standalone app under a JACK server, then the Python package installed
@@ -70,7 +71,13 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             }
             run(&cli(), &["render", "-o", "pour.wav"])?;
             if !missing.is_empty() {
-                println!("{}", standalone_skipped("the standalone app", &missing));
+                println!(
+                    "{}",
+                    standalone_skipped(
+                        "the standalone app, and the CLI's audio (`experiment`, `measure-actuator`),",
+                        &missing
+                    )
+                );
             }
             Ok(())
         }
@@ -88,15 +95,16 @@ fn xtask() -> nice_plug_xtask::Result<()> {
                 "-D",
                 "warnings",
             ])?;
-            // The command line as the main job builds it (its default features, no `audio`):
-            // code behind a feature must compile, and cleanly, without it too.
+            // The command line with its default features (no `audio`, as the main job builds it
+            // where the app's libraries are missing): code behind a feature must compile, and
+            // cleanly, without it too.
             cargo(&["clippy", "-p", "sake-glug", "--", "-D", "warnings"])?;
             // All features, assert_process_allocs among them: the dev profile keeps the debug
             // assertions it needs.
             cargo(&["test", "--workspace", "--no-fail-fast", "--all-features"])?;
             build_bundles()?;
-            // Built once, with what the host tests need of it: a study played on JACK and ALSA.
-            build_cli_with("ogg,audio")?;
+            // With audio (the app's libraries are there): a study played on JACK and ALSA.
+            build_cli()?;
             build_standalone()?;
             // The C library that the examples of examples/ link (tests/host/test_capi.py).
             build_c_library()?;
@@ -111,7 +119,7 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             require_standalone("cargo xtask dist")?;
             // The builds of `cargo xtask test`, with the same features: nothing is built twice.
             build_bundles()?;
-            build_cli_with("ogg,audio")?;
+            build_cli()?;
             build_standalone()?;
             build_c_library()?;
             build_wheel()?;
@@ -282,13 +290,16 @@ fn dist() -> nice_plug_xtask::Result<()> {
     Ok(())
 }
 
-/// The release command line alone, with its default features.
+/// The release command line: with `ogg`, and with `audio` (JACK and ALSA) where the app's
+/// libraries are.
 fn build_cli() -> nice_plug_xtask::Result<()> {
-    build_cli_with("ogg")
-}
-
-/// The release command line with `features`.
-fn build_cli_with(features: &str) -> nice_plug_xtask::Result<()> {
+    // Every command builds the same CLI, so none rebuilds another's: with the audio of
+    // `experiment` and `measure-actuator` wherever the standalone app's libraries are.
+    let features = if standalone_missing().is_empty() {
+        "ogg,audio"
+    } else {
+        "ogg"
+    };
     cargo(&[
         "build",
         "--release",
