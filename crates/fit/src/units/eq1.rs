@@ -458,18 +458,31 @@ mod tests {
             .collect()
     }
 
+    /// A window of `len` samples in −1…1 with no structure a fit could lock on to: n·`prime`
+    /// modulo `modulus`, scaled.
+    fn scrambled_window(
+        len: usize,
+        prime: usize,
+        modulus: usize,
+        first: usize,
+        stride: usize,
+        fs: f64,
+    ) -> Window {
+        let data = (0..len)
+            .map(|n| ((n * prime) % modulus) as f64 / (modulus / 2) as f64 - 1.0)
+            .collect();
+        Window {
+            data,
+            first,
+            stride,
+            fs,
+        }
+    }
+
     #[test]
     fn the_onset_grids_sums_equal_the_columns_products_at_every_onset() {
         let fs = 25_000.0;
-        let data: Vec<f64> = (0..700)
-            .map(|n| ((n * 7919) % 113) as f64 / 56.0 - 1.0)
-            .collect();
-        let window = Window {
-            data,
-            first: 1_000,
-            stride: 3,
-            fs,
-        };
+        let window = scrambled_window(700, 7919, 113, 1_000, 3, fs);
         let (hz, decay) = ([83.0, 310.0], [31.0, 55.0]);
         let earliest_s = 1_000.0 / fs + 0.0004;
         let sums = GridSums::new(&window, earliest_s, hz, decay);
@@ -497,15 +510,7 @@ mod tests {
     #[test]
     fn the_compressed_problem_keeps_the_sum_of_squares_and_the_normal_equations() {
         let fs = 25_000.0;
-        let data: Vec<f64> = (0..600)
-            .map(|n| ((n * 104_729) % 97) as f64 / 48.0 - 1.0)
-            .collect();
-        let window = Window {
-            data,
-            first: 200,
-            stride: 2,
-            fs,
-        };
+        let window = scrambled_window(600, 104_729, 97, 200, 2, fs);
         let params = Vector7::from_column_slice(&[0.3, 0.8, 0.2, 80.0, 300.0, 30.0, 45.0]);
         let problem = UnitProblem::new(&window, 200.0 / fs + 0.001, params);
         let (mut rows, mut residuals) = (Vec::new(), Vec::new());
