@@ -27,7 +27,6 @@ A trial during which JACK reported an xrun is dropped and counted.
 import argparse
 import os
 import random
-import signal
 import socket
 import struct
 import subprocess
@@ -39,7 +38,8 @@ from pathlib import Path
 
 import numpy as np
 
-RATE = 48000
+from jack_server import RATE, connect_once_active, start_jack, stop, wait_for
+
 PERIOD = 64
 # The device's 14-bit tilt on CC 16 (MSB) and CC 48 (LSB), 0..16383 over 0..180°.
 MIDI_TILT_VALUE = 12287
@@ -52,6 +52,8 @@ SETTLE_S = 0.06
 QUIET_S = 0.02
 # ... and its first glug's first samples are the offline render's (the bottle was a fresh one).
 COMPARED = 256
+# How often a trial looks for its glug (s).
+POLL_S = 0.001
 
 
 def model_delay(cli, tilt_deg):
@@ -66,23 +68,6 @@ def model_delay(cli, tilt_deg):
         samples = np.loadtxt(samples_csv, dtype=np.float32)
     first = int(np.flatnonzero(samples)[0])
     return first, samples[first : first + COMPARED]
-
-
-def _connected(jack, client, source, destination):
-    try:
-        client.connect(source, destination)
-        return True
-    except jack.JackErrorCode:
-        return False
-
-
-def wait_for(condition, timeout_s, what):
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if condition():
-            return
-        time.sleep(0.001)
-    raise TimeoutError(f"timed out after {timeout_s} s waiting for {what}")
 
 
 class Rig:
@@ -116,7 +101,7 @@ class Rig:
             (self.tilt, "tilt:out", "sake_glug:midi_input"),
             (self.recorder, "sake_glug:output_1", "recorder:in"),
         ):
-            wait_for(lambda: _connected(jack, client, source, destination), 60, f"{source} → {destination}")
+            connect_once_active(client, source, destination)
 
     def _xrun(self, delay):
         self.xruns += 1
@@ -205,7 +190,7 @@ def trial(rig, send, delay, glug):
     sent = send("tilt")
     rig.watch_from = watch_from
     try:
-        wait_for(lambda: rig.first_sound is not None, 1.0, "the first glug")
+        wait_for(lambda: rig.first_sound is not None, 1.0, "the first glug", POLL_S)
     except TimeoutError:
         return "no glug within a second"
     finally:
@@ -215,7 +200,7 @@ def trial(rig, send, delay, glug):
         return "an xrun"
     if last_loud is not None and last_loud >= watch_from - QUIET_S * RATE:
         return "sound before the message"
-    wait_for(lambda: sum(map(len, rig.first_samples)) >= COMPARED, 1.0, "the first glug")
+    wait_for(lambda: sum(map(len, rig.first_samples)) >= COMPARED, 1.0, "the first glug", POLL_S)
     heard = np.concatenate(rig.first_samples)[:COMPARED]
     if np.abs(heard - glug).max() > 1e-3 * np.abs(glug).max():
         return "a first glug other than a fresh bottle's"
@@ -256,41 +241,16 @@ def measure(rig, channel, model, trials, osc_port):
     return np.array(added, dtype=float), dropped
 
 
-def start_jack(name):
+def start_jack_for_latency(name):
     """A JACK server with real-time scheduling, as an audio machine runs one (64-frame periods
     on a busy machine without it are mostly xruns), or without it where it is refused. Returns
     the server and whether it runs in real time."""
     try:
-        return start_jack_with(name, ["-R", "-P", "70"]), True
+        server, _log = start_jack(name, PERIOD, ("-R", "-P", "70"))
+        return server, True
     except RuntimeError:
-        return start_jack_with(name, ["--no-realtime"]), False
-
-
-def start_jack_with(name, scheduling):
-    import jack
-
-    log = tempfile.TemporaryFile()
-    server = subprocess.Popen(
-        ["jackd", *scheduling, "-n", name, "-d", "dummy", "-r", str(RATE), "-p", str(PERIOD)],
-        stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-    )
-
-    def up():
-        if server.poll() is not None:
-            log.seek(0)
-            raise RuntimeError(f"jackd exited: {log.read().decode(errors='replace')[-2000:]}")
-        try:
-            jack.Client("probe", servername=name, no_start_server=True).close()
-            return True
-        except jack.JackOpenError:
-            return False
-
-    try:
-        wait_for(up, 10, "the JACK server")
-    except TimeoutError as error:
-        stop(server)
-        raise RuntimeError(str(error)) from error
-    return server
+        server, _log = start_jack(name, PERIOD)
+        return server, False
 
 
 def start_app(app, server, osc_port):
@@ -313,16 +273,6 @@ def start_app(app, server, osc_port):
     finally:
         probe.close()
     return process
-
-
-def stop(process):
-    if process.poll() is None:
-        process.send_signal(signal.SIGTERM)
-        try:
-            process.wait(10)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait()
 
 
 def free_udp_port():
@@ -383,7 +333,7 @@ def main():
     args = parser.parse_args()
     models = {"MIDI": model_delay(args.cli, MIDI_TILT_DEG), "OSC": model_delay(args.cli, OSC_TILT_DEG)}
     name = f"sakeglug-latency-{os.getpid()}"
-    server, realtime = start_jack(name)
+    server, realtime = start_jack_for_latency(name)
     app = None
     rig = None
     try:

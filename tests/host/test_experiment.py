@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from test_standalone import CLI, connect_once_active, own_jack_server, stop, wait_for
+from jack_server import connect_once_active, stop, wait_for
+from test_standalone import CLI, own_jack_server
 
 NOISE_DBFS = -30.0
 SPEC = f"""

@@ -21,7 +21,8 @@ import tomllib
 import numpy as np
 import pytest
 
-from test_standalone import CLI, RATE, own_jack_server
+from jack_server import RATE
+from test_standalone import CLI, own_jack_server
 
 FILTER = "device-under-test"
 GAIN = 0.5

@@ -29,12 +29,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from jack_server import RATE, connect_once_active, forget_jack, start_jack, stop, wait_for
+
 REPO = Path(__file__).resolve().parents[2]
 TARGET = Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target"))
 APP = TARGET / "release" / "sake-glug-standalone"
 CLI = TARGET / "release" / "sake-glug"
 
-RATE = 48000
 PERIOD = 256
 # The app may add at most this to the model's own time to the first glug.
 MAX_ADDED_LATENCY_S = 0.050
@@ -48,88 +49,6 @@ QUIT_BOUND_S = 3.0
 # A JACK server that goes away must end the app within this (it waits 1 s for the audio; the
 # rest is margin for a busy machine).
 LOST_SERVER_BOUND_S = 6.0
-
-
-def wait_for(condition, timeout_s, what):
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if condition():
-            return
-        time.sleep(0.02)
-    raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
-
-
-def connect_once_active(client, source, destination, timeout_s=60):
-    """Connects two ports as soon as JACK lets it: a client's ports are visible as soon as it
-    registers them, but connecting them fails (-1) until it has activated, a window that a busy
-    machine stretches."""
-    import jack
-
-    def connected():
-        try:
-            client.connect(source, destination)
-            return True
-        except jack.JackErrorCode:
-            return False
-
-    wait_for(connected, timeout_s, f"{source} → {destination} to connect")
-
-
-def stop(process, sig=signal.SIGTERM, timeout_s=10):
-    """Stops a child we started, however it is doing; returns its exit status."""
-    if process.poll() is None:
-        process.send_signal(sig)
-        try:
-            process.wait(timeout_s)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait()
-    return process.returncode
-
-
-def start_jack(name, period=PERIOD):
-    """Starts a JACK server called `name` on the dummy driver, `period` frames a cycle; returns
-    (process, its log)."""
-    import jack
-
-    log = tempfile.TemporaryFile()
-    server = subprocess.Popen(
-        # Not --sync: a client leaving mid-cycle can stall a synchronous server. A cycle that
-        # a busy machine misses spoils a measurement, which is then taken again.
-        ["jackd", "--no-realtime", "-n", name, "-d", "dummy", "-r", str(RATE), "-p", str(period)],
-        stdout=log,
-        stderr=subprocess.STDOUT,
-        stdin=subprocess.DEVNULL,
-    )
-
-    def up():
-        if server.poll() is not None:
-            log.seek(0)
-            said = log.read().decode(errors="replace")[-2000:]
-            raise AssertionError(f"jackd exited at start ({server.returncode}): {said}")
-        try:
-            jack.Client("probe", servername=name, no_start_server=True).close()
-            return True
-        except jack.JackOpenError:
-            return False
-
-    try:
-        wait_for(up, 10, "the JACK server")
-    except BaseException:
-        stop(server, signal.SIGKILL)
-        raise
-    return server, log
-
-
-def forget_jack(name):
-    """Cleans up after a JACK server `name` that was killed: a server killed with SIGKILL keeps
-    its slot in JACK's registry of servers (8 per machine), which only a server of the same name
-    frees, and its clients' semaphores stay in /dev/shm."""
-    server, log = start_jack(name)
-    stop(server, signal.SIGTERM)
-    log.close()
-    for semaphore in Path("/dev/shm").glob(f"jack_sem.*_{name}_*"):
-        semaphore.unlink(missing_ok=True)
 
 
 def own_jack_server(prefix, needs, period=PERIOD):
@@ -586,7 +505,7 @@ def test_sigterm_ends_the_app_at_once_with_its_editor_open(jack_server, display,
 @pytest.mark.parametrize("kill", [signal.SIGKILL, signal.SIGTERM], ids=lambda sig: sig.name)
 def test_a_jack_server_that_goes_away_is_logged_and_ends_the_app(jack_server, app, kill):
     name = f"sakeglug-lost-{kill.name}-{os.getpid()}"
-    server, server_log = start_jack(name)
+    server, server_log = start_jack(name, PERIOD)
     try:
         process, log = app(server=name)
         time.sleep(0.3)
@@ -600,7 +519,7 @@ def test_a_jack_server_that_goes_away_is_logged_and_ends_the_app(jack_server, ap
     finally:
         stop(server, signal.SIGKILL)
         server_log.close()
-        forget_jack(name)
+        forget_jack(name, PERIOD)
     print(f"the app ended {took_s * 1000:.0f} ms after its JACK server")
     said = [line for line in read(log).splitlines() if "audio stopped" in line]
     assert len(said) == 1, f"one line says the audio stopped: {read(log)}"
