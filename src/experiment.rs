@@ -8,8 +8,8 @@ use clap::{Args, ValueEnum};
 use sake_glug_io::text::{printable, quoted};
 
 use sake_glug_study::{
-    check_dry_run_folder, order_seed, plan_trials, render_stimuli, write_dry_run, Discriminate,
-    Equalize, Silent, Spec, StudyError, StudySession, TrialLog,
+    check_dry_run_folder, order_seed, plan_trials, render_stimuli, write_dry_run, Design,
+    Discriminate, Equalize, Silent, Spec, StudyError, StudySession, TrialLog, DISCRIMINATE_DESIGNS,
 };
 #[cfg(feature = "audio")]
 use sake_glug_study::{AlsaOutput, Channels, JackOutput, Presenter};
@@ -24,9 +24,10 @@ pub struct ExperimentArgs {
     /// The study's spec file (see experiments/README.md).
     #[arg(required_unless_present = "discriminate")]
     spec: Option<PathBuf>,
-    /// Without a spec file: a 2AFC study of a recording against the model fitted to it ("which
-    /// one is the recording?"), the recording's excerpt and the model's render level-matched by
-    /// RMS, each order --repetitions times.
+    /// Without a spec file: a discrimination study of a recording against the model fitted to
+    /// it (by default a triangle test: "two are alike: which one is different?"), the
+    /// recording's excerpt and the model's render level-matched by RMS, each arrangement
+    /// --repetitions times.
     #[arg(
         long,
         num_args = 2,
@@ -34,7 +35,9 @@ pub struct ExperimentArgs {
         conflicts_with = "spec"
     )]
     discriminate: Option<Vec<PathBuf>>,
-    /// With --discriminate: the design (2afc; triangle and abx are analysed, not yet played).
+    /// With --discriminate: the design: `triangle` (three stimuli, two alike: which one is
+    /// different? 6 arrangements), `2afc` (which one is the recording? 2 orders) or `abx` (is
+    /// the third the first or the second? 4 arrangements) [default: triangle].
     #[arg(long, requires = "discriminate", value_name = "DESIGN")]
     design: Option<String>,
     /// With --discriminate: each stimulus's length (s) [default: 2].
@@ -43,8 +46,8 @@ pub struct ExperimentArgs {
     /// With --discriminate: where the recording's excerpt starts (s) [default: 0].
     #[arg(long = "start-s", requires = "discriminate", value_name = "S")]
     start_s: Option<f64>,
-    /// With --discriminate: presentations of each order (the recording first, then second)
-    /// [default: 10].
+    /// With --discriminate: presentations of each arrangement (the triangle's 6, 2AFC's 2,
+    /// ABX's 4) [default: 4 for the triangle (24 trials), 10 for 2AFC, 6 for ABX].
     #[arg(long, requires = "discriminate", value_name = "N")]
     repetitions: Option<u32>,
     /// The participant's ID: with the spec's seed it fixes the trial order.
@@ -53,8 +56,9 @@ pub struct ExperimentArgs {
     /// The trial log (CSV), one row appended per answer.
     #[arg(long, required_unless_present = "no_answers")]
     log: Option<PathBuf>,
-    /// Writes every trial's two stimuli as WAV files and the trial list into this new (or
-    /// empty) folder, and runs the session without playing anything.
+    /// Writes every trial's stimuli as WAV files and the trial list into this new (or empty)
+    /// folder, and runs the session without playing anything. If the answers (stdin) end
+    /// before the first one, the dry run ends there as --no-answers does (exit status 0).
     #[arg(long, value_name = "DIR")]
     dry_run: Option<PathBuf>,
     /// With --dry-run: writes the folder and ends there, asking for no answers and keeping no
@@ -199,30 +203,34 @@ fn load_spec(args: &ExperimentArgs) -> Result<(PathBuf, Spec), StudyError> {
         return Spec::load(&path).map(|spec| (path, spec));
     };
     let path = PathBuf::from("--discriminate");
-    match args.design.as_deref().unwrap_or("2afc") {
-        "2afc" => {}
-        "triangle" | "abx" => {
-            return Err(StudyError::Spec {
-                path,
-                message: "--design: the runner plays `2afc`; triangle and ABX trials (three \
-                          stimuli) are analysed by `sake-glug analyze discrimination` but not \
-                          played yet"
-                    .into(),
-            })
-        }
-        other => {
-            return Err(StudyError::Spec {
-                path,
-                message: format!("--design `{}`: `2afc`", quoted(other)),
-            })
-        }
-    }
+    let design = match args.design.as_deref() {
+        None => DISCRIMINATE_DESIGNS[0],
+        Some(name) => Design::from_name(name)
+            .filter(|design| DISCRIMINATE_DESIGNS.contains(design))
+            .ok_or_else(|| {
+                let names: Vec<String> = DISCRIMINATE_DESIGNS
+                    .iter()
+                    .map(|design| format!("`{}`", design.name()))
+                    .collect();
+                StudyError::Spec {
+                    path: path.clone(),
+                    message: format!("--design `{}`: one of {}", quoted(name), names.join(", ")),
+                }
+            })?,
+    };
+    // About two dozen trials whatever the design.
+    let repetitions = match design {
+        Design::Triangle => 4,
+        Design::Abx => 6,
+        _ => 10,
+    };
     let study = Discriminate {
+        design,
         recording: files[0].clone(),
         model: files[1].clone(),
         start_s: args.start_s.unwrap_or(0.0),
         duration_s: args.duration_s.unwrap_or(2.0),
-        repetitions: args.repetitions.unwrap_or(10),
+        repetitions: args.repetitions.unwrap_or(repetitions),
     };
     Spec::parse(&study.spec_text(), &path).map(|spec| (path, spec))
 }
@@ -328,7 +336,7 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
     // Locked and checked whole before anything is written, its own rows or the dry run's.
     let resumed = match (&args.log, args.resume) {
         (Some(log), true) => {
-            let (log, done) = TrialLog::resume(log, &session).map_err(usage)?;
+            let (log, done) = session.resume_log(log).map_err(usage)?;
             // Counted with the practice trials, which come first.
             println!(
                 "Resuming after trial {done} of {}.",
@@ -389,5 +397,19 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         #[cfg(not(feature = "audio"))]
         None => unreachable!("refused above without --dry-run"),
     };
-    result.map_err(|error| (1, error))
+    match result {
+        // A dry run whose answers end before the first one (stdin closed, or /dev/null) is a
+        // scripted dry run, as --no-answers is: its folder is the job, done.
+        Err(StudyError::InputClosed { answered, total })
+            if args.dry_run.is_some() && answered == done =>
+        {
+            eprintln!(
+                "The answers (stdin) ended before the first one: the dry run's folder is \
+                 written, and no trial was answered in this run ({answered} of {total} in the \
+                 log; --resume continues). `--no-answers` (without --log) does this without a log."
+            );
+            Ok(())
+        }
+        result => result.map_err(|error| (1, error)),
+    }
 }

@@ -10,12 +10,17 @@ the logged frames, sample for sample what the dry run of the same spec and parti
 the masking noise is on the headphone channels alone, at its level, and none of the stimulus
 leaks into them. A device ALSA does not know is refused with a message naming it.
 
+The same for a triangle test of a recording against a scene: three stimuli a trial in the
+participant's seeded order, the recording resampled to JACK's rate, level-matched, the same
+samples at each presentation; and on ALSA a session killed mid-way and resumed.
+
 Needs the release `sake-glug` built with audio (`cargo build --release --bin sake-glug
 --no-default-features --features cli,audio`), and `jackd` (Debian's jackd2) for the JACK test.
 """
 
 import csv
 import os
+import signal
 import subprocess
 import time
 from pathlib import Path
@@ -258,3 +263,170 @@ def check_recording(tmp_path, rows, recorded, start):
         both = stimulus_mask & session
         correlation = np.corrcoef(headphone[both], actuator[both])[0, 1]
         assert abs(correlation) < 0.05, correlation
+
+
+# A triangle test of a recording (44.1 kHz) against the built-in pour: the recording is
+# resampled to a 48 kHz interface, level-matched by RMS, the same samples at every presentation.
+RECORDING = Path(__file__).resolve().parents[1] / "fixtures" / "recordings" / \
+    "isbeorn-bottle-glugs-44k.wav"
+TRIANGLE_SPEC = f"""
+design = "triangle"
+duration_s = 0.4
+gap_s = 0.2
+repetitions = 1
+seed = 11
+equalize = "rms"
+
+[stimuli.recording]
+audio = "{RECORDING}"
+
+[stimuli.model]
+preset = "water"
+"""
+TRIANGLE_TRIALS = 6
+PLACES = ("first", "second", "third")
+
+
+def triangle_dry_run(tmp_path, participant="p1"):
+    """The triangle spec written, and its dry run's trial list for `participant` (the seeded
+    order; the dry run plays at the recording's own rate, so only its order is compared)."""
+    assert CLI.exists(), f"{CLI} is missing: build it with --features cli,audio"
+    (tmp_path / "triangle.toml").write_text(TRIANGLE_SPEC)
+    dry = subprocess.run(
+        [CLI, "experiment", "triangle.toml", "--participant", participant, "--dry-run",
+         f"dry-{participant}", "--no-answers"],
+        cwd=tmp_path, capture_output=True, text=True, timeout=120,
+    )
+    assert dry.returncode == 0, dry.stderr
+    return list(csv.DictReader(open(tmp_path / f"dry-{participant}" / "trials.csv")))
+
+
+def check_triangle_log(rows, trials):
+    """The log holds the seeded order, and whether each answer named the odd one."""
+    assert len(rows) == TRIANGLE_TRIALS
+    for row, trial in zip(rows, trials):
+        assert row["design"] == "triangle"
+        assert tuple(row[place] for place in PLACES) == tuple(trial[place] for place in PLACES)
+        played = [row[place] for place in PLACES]
+        chosen = played[int(row["pressed"]) - 1]
+        assert row["answer"] == chosen
+        assert row["correct"] == ("1" if played.count(chosen) == 1 else "0")
+
+
+def check_triangle_recording(rows, actuator, start, rate):
+    """Each trial's three stimuli on the actuator at their logged frames (NaN: not recorded),
+    the gap between them; every presentation of a stimulus the same samples, as long as the
+    spec's duration at the interface's rate, and the two stimuli at one RMS level."""
+    length = round(0.4 * rate)
+    heard = {}
+    for row in rows:
+        onsets = [int(row[f"{place}_onset_frame"]) - start for place in PLACES]
+        assert onsets[1] - onsets[0] == onsets[2] - onsets[1] == length + round(0.2 * rate)
+        for place, at in zip(PLACES, onsets):
+            samples = actuator[at : at + length]
+            assert len(samples) == length, "recorded whole"
+            name = row[place]
+            if name in heard:
+                kept = ~np.isnan(samples) & ~np.isnan(heard[name])
+                assert kept.mean() > 0.5
+                assert np.array_equal(samples[kept], heard[name][kept]), \
+                    f"trial {row['trial']}: `{name}` differs from its earlier presentations"
+                # A frame the recorder missed in one presentation is filled from another.
+                missing = np.isnan(heard[name])
+                heard[name][missing] = samples[missing]
+            else:
+                heard[name] = samples.copy()
+            # Silence before and after, up to the gap.
+            assert not np.any(np.nan_to_num(actuator[at + length : at + length + 100]))
+    assert set(heard) == {"recording", "model"}
+    assert not any(np.isnan(samples).any() for samples in heard.values()), \
+        "every frame of each stimulus heard in one presentation or another"
+    levels = {name: np.sqrt(np.mean(samples.astype(np.float64) ** 2))
+              for name, samples in heard.items()}
+    assert abs(levels["recording"] / levels["model"] - 1) < 1e-3, f"RMS matched: {levels}"
+
+
+def test_a_triangle_test_of_a_recording_plays_on_jack_in_the_seeded_order(jack_server, tmp_path):
+    import jack
+
+    trials = triangle_dry_run(tmp_path)
+    recorder = jack.Client("recorder3", servername=jack_server, no_start_server=True)
+    inport = recorder.inports.register("in_1")
+    chunks = []
+    recording = [True]
+
+    def record(frames):
+        if recording[0]:
+            chunks.append((recorder.last_frame_time, inport.get_array().copy()))
+
+    recorder.set_process_callback(record)
+    recorder.activate()
+    env = dict(os.environ, JACK_DEFAULT_SERVER=jack_server)
+    client = "triangle-under-test"
+    runner = subprocess.Popen(
+        [CLI, "experiment", "triangle.toml", "--participant", "p1", "--log", "log.csv",
+         "--client-name", client],
+        cwd=tmp_path, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE, text=True,
+    )
+    try:
+        wait_for(lambda: len(recorder.get_ports(f"{client}:out_")) == 1, 60, "the runner's port")
+        connect_once_active(recorder, f"{client}:out_1", "recorder3:in_1")
+        # Key 4 is no answer in a triangle: asked again.
+        out, err = runner.communicate("\n" + "4\n1\n2\n3\n" * 2, timeout=60)
+        assert runner.returncode == 0, err
+        assert out.count("Please answer 1, 2 or 3") == 2
+        assert "(48000 Hz)" in out
+        time.sleep(0.1)
+    finally:
+        stop(runner)
+        recording[0] = False
+        recorder.deactivate()
+        recorder.close()
+    rows = list(csv.DictReader(open(tmp_path / "log.csv")))
+    check_triangle_log(rows, trials)
+    start = chunks[0][0]
+    length = chunks[-1][0] + len(chunks[-1][1]) - start
+    actuator = np.full(length, np.nan, dtype=np.float32)
+    for frame, array in chunks:
+        actuator[frame - start : frame - start + len(array)] = array
+    check_triangle_recording(rows, actuator, start, 48000)
+
+
+def test_a_triangle_test_killed_on_alsa_resumes_in_the_seeded_order(tmp_path):
+    """On ALSA's `file` device (asked for the recording's rate, 44.1 kHz, and given it): three
+    trials answered, the runner killed while it waits for the fourth, then `--resume` plays the
+    other three into a second file; the log holds the six in the seeded order."""
+    trials = triangle_dry_run(tmp_path)
+    first = subprocess.Popen(
+        [CLI, "experiment", "triangle.toml", "--participant", "p1", "--log", "log.csv",
+         "--audio", "alsa", "--alsa-device", f"file:FILE={tmp_path / 'a.wav'},FORMAT=wav"],
+        cwd=tmp_path, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        first.stdin.write("\n1\n2\n3\n")
+        first.stdin.flush()
+
+        def rows_logged():
+            log = tmp_path / "log.csv"
+            return log.exists() and len(list(csv.DictReader(open(log)))) == 3
+
+        wait_for(rows_logged, 60, "three rows in the log")
+    finally:
+        stop(first, signal.SIGKILL)
+    resumed = subprocess.run(
+        [CLI, "experiment", "triangle.toml", "--participant", "p1", "--log", "log.csv",
+         "--resume", "--audio", "alsa", "--alsa-device",
+         f"file:FILE={tmp_path / 'b.wav'},FORMAT=wav"],
+        cwd=tmp_path, input="\n1\n2\n3\n", capture_output=True, text=True, timeout=120,
+    )
+    assert resumed.returncode == 0, resumed.stderr
+    assert "Resuming after trial 3 of 6." in resumed.stdout
+    rows = list(csv.DictReader(open(tmp_path / "log.csv")))
+    check_triangle_log(rows, trials)
+    # The second run's device got the recording's own rate (ALSA is asked for it), and holds
+    # its three trials at their logged frames.
+    recorded, rate = read_f32_wav_channels(tmp_path / "b.wav")
+    assert rate == 44100
+    check_triangle_recording(rows[3:], recorded[0], 0, rate)

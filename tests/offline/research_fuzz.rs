@@ -255,7 +255,7 @@ proptest! {
         let path = folder.path().join("log.csv");
         let text = mutate(&base.log, &edits);
         std::fs::write(&path, &text).unwrap();
-        match TrialLog::resume(&path, &base.session()) {
+        match base.session().resume_log(&path) {
             Ok((_, done)) => prop_assert!(done <= base.trials.len()),
             Err(error) => assert_clean("resumed log", &error.to_string()),
         }
@@ -277,7 +277,7 @@ fn the_bases_are_valid() {
     let base = ResumeBase::get();
     let log = folder.path().join("resumed.csv");
     std::fs::write(&log, &base.log).unwrap();
-    let (_, done) = TrialLog::resume(&log, &base.session()).unwrap();
+    let (_, done) = base.session().resume_log(&log).unwrap();
     assert_eq!(done, 7);
     for (base, constant) in [(PAIRED_LOG, false), (CONSTANT_LOG, true)] {
         let log = folder.path().join("log.csv");

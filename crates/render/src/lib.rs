@@ -22,6 +22,7 @@ pub use outputs::{remove_temporary_files, render_to_files, RenderReport};
 pub use render::{
     render_scene, render_scene_to_vec, BottleReport, RenderError, RenderObserver, RenderSummary,
 };
+pub use resample::Resample;
 pub use scene::{
     InputFile, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S, MAX_SCENE_BYTES,
 };

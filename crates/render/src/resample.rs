@@ -1,5 +1,5 @@
-//! The render's samples at another rate, for a format that plays one rate only (the DualSense's
-//! 48 kHz). rubato's synchronous FFT resampler (`Fft`): the ratio of two whole rates is fixed
+//! Samples at another rate: the project's one resampler, for a format that plays one rate only
+//! (the DualSense's 48 kHz) and for a study's recording played at the interface's rate. rubato's synchronous FFT resampler (`Fft`): the ratio of two whole rates is fixed
 //! and exact, which is the job it is made for (band-limited, as good as its asynchronous sinc
 //! resampler, and faster). It is fed as the render runs, in chunks of its own size whatever the
 //! render's blocks, so the output is the same at every block size; its delay is trimmed, so the
@@ -15,8 +15,9 @@ use rubato::{Fft, FixedSync, Indexing, Resampler};
 /// Input frames handed to the resampler at a time.
 const CHUNK_FRAMES: usize = 1024;
 
-/// A stream of samples resampled from one rate to another.
-pub(crate) struct Resample {
+/// A stream of samples resampled from one rate to another: fed with [`Resample::push`] in blocks
+/// of any size, ended with [`Resample::finish`]; the output is the same at every block size.
+pub struct Resample {
     fft: Fft<f64>,
     /// Input not yet handed to the resampler: less than a chunk.
     input: Vec<f64>,

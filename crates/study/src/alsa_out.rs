@@ -23,7 +23,7 @@ use alsa::pcm::{Access, Format, HwParams, IoFormat, IO, PCM};
 use alsa::{Direction, ValueOr};
 
 use super::mix::{Mix, Timeline};
-use super::session::{Presented, Presenter};
+use super::session::{Onsets, Presented, Presenter};
 use super::spec::Channels;
 use super::trials::Trial;
 use super::StudyError;
@@ -122,7 +122,7 @@ fn offset(now: Instant, seconds: f64) -> Instant {
 /// The player: the writer thread runs until this is dropped.
 pub struct AlsaPlayer {
     device: String,
-    requests: Option<Sender<(usize, usize)>>,
+    requests: Option<Sender<Trial>>,
     reports: Receiver<Result<Played, StudyError>>,
     writer: Option<JoinHandle<()>>,
     timeline: Timeline,
@@ -276,7 +276,7 @@ impl AlsaOutput {
     fn write<S: Sample>(
         self,
         mix: Mix,
-        requested: Receiver<(usize, usize)>,
+        requested: Receiver<Trial>,
         report: Sender<Result<Played, StudyError>>,
     ) {
         if let Err(error) = self.write_periods::<S>(mix, &requested, &report) {
@@ -288,7 +288,7 @@ impl AlsaOutput {
     fn write_periods<S: Sample>(
         &self,
         mut mix: Mix,
-        requested: &Receiver<(usize, usize)>,
+        requested: &Receiver<Trial>,
         report: &Sender<Result<Played, StudyError>>,
     ) -> Result<(), StudyError> {
         let io = self
@@ -310,9 +310,9 @@ impl AlsaOutput {
         loop {
             if !mix.playing() {
                 match requested.try_recv() {
-                    Ok((first, second)) => {
-                        mix.begin(first, second);
-                        let (_, length) = mix.timeline().of(first, second);
+                    Ok(asked) => {
+                        mix.begin(asked);
+                        let length = mix.timeline().of(asked).end;
                         trial = Some(Playing {
                             onset: written,
                             end: written + length,
@@ -425,10 +425,9 @@ impl Presenter for AlsaPlayer {
             ))
         };
         let requests = self.requests.as_ref().ok_or_else(stopped)?;
-        requests
-            .send((trial.first, trial.second))
-            .map_err(|_| stopped())?;
-        let (second_onset, length) = self.timeline.of(trial.first, trial.second);
+        requests.send(trial).map_err(|_| stopped())?;
+        let placed = self.timeline.of(trial);
+        let length = placed.end;
         // Far longer than the trial: a device that stopped taking samples.
         let give_up = Duration::from_secs_f64(2.0 * length as f64 / self.sample_rate as f64 + 5.0);
         let played = match self.reports.recv_timeout(give_up) {
@@ -461,7 +460,11 @@ impl Presenter for AlsaPlayer {
             std::thread::sleep(wait);
         }
         Ok(Presented {
-            onset_frames: Some((played.onset, played.onset + second_onset)),
+            onset_frames: Some(Onsets {
+                first: played.onset,
+                second: played.onset + placed.onsets[1],
+                third: (placed.count > 2).then(|| played.onset + placed.onsets[2]),
+            }),
             ended: played.ended,
         })
     }

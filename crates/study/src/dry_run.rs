@@ -1,9 +1,9 @@
-//! The dry run's folder: every trial's two stimuli as mono 32-bit float WAV files, with the
+//! The dry run's folder: every trial's stimuli (two, or three in the triangle and ABX) as mono 32-bit float WAV files, with the
 //! trial list, written all or nothing (a temporary folder beside the target, renamed onto it).
 //!
 //! What it writes is known before it starts, and refused with the figure if the disk has not the
 //! room; a session has at most [`MAX_TRIALS`](crate::MAX_TRIALS) trials, so a dry run at most
-//! twice as many files and the list. A temporary folder that a killed dry run left is removed by
+//! three times as many files and the list. A temporary folder that a killed dry run left is removed by
 //! the next one to the same folder (it is named after its process, as every temporary file).
 
 use std::fs::File;
@@ -117,7 +117,7 @@ pub fn write_dry_run(
     let mut written = Vec::new();
     let mut copies_checked = false;
     for (trial, names) in session.trials.iter().zip(&files) {
-        for (stimulus, name) in [trial.first, trial.second].into_iter().zip(names) {
+        for (stimulus, name) in trial.played().zip(names) {
             let path = temp.path().join(name);
             let source = &stimulus_files[stimulus];
             if std::fs::hard_link(source, &path).is_err() {
@@ -126,7 +126,12 @@ pub fn write_dry_run(
                     let copies = session
                         .trials
                         .iter()
-                        .map(|trial| stimulus_bytes[trial.first] + stimulus_bytes[trial.second])
+                        .map(|trial| {
+                            trial
+                                .played()
+                                .map(|stimulus| stimulus_bytes[stimulus])
+                                .sum::<u64>()
+                        })
                         .sum::<u64>();
                     room(
                         copies,
@@ -158,11 +163,12 @@ pub fn write_dry_run(
     Ok(written)
 }
 
-/// The trial list's bytes and each trial's two file names: `trial-007-1-model.wav`, ….
+/// The trial list's bytes and each trial's file names, one a stimulus played:
+/// `trial-007-1-model.wav`, ….
 fn trial_list(
     session: &StudySession,
     dir: &Path,
-) -> Result<(Vec<u8>, Vec<[String; 2]>), StudyError> {
+) -> Result<(Vec<u8>, Vec<Vec<String>>), StudyError> {
     let spec = session.spec;
     let mut list = csv::Writer::from_writer(Vec::new());
     let list_error = |error: csv::Error| StudyError::Io {
@@ -177,29 +183,41 @@ fn trial_list(
         "second_file",
         "first_gain_db",
         "second_gain_db",
+        "third",
+        "third_file",
+        "third_gain_db",
     ])
     .map_err(list_error)?;
     let mut files = Vec::with_capacity(session.trials.len());
     for (index, trial) in session.trials.iter().enumerate() {
-        let [first, second] = [(1, trial.first), (2, trial.second)].map(|(place, stimulus)| {
-            format!(
-                "trial-{:03}-{place}-{}.wav",
-                index + 1,
-                file_safe(&spec.stimuli[stimulus].name)
-            )
-        });
+        let names: Vec<String> = trial
+            .played()
+            .zip(1..)
+            .map(|(stimulus, place)| {
+                format!(
+                    "trial-{:03}-{place}-{}.wav",
+                    index + 1,
+                    file_safe(&spec.stimuli[stimulus].name)
+                )
+            })
+            .collect();
         // The names are the spec's: a spreadsheet shows them as text, never runs them.
+        let name = |stimulus: usize| csv_cell(&spec.stimuli[stimulus].name).into_owned();
+        let gain = |stimulus: usize| session.rendered[stimulus].gain_db.to_string();
         list.write_record([
             (index + 1).to_string(),
-            csv_cell(&spec.stimuli[trial.first].name).into_owned(),
-            csv_cell(&spec.stimuli[trial.second].name).into_owned(),
-            first.clone(),
-            second.clone(),
-            session.rendered[trial.first].gain_db.to_string(),
-            session.rendered[trial.second].gain_db.to_string(),
+            name(trial.first),
+            name(trial.second),
+            names[0].clone(),
+            names[1].clone(),
+            gain(trial.first),
+            gain(trial.second),
+            trial.third.map(name).unwrap_or_default(),
+            names.get(2).cloned().unwrap_or_default(),
+            trial.third.map(gain).unwrap_or_default(),
         ])
         .map_err(list_error)?;
-        files.push([first, second]);
+        files.push(names);
     }
     Ok((list.into_inner().expect("a Vec never fails"), files))
 }

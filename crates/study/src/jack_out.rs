@@ -12,7 +12,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use super::mix::{Mix, Timeline};
-use super::session::{Presented, Presenter};
+use super::session::{Onsets, Presented, Presenter};
 use super::spec::Channels;
 use super::trials::Trial;
 use super::StudyError;
@@ -26,7 +26,7 @@ pub struct JackOutput {
 /// The callback's side of the hand-off.
 #[derive(Default)]
 struct Shared {
-    /// Generation (high 32 bits), first and second stimulus (16 bits each) of the trial asked.
+    /// The trial asked: its generation and stimuli ([`encode`]).
     request: AtomicU64,
     /// Generation of the last trial that has ended.
     ended: AtomicU64,
@@ -44,6 +44,32 @@ pub struct JackPlayer {
 }
 
 type Callback = Box<dyn FnMut(&Client, &jack::ProcessScope) -> Control + Send>;
+
+/// A stimulus's index in a request: 16 bits, all ones for none (a two-interval trial's third).
+/// A spec has far fewer stimuli than that (at most [`crate::MAX_TRIALS`] + 1).
+const NO_STIMULUS: u64 = 0xffff;
+const _: () = assert!(crate::MAX_TRIALS < NO_STIMULUS);
+
+/// A request in one word: the generation in the high 16 bits (a session has far fewer trials
+/// than 2¹⁶, practice included), then the first, second and third stimulus, 16 bits each.
+fn encode(generation: u64, trial: Trial) -> u64 {
+    let third = trial.third.map_or(NO_STIMULUS, |third| third as u64);
+    (generation << 48) | ((trial.first as u64) << 32) | ((trial.second as u64) << 16) | third
+}
+
+/// The generation and the trial of a request.
+fn decode(request: u64) -> (u64, Trial) {
+    let stimulus = |shift: u32| ((request >> shift) & 0xffff) as usize;
+    let third = (request & 0xffff != NO_STIMULUS).then(|| stimulus(0));
+    (
+        request >> 48,
+        Trial {
+            first: stimulus(32),
+            second: stimulus(16),
+            third,
+        },
+    )
+}
 
 fn audio_error(what: &str, error: impl std::fmt::Display) -> StudyError {
     StudyError::Audio(format!("{what}: {error}"))
@@ -97,14 +123,10 @@ impl JackOutput {
         let callback: Callback = Box::new(move |_client, scope| {
             let frames = scope.n_frames() as usize;
             let now = scope.last_frame_time();
-            let request = callback_shared.request.load(Ordering::Acquire);
-            let generation = request >> 32;
+            let (generation, trial) = decode(callback_shared.request.load(Ordering::Acquire));
             if playing.is_none() && generation > served {
                 served = generation;
-                mix.begin(
-                    ((request >> 16) & 0xffff) as usize,
-                    (request & 0xffff) as usize,
-                );
+                mix.begin(trial);
                 playing = Some((generation, now));
                 callback_shared
                     .onset_frame
@@ -146,9 +168,11 @@ impl JackOutput {
 impl Presenter for JackPlayer {
     fn present(&mut self, trial: Trial) -> Result<Presented, StudyError> {
         self.generation += 1;
-        let request = (self.generation << 32) | ((trial.first as u64) << 16) | trial.second as u64;
-        self.shared.request.store(request, Ordering::Release);
-        let (second_onset, length) = self.timeline.of(trial.first, trial.second);
+        self.shared
+            .request
+            .store(encode(self.generation, trial), Ordering::Release);
+        let placed = self.timeline.of(trial);
+        let length = placed.end;
         // Far longer than the trial: a server that stopped running our callback.
         let give_up = Instant::now()
             + Duration::from_secs_f64(2.0 * length as f64 / self.sample_rate as f64 + 5.0);
@@ -170,7 +194,11 @@ impl Presenter for JackPlayer {
         let now_us = client.time();
         let since = Duration::from_micros(now_us.saturating_sub(end_us));
         Ok(Presented {
-            onset_frames: Some((first, first + second_onset)),
+            onset_frames: Some(Onsets {
+                first,
+                second: first + placed.onsets[1],
+                third: (placed.count > 2).then(|| first + placed.onsets[2]),
+            }),
             ended: Instant::now()
                 .checked_sub(since)
                 .unwrap_or_else(Instant::now),

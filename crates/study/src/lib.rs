@@ -1,8 +1,10 @@
-//! Listening studies (feature `study`): the paper's two designs run on any actuator.
+//! Listening studies (feature `study`): the paper's two designs, and discrimination (2AFC,
+//! triangle, ABX), run on any actuator.
 //!
-//! A [`Spec`] file names the stimuli (scenes, presets or model files with scene keys over them)
-//! and the design; [`plan_trials`] orders a participant's trials from a seed; [`render_stimuli`]
-//! renders each stimulus once with the offline renderer and matches their levels; a [`StudySession`]
+//! A [`Spec`] file names the stimuli (scenes, presets or model files with scene keys over them,
+//! or recordings) and the design; [`plan_trials`] orders a participant's trials from a seed;
+//! [`render_stimuli`] renders each stimulus once with the offline renderer (or reads a
+//! recording) and matches their levels; a [`StudySession`]
 //! presents the trials through a [`Presenter`] (with feature `audio` a JACK server or an ALSA
 //! device, whose samples come from one mix; or [`Silent`] for a dry run, whose files
 //! [`write_dry_run`] writes), reads each answer and appends it to the [`TrialLog`] at once.
@@ -31,10 +33,11 @@ pub use dry_run::{check_dry_run_folder, write_dry_run, TRIAL_LIST};
 pub use jack_out::{JackOutput, JackPlayer};
 pub use log::{header as log_header, LogRow, TrialLog};
 pub use recording::{Recording, RECORDING_RATES_HZ};
-pub use session::{Place, Presented, Presenter, Silent, StudySession};
+pub use session::{Onsets, Place, Presented, Presenter, Silent, StudySession};
 pub use spec::{
-    level_keys, Channels, Design, Discriminate, Equalize, Source, Spec, Stimulus, MAX_NOISE_DBFS,
-    MAX_PRACTICE, MAX_TRIALS, MIN_NOISE_DBFS, STANDARD,
+    level_keys, Channels, Design, Discriminate, Equalize, Source, Spec, Stimulus,
+    DISCRIMINATE_DESIGNS, MAX_NOISE_DBFS, MAX_PRACTICE, MAX_TRIALS, MIN_NOISE_DBFS, STANDARD,
+    STIMULUS_KEYS,
 };
 pub use stimuli::{level_of, render_stimuli, Rendered};
 pub use trials::{order_seed, plan_practice, plan_trials, Trial};

@@ -5,6 +5,11 @@
 //! its session (an advisory lock: a second session on it is refused at once), read and checked
 //! whole before a resumed session writes anything, and never shortened. Text cells that a
 //! spreadsheet would read as a formula are written as text.
+//!
+//! A log an earlier runner wrote lacks the columns added since (`practice`, `correct`, the
+//! third stimulus's): it is resumed in its own columns when the session would leave every
+//! missing one blank, else refused, naming them. This module knows rows and files; whether a
+//! row is the session's is the session's to say ([`TrialLog::resume`] takes its check).
 
 use std::fs::{File, TryLockError};
 use std::io::{Read, Write};
@@ -12,10 +17,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::session::{Place, StudySession};
 use super::StudyError;
 use sake_glug_io::append::open_to_append;
-use sake_glug_io::text::{csv_cell, cut_quotes, from_csv_cell, quoted};
+use sake_glug_io::text::{csv_cell, cut_quotes, from_csv_cell};
 use sake_glug_io::InputKind;
 
 /// One answered trial. The struct's fields are the log's columns, in order.
@@ -25,7 +29,7 @@ pub struct LogRow {
     pub participant: String,
     /// The trial's number in the session, from 1.
     pub trial: usize,
-    /// `paired` or `constant`.
+    /// The design's name: `paired`, `constant`, `2afc`, `triangle` or `abx`.
     pub design: String,
     /// The stimulus played first.
     pub first: String,
@@ -33,9 +37,9 @@ pub struct LogRow {
     pub second: String,
     /// The name of the stimulus chosen.
     pub answer: String,
-    /// The key answered: 1 (the first) or 2 (the second).
+    /// The key answered: 1 (the first), 2 (the second) or, in the triangle, 3 (the third).
     pub pressed: u8,
-    /// Seconds from the end of the second stimulus to the answer.
+    /// Seconds from the end of the trial's last stimulus to the answer.
     pub rt_s: f64,
     /// The seed of the participant's trial order.
     pub seed: u64,
@@ -56,10 +60,21 @@ pub struct LogRow {
     pub first_params: String,
     /// The second stimulus as the spec defines it.
     pub second_params: String,
-    /// 1 for a practice trial (not data: the analyses leave it out), 0 for the study's.
+    /// 1 for a practice trial (not data: the analyses leave it out), 0 for the study's. A log
+    /// written before the column has none: its rows are the study's.
+    #[serde(default)]
     pub practice: u8,
-    /// 2AFC: 1 if the target was chosen, else 0 (empty for the other designs).
+    /// The discrimination designs: 1 if the answer was right (2AFC: the target chosen;
+    /// triangle: the odd one; ABX: the one X is), else 0; empty for the other designs.
     pub correct: Option<u8>,
+    /// The stimulus played third (triangle, ABX's X); empty in the two-interval designs.
+    pub third: Option<String>,
+    /// The equalisation gain applied to the third stimulus (dB).
+    pub third_gain_db: Option<f64>,
+    /// The frame at which the third stimulus started; empty in a dry run.
+    pub third_onset_frame: Option<u64>,
+    /// The third stimulus as the spec defines it.
+    pub third_params: Option<String>,
 }
 
 impl LogRow {
@@ -75,6 +90,8 @@ impl LogRow {
             answer: cell(&self.answer),
             first_params: cell(&self.first_params),
             second_params: cell(&self.second_params),
+            third: self.third.as_deref().map(cell),
+            third_params: self.third_params.as_deref().map(cell),
             ..self.clone()
         }
     }
@@ -90,6 +107,8 @@ impl LogRow {
             answer: text(self.answer),
             first_params: text(self.first_params),
             second_params: text(self.second_params),
+            third: self.third.map(text),
+            third_params: self.third_params.map(text),
             ..self
         }
     }
@@ -100,6 +119,9 @@ impl LogRow {
 pub struct TrialLog {
     path: PathBuf,
     file: File,
+    /// The file's columns, as indices into [`header`]: all of them in a log this runner began,
+    /// fewer in one an earlier runner began.
+    columns: Vec<usize>,
 }
 
 impl TrialLog {
@@ -146,13 +168,18 @@ impl TrialLog {
         Ok(log)
     }
 
-    /// The log at `path` reopened to continue `session`, locked, and read whole before anything
-    /// is written to it: every row must be the session's (same participant, design, seed, each
-    /// trial's stimuli in the planned order, an answer that is one of them, and for the constant
-    /// design its level and whether the comparison was chosen), and the file must end with a
-    /// whole row. A log that fails is refused as it is: nothing is cut or written. Returns the
-    /// log and how many trials it holds.
-    pub fn resume(path: &Path, session: &StudySession) -> Result<(Self, usize), StudyError> {
+    /// The log at `path` reopened to continue a session, locked, and read whole before anything
+    /// is written to it: `check` must accept every row (given its index from 0; its message says
+    /// what differs), and the file must end with a whole row. A log whose columns are an
+    /// earlier runner's (some of [`header`]'s missing) is continued in its own columns if every
+    /// row of `planned` (the rows the session may still write) leaves the missing ones blank.
+    /// A log that fails is refused as it is: nothing is cut or written. Returns the log and how
+    /// many trials it holds.
+    pub fn resume(
+        path: &Path,
+        planned: &[LogRow],
+        mut check: impl FnMut(usize, &LogRow) -> Result<(), String>,
+    ) -> Result<(Self, usize), StudyError> {
         let file = open_to_append(path, false).map_err(|source| {
             if source.kind() == std::io::ErrorKind::NotFound {
                 StudyError::NothingToResume(path.to_owned())
@@ -194,13 +221,7 @@ impl TrialLog {
             .iter()
             .map(str::to_owned)
             .collect();
-        if found != header() {
-            return Err(bad(
-                1,
-                format!("its columns are not a trial log's ({})", header().join(",")),
-            ));
-        }
-        let places = session.places();
+        log.columns = columns_of(&found, planned).map_err(|message| bad(1, message))?;
         let mut done = 0;
         for record in reader.deserialize::<LogRow>() {
             let row = record
@@ -210,7 +231,7 @@ impl TrialLog {
                 })?
                 .read_back();
             let line = 2 + done as u64;
-            check_row(&row, done, &places, session).map_err(|what| {
+            check(done, &row).map_err(|what| {
                 bad(
                     line,
                     format!(
@@ -243,6 +264,7 @@ impl TrialLog {
             Ok(()) => Ok(Self {
                 path: path.to_owned(),
                 file,
+                columns: (0..header().len()).collect(),
             }),
             Err(TryLockError::WouldBlock) => Err(StudyError::LogInUse(path.to_owned())),
             Err(TryLockError::Error(source)) => Err(StudyError::Io {
@@ -252,13 +274,14 @@ impl TrialLog {
         }
     }
 
-    /// Appends `row` and syncs it to disk before returning.
+    /// Appends `row` (in the file's columns) and syncs it to disk before returning.
     pub fn append(&mut self, row: &LogRow) -> Result<(), StudyError> {
+        let cells = cells(&row.written());
         let mut writer = csv::WriterBuilder::new()
             .has_headers(false)
             .from_writer(Vec::new());
         writer
-            .serialize(row.written())
+            .write_record(self.columns.iter().map(|&column| &cells[column]))
             .map_err(|error| self.io(error.into()))?;
         self.write(&writer.into_inner().expect("a Vec never fails"))
     }
@@ -279,96 +302,84 @@ impl TrialLog {
     }
 }
 
-/// Whether `row` is what `session` plans at its place `index` (0-based, of `places`), with one
-/// of its two answers; else what differs, for the message.
-fn check_row(
-    row: &LogRow,
-    index: usize,
-    places: &[Place],
-    session: &StudySession,
-) -> Result<(), String> {
-    let shown = |text: &str| format!("`{}`", quoted(text));
-    if row.participant != session.participant {
-        return Err(format!("participant {}", shown(&row.participant)));
+/// The cells of `row` in [`header`]'s order, as written.
+fn cells(row: &LogRow) -> Vec<String> {
+    let mut writer = csv::WriterBuilder::new()
+        .has_headers(false)
+        .from_writer(Vec::new());
+    writer.serialize(row).expect("a Vec never fails");
+    let bytes = writer.into_inner().expect("a Vec never fails");
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .from_reader(&bytes[..]);
+    let record = reader
+        .records()
+        .next()
+        .expect("one row written")
+        .expect("read as written");
+    record.iter().map(str::to_owned).collect()
+}
+
+/// What a column holds in a row that leaves it blank: nothing, or for `practice` 0 (a log
+/// written before that column holds the study's trials only).
+fn blank(column: &str) -> &'static str {
+    if column == "practice" {
+        "0"
+    } else {
+        ""
     }
-    let design = session.spec.design.name();
-    if row.design != design || row.seed != session.seed {
-        return Err(format!(
-            "design {}, seed {} (this session: `{design}`, seed {})",
-            shown(&row.design),
-            row.seed,
-            session.seed
-        ));
-    }
-    let Some(&place) = places.get(index) else {
-        return Err(format!("trial {}, past the session's last", row.trial));
-    };
-    if row.practice != u8::from(place.practice) {
-        return Err(format!(
-            "row {}: practice {}, where this session plans {}",
-            index + 1,
-            row.practice,
-            if place.practice {
-                "a practice trial (1)"
-            } else {
-                "a trial of the study (0)"
-            }
-        ));
-    }
-    let pressed = match row.pressed {
-        1 | 2 => row.pressed,
-        other => {
-            return Err(format!(
-                "trial {}: key {other} pressed, not 1 or 2",
-                row.trial
-            ))
+}
+
+/// The columns of a log whose header is `found`, as indices into [`header`]; refused, with the
+/// reason, when a column is not a trial log's or is given twice, or when one is missing that a
+/// row of `planned` fills.
+fn columns_of(found: &[String], planned: &[LogRow]) -> Result<Vec<usize>, String> {
+    let all = header();
+    let not_a_log = || format!("its columns are not a trial log's ({})", all.join(","));
+    let mut columns = Vec::with_capacity(found.len());
+    for name in found {
+        let index = all
+            .iter()
+            .position(|column| column == name)
+            .ok_or_else(not_a_log)?;
+        if columns.contains(&index) {
+            return Err(not_a_log());
         }
-    };
-    let planned = session.planned_row(place, pressed);
-    let same_trial = row.trial == planned.trial
-        && row.first == planned.first
-        && row.second == planned.second
-        && row.first_params == planned.first_params
-        && row.second_params == planned.second_params;
-    if !same_trial {
+        columns.push(index);
+    }
+    // An earlier runner's log: it lacks the columns added since, and keeps its own.
+    let missing: Vec<usize> = (0..all.len())
+        .filter(|index| !columns.contains(index))
+        .collect();
+    if missing.is_empty() {
+        return Ok(columns);
+    }
+    if !missing
+        .iter()
+        .any(|&index| ["participant", "trial", "design"].contains(&all[index].as_str()))
+    {
+        let planned_cells: Vec<Vec<String>> = planned.iter().map(cells).collect();
+        let filled: Vec<String> = missing
+            .iter()
+            .filter(|&&index| {
+                planned_cells
+                    .iter()
+                    .any(|cells| cells[index] != blank(&all[index]))
+            })
+            .map(|&index| format!("`{}`", all[index]))
+            .collect();
+        if filled.is_empty() {
+            return Ok(columns);
+        }
         return Err(format!(
-            "trial {} is {} then {}; this spec plans trial {} as {} then {}",
-            row.trial,
-            shown(&row.first),
-            shown(&row.second),
-            planned.trial,
-            shown(&planned.first),
-            shown(&planned.second)
+            "an earlier runner's log: it has no column {}, which this session fills (the \
+             spec's practice trials, whether each answer was right, a third stimulus); finish \
+             it with the version that began it, or start a new log (`analyze` reads this one as \
+             it is)",
+            filled.join(", ")
         ));
     }
-    // Compared as written: a level is the spec's number, read back exactly.
-    let same_answer = row.answer == planned.answer
-        && row.level == planned.level
-        && row.chose_comparison == planned.chose_comparison
-        && row.correct == planned.correct;
-    if !same_answer {
-        return Err(format!(
-            "trial {}: answer {}, key {pressed}, level {:?}, chose_comparison {:?}, correct \
-             {:?}; key {pressed} of this trial chooses {} (level {:?}, chose_comparison {:?}, \
-             correct {:?})",
-            row.trial,
-            shown(&row.answer),
-            row.level,
-            row.chose_comparison,
-            row.correct,
-            shown(&planned.answer),
-            planned.level,
-            planned.chose_comparison,
-            planned.correct
-        ));
-    }
-    if !(row.rt_s.is_finite() && row.rt_s >= 0.0) {
-        return Err(format!(
-            "trial {}: response time {} s is not a time",
-            row.trial, row.rt_s
-        ));
-    }
-    Ok(())
+    Err(not_a_log())
 }
 
 /// The log's columns: [`LogRow`]'s fields, in order.
@@ -395,6 +406,10 @@ pub fn header() -> Vec<String> {
             second_params: String::new(),
             practice: 0,
             correct: None,
+            third: None,
+            third_gain_db: None,
+            third_onset_frame: None,
+            third_params: None,
         })
         .expect("a Vec never fails");
     let bytes = writer.into_inner().expect("a Vec never fails");

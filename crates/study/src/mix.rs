@@ -1,5 +1,5 @@
 //! What a study's output channels carry, block by block, for every audio backend: a trial's
-//! first stimulus, the gap, its second stimulus on the actuator channels, the masking noise on
+//! stimuli one after another with the gap between each two on the actuator channels, the masking noise on
 //! the headphone channels, silence elsewhere (MODEL.md §15). The backends own the clock and the
 //! hand-off; this owns the samples. It neither allocates nor locks once made.
 
@@ -7,6 +7,7 @@ use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::spec::Channels;
+use super::trials::Trial;
 
 /// What one output channel carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -23,12 +24,36 @@ pub(super) struct Timeline {
     gap: u64,
 }
 
+/// Where a trial's stimuli fall: frames from its onset to each stimulus's onset, and to its end.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Placed {
+    /// Each stimulus's onset, in the order played (the first's is 0).
+    pub(super) onsets: [u64; 3],
+    /// The stimuli played: 2 or 3.
+    pub(super) count: usize,
+    /// Just after its last sample.
+    pub(super) end: u64,
+}
+
 impl Timeline {
-    /// The frames from the onset of a trial of stimuli `first` and `second` to its second
-    /// stimulus's onset, and to its end (just after its last sample).
-    pub(super) fn of(&self, first: usize, second: usize) -> (u64, u64) {
-        let second_at = self.lengths[first] + self.gap;
-        (second_at, second_at + self.lengths[second])
+    /// Where the stimuli of `trial` fall.
+    pub(super) fn of(&self, trial: Trial) -> Placed {
+        let mut onsets = [0; 3];
+        let mut at = 0;
+        let mut count = 0;
+        for (slot, stimulus) in onsets.iter_mut().zip(trial.played()) {
+            if count > 0 {
+                at += self.gap;
+            }
+            *slot = at;
+            at += self.lengths[stimulus];
+            count += 1;
+        }
+        Placed {
+            onsets,
+            count,
+            end: at,
+        }
     }
 }
 
@@ -40,8 +65,8 @@ pub(super) struct Mix {
     /// Half the noise's span (0: no noise).
     noise_peak: f32,
     rng: Xoshiro256PlusPlus,
-    /// The trial playing: its first and second stimulus.
-    playing: Option<(usize, usize)>,
+    /// The trial playing, and where its stimuli fall.
+    playing: Option<(Trial, Placed)>,
 }
 
 impl Mix {
@@ -95,8 +120,8 @@ impl Mix {
     }
 
     /// Starts a trial: the next [`fill`](Self::fill) counts from its onset.
-    pub(super) fn begin(&mut self, first: usize, second: usize) {
-        self.playing = Some((first, second));
+    pub(super) fn begin(&mut self, trial: Trial) {
+        self.playing = Some((trial, self.timeline.of(trial)));
     }
 
     /// Fills one block of `frames` frames, `outputs` being the channels' buffers in order (one
@@ -114,22 +139,21 @@ impl Mix {
             out.fill(0.0);
             match role {
                 Role::Actuator => {
-                    if let Some((first, second)) = self.playing {
-                        let (second_at, _) = self.timeline.of(first, second);
-                        let first = &self.stimuli[first];
-                        let second = &self.stimuli[second];
+                    if let Some((trial, placed)) = self.playing {
                         for (offset, sample) in out.iter_mut().enumerate() {
                             let position = into_trial + offset as u64;
-                            *sample = if position < first.len() as u64 {
-                                first[position as usize]
-                            } else if position >= second_at {
-                                second
-                                    .get((position - second_at) as usize)
-                                    .copied()
-                                    .unwrap_or(0.0)
-                            } else {
-                                0.0
-                            };
+                            // The stimulus whose span holds this frame, if any (else a gap).
+                            *sample = trial
+                                .played()
+                                .zip(placed.onsets)
+                                .find_map(|(stimulus, onset)| {
+                                    let samples = &self.stimuli[stimulus];
+                                    position
+                                        .checked_sub(onset)
+                                        .and_then(|into| samples.get(into as usize))
+                                        .copied()
+                                })
+                                .unwrap_or(0.0);
                         }
                     }
                 }
@@ -141,10 +165,10 @@ impl Mix {
                 Role::Headphone | Role::Unused => {}
             }
         }
-        let Some((first, second)) = self.playing else {
+        let Some((_, placed)) = self.playing else {
             return false;
         };
-        let ended = into_trial + frames as u64 >= self.timeline.of(first, second).1;
+        let ended = into_trial + frames as u64 >= placed.end;
         if ended {
             self.playing = None;
         }
@@ -167,13 +191,18 @@ mod tests {
 
     /// Every block of a session, each channel's samples end to end, and the block the trial
     /// ended in.
-    fn play(mix: &mut Mix, blocks: usize, begin_at_block: usize) -> (Vec<Vec<f32>>, Option<usize>) {
+    fn play(
+        mix: &mut Mix,
+        trial: Trial,
+        blocks: usize,
+        begin_at_block: usize,
+    ) -> (Vec<Vec<f32>>, Option<usize>) {
         let mut recorded = vec![Vec::new(); mix.channels()];
         let mut buffers = vec![vec![f32::NAN; FRAMES]; mix.channels()];
         let mut ended = None;
         for block in 0..blocks {
             if block == begin_at_block {
-                mix.begin(0, 1);
+                mix.begin(trial);
             }
             let into_trial = (block.saturating_sub(begin_at_block) * FRAMES) as u64;
             if mix.fill(into_trial, FRAMES, buffers.iter_mut().map(|b| &mut b[..])) {
@@ -196,8 +225,9 @@ mod tests {
             &channels(&[1, 3], &[]),
             None,
         );
-        assert_eq!(mix.timeline().of(0, 1), (7, 10));
-        let (recorded, ended) = play(&mut mix, 6, 1);
+        let placed = mix.timeline().of(Trial::pair(0, 1));
+        assert_eq!((placed.onsets[1], placed.end, placed.count), (7, 10, 2));
+        let (recorded, ended) = play(&mut mix, Trial::pair(0, 1), 6, 1);
         let mut expected = vec![0.0; FRAMES];
         expected.extend(&first);
         expected.extend([0.0, 0.0]);
@@ -214,6 +244,30 @@ mod tests {
         assert!(!mix.playing());
     }
 
+    /// A triangle's three stimuli, each after a gap, the trial ending after the third.
+    #[test]
+    fn three_stimuli_follow_one_another_with_the_gap_between_each_two() {
+        let a = vec![1.0, 2.0];
+        let b = vec![-1.0, -2.0, -3.0];
+        let mut mix = Mix::new(vec![a.clone(), b.clone()], 1, &channels(&[1], &[]), None);
+        let trial = Trial::triple(0, 1, 0);
+        let placed = mix.timeline().of(trial);
+        assert_eq!((placed.onsets, placed.end, placed.count), ([0, 3, 7], 9, 3));
+        let (recorded, ended) = play(&mut mix, trial, 3, 0);
+        let mut expected = a.clone();
+        expected.push(0.0);
+        expected.extend(&b);
+        expected.push(0.0);
+        expected.extend(&a);
+        expected.resize(3 * FRAMES, 0.0);
+        assert_eq!(recorded[0], expected);
+        assert_eq!(
+            ended,
+            Some(2),
+            "frames 8..12 hold the trial's last, frame 8"
+        );
+    }
+
     #[test]
     fn a_trial_ending_on_a_block_boundary_ends_in_that_block() {
         let mut mix = Mix::new(
@@ -222,7 +276,7 @@ mod tests {
             &channels(&[1], &[]),
             None,
         );
-        let (_, ended) = play(&mut mix, 4, 0);
+        let (_, ended) = play(&mut mix, Trial::pair(0, 1), 4, 0);
         assert_eq!(ended, Some(1), "frames 0..8 hold the whole trial");
     }
 
@@ -236,7 +290,7 @@ mod tests {
             &channels(&[2], &[1, 4]),
             Some(noise_dbfs),
         );
-        let (recorded, ended) = play(&mut mix, 2000, 0);
+        let (recorded, ended) = play(&mut mix, Trial::pair(0, 1), 2000, 0);
         assert!(ended.is_some());
         for headphone in [&recorded[0], &recorded[3]] {
             let rms = (headphone.iter().map(|&s| (s * s) as f64).sum::<f64>()
@@ -270,7 +324,7 @@ mod tests {
     #[test]
     fn between_trials_the_noise_plays_and_the_actuator_is_silent() {
         let mut mix = Mix::new(vec![vec![1.0; 8]], 0, &channels(&[1], &[2]), Some(-30.0));
-        let (recorded, ended) = play(&mut mix, 3, usize::MAX);
+        let (recorded, ended) = play(&mut mix, Trial::pair(0, 0), 3, usize::MAX);
         assert_eq!(ended, None);
         assert!(recorded[0].iter().all(|&s| s == 0.0));
         assert!(

@@ -2,12 +2,15 @@
 //! from `start_s`, its first channel, read through the one reader (`sake_glug_io`) and hound.
 //! Refused, with the file and the reason: a file that is not a WAV hound reads, a rate it cannot
 //! be played at, an excerpt running past the file's end, silence, clipping and samples that are
-//! not numbers (MODEL.md §15).
+//! not numbers (MODEL.md §15). At another rate than the interface's, the excerpt is resampled
+//! with the project's one resampler ([`Resample`]) after these checks, once: every presentation
+//! plays the same samples.
 
 use std::path::{Path, PathBuf};
 
 use sake_glug_io::read::{self, InputKind};
 use sake_glug_io::text::printable;
+use sake_glug_render::Resample;
 
 /// The rates a recording may have (Hz): those a sound card plays.
 pub const RECORDING_RATES_HZ: std::ops::RangeInclusive<u32> = 8_000..=384_000;
@@ -55,16 +58,31 @@ impl Recording {
     }
 
     /// The excerpt of `duration_s` from `start_s`, its first channel, full scale ±1, for an
-    /// interface at `sample_rate` Hz; or why it cannot be played.
+    /// interface at `sample_rate` Hz (resampled if the file's rate is another: then exactly
+    /// `duration_s` × `sample_rate` samples, rounded, as a rendered stimulus has); or why it
+    /// cannot be played.
     pub fn excerpt(&self, duration_s: f64, sample_rate: u32) -> Result<Vec<f32>, String> {
-        let path = shown(&self.path);
-        if self.sample_rate != sample_rate {
-            return Err(format!(
-                "{path}: at {} Hz, and the interface plays {sample_rate} Hz; the runner does not \
-                 resample recordings yet: give it a file at {sample_rate} Hz",
-                self.sample_rate
-            ));
+        let samples = self.excerpt_at_its_rate(duration_s)?;
+        if self.sample_rate == sample_rate {
+            return Ok(samples);
         }
+        let mut resampled = Vec::new();
+        let mut keep = |block: &[f64]| -> Result<(), std::convert::Infallible> {
+            resampled.extend(block.iter().map(|&sample| sample as f32));
+            Ok(())
+        };
+        let mut resample = Resample::new(self.sample_rate, sample_rate);
+        let Ok(()) = resample.push(&samples, &mut keep);
+        let Ok(()) = resample.finish(&mut keep);
+        // ⌈n·to/from⌉ out may pass the rounded length by a sample.
+        let length = (duration_s * f64::from(sample_rate)).round() as usize;
+        resampled.resize(length, 0.0);
+        Ok(resampled)
+    }
+
+    /// The excerpt at the file's own rate, checked.
+    fn excerpt_at_its_rate(&self, duration_s: f64) -> Result<Vec<f32>, String> {
+        let path = shown(&self.path);
         let mut reader = wav_reader(&self.path)?;
         let spec = reader.spec();
         let channels = usize::from(spec.channels.max(1));

@@ -14,7 +14,7 @@ use sake_glug_io::read::{self, InputKind};
 use sake_glug_io::text::{cut_quotes, quoted};
 use sake_glug_render::{Scene, DEFAULT_SCENE, MAX_DURATION_S};
 
-/// The designs: the paper's two studies, and discrimination.
+/// The designs: the paper's two studies, and three of discrimination.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Design {
@@ -26,6 +26,11 @@ pub enum Design {
     /// (two-alternative forced choice; `sake-glug analyze discrimination` reads its log).
     #[serde(rename = "2afc")]
     TwoAfc,
+    /// Two stimuli, three intervals, two alike: which one is different? (oddity; either
+    /// stimulus the odd one, at each place).
+    Triangle,
+    /// Two stimuli as A and B, then X, one of them: is X A or B?
+    Abx,
 }
 
 impl Design {
@@ -35,7 +40,44 @@ impl Design {
             Design::Paired => "paired",
             Design::Constant => "constant",
             Design::TwoAfc => "2afc",
+            Design::Triangle => "triangle",
+            Design::Abx => "abx",
         }
+    }
+
+    /// Every design, in the order `--help` and the messages list them.
+    pub const ALL: [Design; 5] = [
+        Design::Paired,
+        Design::Constant,
+        Design::TwoAfc,
+        Design::Triangle,
+        Design::Abx,
+    ];
+
+    /// The design of `name` (as the spec and the log write it).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|design| design.name() == name)
+    }
+
+    /// The stimuli a trial plays: 3 in the triangle and ABX, else 2.
+    pub fn intervals(self) -> u8 {
+        match self {
+            Design::Triangle | Design::Abx => 3,
+            Design::Paired | Design::Constant | Design::TwoAfc => 2,
+        }
+    }
+
+    /// The answers a trial takes (keys 1 to this): the triangle's three places, else two.
+    pub fn answers(self) -> u8 {
+        match self {
+            Design::Triangle => 3,
+            _ => 2,
+        }
+    }
+
+    /// Whether its log rows say if the answer was right (the discrimination designs).
+    pub fn discriminates(self) -> bool {
+        matches!(self, Design::TwoAfc | Design::Triangle | Design::Abx)
     }
 }
 
@@ -206,10 +248,12 @@ impl Spec {
     }
 }
 
-/// How `sake-glug experiment --discriminate` sets up a 2AFC study of a recording against a
-/// model.
+/// How `sake-glug experiment --discriminate` sets up a discrimination study of a recording
+/// against a model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Discriminate {
+    /// The design: triangle, 2AFC or ABX.
+    pub design: Design,
     /// The recording (the target: "which one is the recording?").
     pub recording: PathBuf,
     /// The model file fitted to it.
@@ -222,9 +266,13 @@ pub struct Discriminate {
     pub repetitions: u32,
 }
 
+/// The designs `--discriminate` sets up, the default first.
+pub const DISCRIMINATE_DESIGNS: [Design; 3] = [Design::Triangle, Design::TwoAfc, Design::Abx];
+
 impl Discriminate {
-    /// The spec file of the study: design 2AFC, the recording the target, the model with the
-    /// built-in pour's other keys, levels matched by RMS, half a second between the two.
+    /// The spec file of the study: its design (for 2AFC the recording the target: "which one is
+    /// the recording?"), the model with the built-in pour's other keys, levels matched by RMS,
+    /// half a second between stimuli.
     pub fn spec_text(&self) -> String {
         let path = |path: &Path| {
             let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_owned());
@@ -241,12 +289,14 @@ impl Discriminate {
         stimuli.insert("model".into(), toml::Value::Table(model));
         let mut spec = toml::Table::new();
         let mut set = |key: &str, value: toml::Value| spec.insert(key.into(), value);
-        set("design", toml::Value::String(Design::TwoAfc.name().into()));
-        set("target", toml::Value::String("recording".into()));
-        set(
-            "question",
-            toml::Value::String("Which one is the recording?".into()),
-        );
+        set("design", toml::Value::String(self.design.name().into()));
+        if self.design == Design::TwoAfc {
+            set("target", toml::Value::String("recording".into()));
+            set(
+                "question",
+                toml::Value::String("Which one is the recording?".into()),
+            );
+        }
         set("duration_s", toml::Value::Float(self.duration_s));
         set("gap_s", toml::Value::Float(0.5));
         set("repetitions", toml::Value::Integer(self.repetitions.into()));
@@ -275,6 +325,9 @@ const MODEL: &str = "model";
 /// The keys of a recorded stimulus.
 const AUDIO: &str = "audio";
 const START_S: &str = "start_s";
+/// A stimulus table's own keys (its others are scene keys), as experiments/README.md lists
+/// them.
+pub const STIMULUS_KEYS: [&str; 5] = [PRESET, SCENE, MODEL, AUDIO, START_S];
 
 impl Spec {
     /// Reads and validates the spec at `path`; the scene and model files it names are found
@@ -385,7 +438,7 @@ impl Spec {
             return Err(misplaced("target"));
         }
         let stimuli = match design {
-            Design::TwoAfc => {
+            Design::TwoAfc | Design::Triangle | Design::Abx => {
                 for (key, value) in [
                     ("stimulus", shared.is_some()),
                     ("standard", standard.is_some()),
@@ -396,37 +449,43 @@ impl Spec {
                     }
                 }
                 let named = named_stimuli.unwrap_or_default();
-                let names = || {
-                    let names: Vec<String> = named
-                        .keys()
-                        .map(|name| format!("`{}`", quoted(name)))
-                        .collect();
-                    names.join(", ")
-                };
+                let names = named
+                    .keys()
+                    .map(|name| format!("`{}`", quoted(name)))
+                    .collect::<Vec<_>>()
+                    .join(", ");
                 if named.len() != 2 {
+                    let study = match design {
+                        Design::TwoAfc => "2AFC",
+                        Design::Abx => "ABX",
+                        _ => "triangle",
+                    };
                     return Err(bad(format!(
-                        "`stimuli` names {} stimulus(es) ({}): a 2AFC study has two",
+                        "`stimuli` names {} stimulus(es) ({}): a {study} study has two",
                         named.len(),
-                        names()
+                        names
                     )));
                 }
-                let target = target.as_deref().ok_or_else(|| {
-                    bad(format!(
-                        "missing field `target`: the stimulus the question asks for, one of {}",
-                        names()
-                    ))
-                })?;
-                if !named.contains_key(target) {
-                    return Err(bad(format!(
-                        "`target` = \"{}\" is not a stimulus; one of {}",
-                        quoted(target),
-                        names()
-                    )));
-                }
-                check_trials(design, 2, repetitions).map_err(bad)?;
-                // The target first, then the other.
                 let mut ordered: Vec<(String, toml::Value)> = named.into_iter().collect();
-                ordered.sort_by_key(|(name, _)| name != target);
+                if design == Design::TwoAfc {
+                    let target = target.as_deref().ok_or_else(|| {
+                        bad(format!(
+                            "missing field `target`: the stimulus the question asks for, one of {}",
+                            names
+                        ))
+                    })?;
+                    if !ordered.iter().any(|(name, _)| name == target) {
+                        return Err(bad(format!(
+                            "`target` = \"{}\" is not a stimulus; one of {}",
+                            quoted(target),
+                            names
+                        )));
+                    }
+                    // The target first, then the other.
+                    ordered.sort_by_key(|(name, _)| name != target);
+                }
+                // The triangle and ABX treat both alike: they stay in the spec's name order.
+                check_trials(design, 2, repetitions).map_err(bad)?;
                 ordered
                     .into_iter()
                     .map(|(name, value)| match value {
@@ -519,6 +578,8 @@ impl Spec {
         };
         let default_question = match design {
             Design::TwoAfc => format!("Which one is `{}`?", stimuli[0].name),
+            Design::Triangle => "Two are alike: which one is different?".into(),
+            Design::Abx => "The third is one of the first two: which?".into(),
             Design::Paired | Design::Constant => QUESTION.into(),
         };
         Ok(Spec {
@@ -560,6 +621,8 @@ fn trial_count(design: Design, stimuli: usize, repetitions: u32) -> u64 {
         Design::Paired => stimuli * stimuli.saturating_sub(1),
         Design::Constant => stimuli.saturating_sub(1),
         Design::TwoAfc => 2,
+        Design::Triangle => 6,
+        Design::Abx => 4,
     };
     per_repetition.saturating_mul(u64::from(repetitions))
 }
@@ -574,6 +637,8 @@ fn check_trials(design: Design, stimuli: usize, repetitions: u32) -> Result<(), 
         Design::Paired => format!("{} ordered pairs", trials / u64::from(repetitions)),
         Design::Constant => format!("{} comparisons", trials / u64::from(repetitions)),
         Design::TwoAfc => "2 orders".into(),
+        Design::Triangle => "6 arrangements".into(),
+        Design::Abx => "4 arrangements".into(),
     };
     Err(format!(
         "{what} × `repetitions` = {repetitions} make {trials} trials a session: at most \

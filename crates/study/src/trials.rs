@@ -1,6 +1,8 @@
 //! The trial order of a session: every ordered pair (paired), every level with the standard
-//! first in half of its repetitions (constant), or the target first in half the trials (2AFC), shuffled from a seed that mixes the spec's seed
-//! with the participant's ID, so one participant's order is the same on every run and resume.
+//! first in half of its repetitions (constant), the target first in half the trials (2AFC),
+//! either stimulus the odd one at each of the three places (triangle), or each order of A and B
+//! with X either (ABX); shuffled from a seed that mixes the spec's seed with the participant's
+//! ID, so one participant's order is the same on every run and resume.
 
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
@@ -8,13 +10,47 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::spec::{Design, Spec};
 
-/// One trial: which stimulus comes first and which second (indices into [`Spec::stimuli`]).
+/// One trial: which stimulus comes first, second and, in the three-interval designs (triangle,
+/// ABX), third (indices into [`Spec::stimuli`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Trial {
     /// The stimulus played first.
     pub first: usize,
     /// The stimulus played second.
     pub second: usize,
+    /// The stimulus played third: the triangle's third, ABX's X; `None` in the two-interval
+    /// designs.
+    pub third: Option<usize>,
+}
+
+impl Trial {
+    /// A two-interval trial.
+    pub fn pair(first: usize, second: usize) -> Self {
+        Self {
+            first,
+            second,
+            third: None,
+        }
+    }
+
+    /// A three-interval trial.
+    pub fn triple(first: usize, second: usize, third: usize) -> Self {
+        Self {
+            first,
+            second,
+            third: Some(third),
+        }
+    }
+
+    /// The stimuli in the order played.
+    pub fn played(self) -> impl Iterator<Item = usize> {
+        [self.first, self.second].into_iter().chain(self.third)
+    }
+
+    /// The stimulus at place `place` (1 the first), if the trial has that place.
+    pub fn at(self, place: u8) -> Option<usize> {
+        self.played().nth(usize::from(place).checked_sub(1)?)
+    }
 }
 
 /// The seed of a participant's order: FNV-1a (64-bit) over the participant's ID, started from
@@ -63,7 +99,7 @@ fn design_trials(spec: &Spec) -> Vec<Trial> {
             for _ in 0..reps {
                 for first in 0..count {
                     for second in (0..count).filter(|&second| second != first) {
-                        trials.push(Trial { first, second });
+                        trials.push(Trial::pair(first, second));
                     }
                 }
             }
@@ -71,14 +107,28 @@ fn design_trials(spec: &Spec) -> Vec<Trial> {
         // The target is stimulus 0: first in half the trials, second in the other half.
         Design::TwoAfc => {
             for _ in 0..reps {
-                trials.push(Trial {
-                    first: 0,
-                    second: 1,
-                });
-                trials.push(Trial {
-                    first: 1,
-                    second: 0,
-                });
+                trials.push(Trial::pair(0, 1));
+                trials.push(Trial::pair(1, 0));
+            }
+        }
+        // Either stimulus the odd one, at each of the three places: AAB, ABA, BAA, BBA, BAB,
+        // ABB, each `repetitions` times.
+        Design::Triangle => {
+            for _ in 0..reps {
+                for (alike, odd) in [(0, 1), (1, 0)] {
+                    trials.push(Trial::triple(alike, alike, odd));
+                    trials.push(Trial::triple(alike, odd, alike));
+                    trials.push(Trial::triple(odd, alike, alike));
+                }
+            }
+        }
+        // A then B in either order, X either of them: ABA, ABB, BAA, BAB.
+        Design::Abx => {
+            for _ in 0..reps {
+                for (a, b) in [(0, 1), (1, 0)] {
+                    trials.push(Trial::triple(a, b, a));
+                    trials.push(Trial::triple(a, b, b));
+                }
             }
         }
         Design::Constant => {
@@ -87,15 +137,9 @@ fn design_trials(spec: &Spec) -> Vec<Trial> {
                 let standard_first = reps / 2 + (reps % 2) * (comparison % 2);
                 for rep in 0..reps {
                     trials.push(if rep < standard_first {
-                        Trial {
-                            first: 0,
-                            second: comparison,
-                        }
+                        Trial::pair(0, comparison)
                     } else {
-                        Trial {
-                            first: comparison,
-                            second: 0,
-                        }
+                        Trial::pair(comparison, 0)
                     });
                 }
             }

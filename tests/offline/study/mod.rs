@@ -8,6 +8,7 @@ mod expectations;
 mod hostile_specs;
 mod log;
 mod recorded;
+mod three_intervals;
 mod two_afc;
 
 use std::io::{BufRead, BufReader, Write};
@@ -127,8 +128,8 @@ fn the_dry_run_writes_each_trials_stimuli_and_the_list() {
         .stdin(Stdio::null())
         .output()
         .unwrap();
-    // No answers: the files are written, the session stops at its first question.
-    assert_eq!(output.status.code(), Some(1));
+    // No answers: the files are written, and the dry run ends there as --no-answers does.
+    assert_eq!(output.status.code(), Some(0));
     let mut names: Vec<String> = std::fs::read_dir(dir.path().join("dry"))
         .unwrap()
         .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
@@ -517,5 +518,62 @@ fn the_constant_log_says_which_was_the_comparison() {
             &row[column("second")]
         };
         assert_eq!(comparison, format!("viscosity_c={}", &row[column("level")]));
+    }
+}
+
+/// The keys a spec's unknown-key message names as expected, at the top or in `[section]`.
+fn expected_keys(text: &str) -> Vec<String> {
+    let error = error_of(text);
+    let (_, listed) = error
+        .split_once("expected one of ")
+        .unwrap_or_else(|| panic!("no list of keys in: {error}"));
+    listed
+        .split(", ")
+        .map(|key| key.trim_matches('`').to_owned())
+        .collect()
+}
+
+/// experiments/README.md's tables of keys are the spec parser's: every key the parser takes (at
+/// the top, in `[channels]`, and a stimulus's own) is listed, and nothing else.
+#[test]
+fn the_experiments_readme_lists_every_spec_key() {
+    let readme = std::fs::read_to_string(experiments().join("README.md")).unwrap();
+    // The first cell of each table row, without its backticks and brackets.
+    let listed: Vec<String> = readme
+        .lines()
+        .filter_map(|line| line.strip_prefix("| `"))
+        .map(|rest| {
+            let key = &rest[..rest.find('`').unwrap()];
+            key.trim_matches(['[', ']']).to_owned()
+        })
+        .collect();
+    let mut top: Vec<String> = listed
+        .iter()
+        .map(|key| key.split('.').next().unwrap().to_owned())
+        .filter(|key| !sake_glug_study::STIMULUS_KEYS.contains(&key.as_str()))
+        .collect();
+    let mut parsed = expected_keys(&SHORT_PAIRED.replace("seed = 9", "no_such_key = 9"));
+    top.sort();
+    parsed.sort();
+    assert_eq!(
+        top, parsed,
+        "experiments/README.md's keys against the parser's"
+    );
+    let channels = expected_keys(&format!("{SHORT_PAIRED}\n[channels]\nno_such_key = 1\n"));
+    let documented = readme
+        .lines()
+        .find(|line| line.starts_with("| `[channels]`"))
+        .unwrap();
+    for key in channels {
+        assert!(
+            documented.contains(&format!("`{key} =")),
+            "[channels] {key}"
+        );
+    }
+    for key in sake_glug_study::STIMULUS_KEYS {
+        assert!(
+            listed.iter().any(|listed| listed == key),
+            "stimulus key {key}"
+        );
     }
 }

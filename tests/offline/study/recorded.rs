@@ -1,7 +1,8 @@
 //! Recorded stimuli (`audio = "FILE.wav"`, `start_s`): the spec's `duration_s` of the file from
 //! `start_s`, read through the one reader, level-matched with the others, the same samples at
-//! every presentation; refused with the file and the reason when too short, silent, clipped, at
-//! a rate no interface plays, at another rate than the interface's, or not a WAV.
+//! every presentation; at another rate than the interface's, resampled with the project's
+//! resampler; refused with the file and the reason when too short, silent, clipped, at a rate no
+//! interface plays, or not a WAV.
 
 use std::path::Path;
 
@@ -89,6 +90,46 @@ fn a_recording_is_its_excerpt_level_matched_at_the_interfaces_rate() {
     assert!((levels[0] / levels[1] - 1.0).abs() < 1e-4, "{levels:?}");
 }
 
+/// A 48 kHz recording on a 44.1 kHz interface: the excerpt resampled (rubato's FFT resampler,
+/// the renderer's), as long as a rendered stimulus of the spec's `duration_s`, the tone on time
+/// and at its level away from the excerpt's cut ends, and level-matched with the others.
+#[test]
+fn a_recording_at_another_rate_is_resampled_to_the_interfaces() {
+    let dir = tempfile::tempdir().unwrap();
+    write_wav(&dir.path().join("take.wav"), RATE, tone);
+    let spec = load(dir.path(), &recorded_spec("")).unwrap();
+    let interface = 44_100;
+    let rendered = render_stimuli(&spec, interface).unwrap();
+    let recording = &rendered[0];
+    assert_eq!(recording.samples.len(), rendered[1].samples.len());
+    assert_eq!(
+        recording.samples.len(),
+        (0.3 * f64::from(interface)).round() as usize
+    );
+    let gain = 10f64.powf(recording.gain_db / 20.0);
+    // The cut at each end rings for a few milliseconds; between, the tone at 44.1 kHz.
+    let edge = 441;
+    let worst = recording.samples[edge..recording.samples.len() - edge]
+        .iter()
+        .enumerate()
+        .map(|(index, &sample)| {
+            let t = 0.2 + (edge + index) as f64 / f64::from(interface);
+            (f64::from(sample) / gain - f64::from(tone(t))).abs()
+        })
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-4, "worst error {worst}");
+    let levels: Vec<f64> = rendered
+        .iter()
+        .map(|stimulus| level_of(Equalize::Rms, &stimulus.samples))
+        .collect();
+    assert!((levels[0] / levels[1] - 1.0).abs() < 1e-4, "{levels:?}");
+    // Read and resampled the same way every time.
+    assert_eq!(
+        render_stimuli(&spec, interface).unwrap()[0].samples,
+        recording.samples
+    );
+}
+
 #[test]
 fn a_dry_run_plays_the_same_recorded_samples_at_every_presentation() {
     let dir = tempfile::tempdir().unwrap();
@@ -143,11 +184,15 @@ fn bad_recordings_are_refused_with_the_file_and_the_reason() {
         error.contains("take.wav") && error.contains("too short"),
         "{error}"
     );
-    // Another rate than the interface's.
-    let spec = load(folder, &recorded_spec("")).unwrap();
+    // Too short at another rate than the interface's: checked at the file's own.
+    let spec = load(
+        folder,
+        &recorded_spec("").replace("start_s = 0.2", "start_s = 0.8"),
+    )
+    .unwrap();
     let error = render_stimuli(&spec, 44_100).unwrap_err().to_string();
     assert!(
-        error.contains("take.wav: at 48000 Hz, and the interface plays 44100 Hz"),
+        error.contains("take.wav") && error.contains("too short"),
         "{error}"
     );
     // Silent, clipped.
@@ -188,7 +233,8 @@ fn bad_recordings_are_refused_with_the_file_and_the_reason() {
 }
 
 /// `sake-glug experiment --discriminate RECORDING.wav MODEL.toml`: the two commands of a study
-/// of a fit, the session (here its dry run) and its analysis.
+/// of a fit, the session (here its dry run: a triangle test by default) and its analysis; then
+/// the 2AFC design asked for, and a design the runner has not refused by name.
 #[test]
 fn a_recording_against_its_model_in_two_commands() {
     let dir = tempfile::tempdir().unwrap();
@@ -211,15 +257,18 @@ fn a_recording_against_its_model_in_two_commands() {
         "--dry-run",
         "dry",
     ];
-    let output = run(dir.path(), &session, &format!("\n{}", "1\n".repeat(6)));
+    let output = run(dir.path(), &session, &format!("\n{}", "1\n".repeat(18)));
     assert!(
         output.status.success(),
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
     let stdout = String::from_utf8_lossy(&output.stdout);
-    assert!(stdout.contains("2afc design, 6 trials"), "{stdout}");
-    assert!(stdout.contains("Which one is the recording?"), "{stdout}");
+    assert!(stdout.contains("triangle design, 18 trials"), "{stdout}");
+    assert!(
+        stdout.contains("Two are alike: which one is different?"),
+        "{stdout}"
+    );
     let analysed = std::process::Command::new(env!("CARGO_BIN_EXE_sake-glug"))
         .current_dir(dir.path())
         .args(["analyze", "discrimination", "log.csv"])
@@ -228,18 +277,34 @@ fn a_recording_against_its_model_in_two_commands() {
     assert!(analysed.status.success());
     let report = String::from_utf8_lossy(&analysed.stdout);
     assert!(
-        report.contains("6 trials") || report.contains("of 6 right"),
+        report.contains("of 18 right") && report.contains("triangle"),
         "{report}"
     );
 
-    let mut triangle = session.to_vec();
-    triangle.extend(["--design", "triangle"]);
-    triangle.retain(|arg| !["--dry-run", "dry"].contains(arg));
-    let refused = run(dir.path(), &triangle, "");
+    let mut two_afc = session.to_vec();
+    two_afc.extend(["--design", "2afc"]);
+    two_afc = two_afc
+        .into_iter()
+        .map(|arg| match arg {
+            "log.csv" => "2afc.csv",
+            "dry" => "dry-2afc",
+            other => other,
+        })
+        .collect();
+    let output = run(dir.path(), &two_afc, &format!("\n{}", "1\n".repeat(6)));
+    assert!(output.status.success());
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.contains("2afc design, 6 trials"), "{stdout}");
+    assert!(stdout.contains("Which one is the recording?"), "{stdout}");
+
+    let mut tetrad = session.to_vec();
+    tetrad.extend(["--design", "tetrad"]);
+    tetrad.retain(|arg| !["--dry-run", "dry"].contains(arg));
+    let refused = run(dir.path(), &tetrad, "");
     assert_eq!(refused.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&refused.stderr);
     assert!(
-        stderr.contains("--design: the runner plays `2afc`"),
+        stderr.contains("--design `tetrad`: one of `triangle`, `2afc`, `abx`"),
         "{stderr}"
     );
 }
