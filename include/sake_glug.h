@@ -332,7 +332,21 @@ SakeGlugStatus sake_glug_control_range(int32_t control, SakeGlugRange *range);
 SakeGlug *sake_glug_create(double sample_rate, const char *model_text, uint64_t seed);
 
 /**
- * Why the last `sake_glug_create` on this thread returned NULL, or the last
+ * A new handle at `sample_rate` (Hz, as `sake_glug_create` takes it) playing the shipped preset
+ * named `name` (a file name of presets/ without `.toml`, such as "syrup": the presets of the
+ * command line and the plugin's menu, from one table in the engine): its
+ * bottle, its glug and its liquid's viscosity and pour time; tilt, fill and gain start at their
+ * defaults (the preset file's tilt automation is a scene's, for the game to play). Seeded with
+ * `seed`. Allocates: not on the audio thread. NULL if the name is unknown or anything else was
+ * wrong: `sake_glug_last_error` then says what (an unknown name's message lists the presets).
+ *
+ * # Safety
+ * `name` is NULL or a NUL-terminated string.
+ */
+SakeGlug *sake_glug_create_preset(double sample_rate, const char *name, uint64_t seed);
+
+/**
+ * Why the last `sake_glug_create` or `sake_glug_create_preset` on this thread returned NULL, or the last
  * `sake_glug_set_actuator` refused its profile ("" after one that succeeded):
  * copied into `buffer` as NUL-terminated UTF-8, cut at a character to fit `capacity` bytes.
  * Returns the message's full length in bytes (without the NUL), as snprintf does; `buffer` may
@@ -341,7 +355,8 @@ SakeGlug *sake_glug_create(double sample_rate, const char *model_text, uint64_t 
  * # Safety
  * `buffer` points to `capacity` writable bytes, or is NULL with `capacity` 0.
  */
-size_t sake_glug_last_error(char *buffer, size_t capacity);
+size_t sake_glug_last_error(char *buffer,
+                            size_t capacity);
 
 /**
  * Frees a handle (NULL is ignored). No other call may use it then or after. Not on the audio

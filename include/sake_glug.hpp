@@ -62,16 +62,13 @@ class Glug {
     // The paper's bottle, or the model file whose text is `model_text`; throws Error.
     explicit Glug(double sample_rate, const char *model_text = nullptr,
                   uint64_t seed = sake_glug_default_seed())
-        : glug_(sake_glug_create(sample_rate, model_text, seed)) {
-        if (sake_glug_abi_version() != SAKE_GLUG_ABI_VERSION) {
-            throw Error("libsake_glug is not the one sake_glug.h describes");
-        }
-        if (!glug_) {
-            std::string message(sake_glug_last_error(nullptr, 0) + 1, '\0');
-            sake_glug_last_error(&message[0], message.size());
-            message.pop_back();
-            throw Error(message);
-        }
+        : Glug(sake_glug_create(sample_rate, model_text, seed), Created{}) {}
+
+    // A shipped preset by name (a file name of presets/ without .toml, such as "syrup"); throws
+    // Error, whose message lists the presets if the name is unknown.
+    static Glug preset(double sample_rate, const char *name,
+                       uint64_t seed = sake_glug_default_seed()) {
+        return Glug(sake_glug_create_preset(sample_rate, name, seed), Created{});
     }
 
     // Any thread; real-time safe.
@@ -105,6 +102,20 @@ class Glug {
     SakeGlug *get() const noexcept { return glug_.get(); }
 
   private:
+    struct Created {};
+    // Owns what a create call returned; throws its message if that was NULL.
+    Glug(SakeGlug *glug, Created) : glug_(glug) {
+        if (sake_glug_abi_version() != SAKE_GLUG_ABI_VERSION) {
+            throw Error("libsake_glug is not the one sake_glug.h describes");
+        }
+        if (!glug_) {
+            std::string message(sake_glug_last_error(nullptr, 0) + 1, '\0');
+            sake_glug_last_error(&message[0], message.size());
+            message.pop_back();
+            throw Error(message);
+        }
+    }
+
     struct Destroy {
         void operator()(SakeGlug *glug) const noexcept { sake_glug_destroy(glug); }
     };

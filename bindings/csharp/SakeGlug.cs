@@ -51,6 +51,7 @@ namespace SakeGlug
         [DllImport(Library)] internal static extern IntPtr sake_glug_status_text(int status);
         [DllImport(Library)] internal static extern Status sake_glug_control_range(int control, out Range range);
         [DllImport(Library)] internal static extern IntPtr sake_glug_create(double sampleRate, byte[] modelText, ulong seed);
+        [DllImport(Library)] internal static extern IntPtr sake_glug_create_preset(double sampleRate, byte[] name, ulong seed);
         [DllImport(Library)] internal static extern UIntPtr sake_glug_last_error(byte[] buffer, UIntPtr capacity);
         [DllImport(Library)] internal static extern void sake_glug_destroy(IntPtr glug);
         [DllImport(Library)] internal static extern Status sake_glug_set(IntPtr glug, int control, double value);
@@ -73,11 +74,23 @@ namespace SakeGlug
         /// The paper's bottle (modelText null) or a model file's text; throws SakeGlugException
         /// with the library's message.
         public Glug(double sampleRate, string modelText = null, ulong? seed = null)
+            : this(Native.sake_glug_create(sampleRate, Nul(modelText), seed ?? Native.sake_glug_default_seed()))
         {
+        }
+
+        /// A shipped preset by name (a file name of presets/ without .toml, such as "syrup");
+        /// throws SakeGlugException, whose message lists the presets if the name is unknown.
+        public static Glug Preset(double sampleRate, string name, ulong? seed = null) =>
+            new Glug(Native.sake_glug_create_preset(sampleRate, Nul(name), seed ?? Native.sake_glug_default_seed()));
+
+        static byte[] Nul(string text) => text == null ? null : Encoding.UTF8.GetBytes(text + "\0");
+
+        /// Owns what a create call returned; throws its message if that was NULL.
+        Glug(IntPtr created)
+        {
+            handle = created;
             if (Native.sake_glug_abi_version() != AbiVersion)
                 throw new SakeGlugException("libsake_glug is not the one this binding describes");
-            byte[] text = modelText == null ? null : Encoding.UTF8.GetBytes(modelText + "\0");
-            handle = Native.sake_glug_create(sampleRate, text, seed ?? Native.sake_glug_default_seed());
             if (handle == IntPtr.Zero)
             {
                 int length = (int)Native.sake_glug_last_error(null, UIntPtr.Zero);

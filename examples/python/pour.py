@@ -43,6 +43,8 @@ def load(name="libsake_glug.so"):
     lib.sake_glug_status_text.restype = ctypes.c_char_p
     lib.sake_glug_create.argtypes = [ctypes.c_double, ctypes.c_char_p, ctypes.c_uint64]
     lib.sake_glug_create.restype = ctypes.c_void_p
+    lib.sake_glug_create_preset.argtypes = [ctypes.c_double, ctypes.c_char_p, ctypes.c_uint64]
+    lib.sake_glug_create_preset.restype = ctypes.c_void_p
     lib.sake_glug_last_error.argtypes = [ctypes.c_char_p, ctypes.c_size_t]
     lib.sake_glug_last_error.restype = ctypes.c_size_t
     lib.sake_glug_destroy.argtypes = [ctypes.c_void_p]
@@ -66,11 +68,16 @@ def check(lib, status, what):
         raise RuntimeError(f"{what}: {lib.sake_glug_status_text(status).decode()}")
 
 
-def render_pour(lib, sample_rate, model_text=None):
+def render_pour(lib, sample_rate, model_text=None, preset=None):
     """The built-in scene (tilt 90° -> 135° over half a second, held until pouring stops and
-    every unit has decayed) at `sample_rate`: its samples as an array of float32."""
-    text = None if model_text is None else model_text.encode()
-    glug = lib.sake_glug_create(sample_rate, text, lib.sake_glug_default_seed())
+    every unit has decayed) at `sample_rate`, in the paper's bottle, a model file's text or a
+    shipped preset (its name, such as "syrup"): its samples as an array of float32."""
+    seed = lib.sake_glug_default_seed()
+    if preset is not None:
+        glug = lib.sake_glug_create_preset(sample_rate, preset.encode(), seed)
+    else:
+        text = None if model_text is None else model_text.encode()
+        glug = lib.sake_glug_create(sample_rate, text, seed)
     if not glug:
         message = ctypes.create_string_buffer(lib.sake_glug_last_error(None, 0) + 1)
         lib.sake_glug_last_error(message, len(message))

@@ -210,6 +210,25 @@ fn a_bad_sample_rate_or_model_gives_null_and_says_what_was_wrong() {
 }
 
 #[test]
+fn an_unknown_preset_gives_null_and_names_the_presets() {
+    let error = Live::preset(48_000.0, "rum", 1).err().unwrap();
+    assert!(
+        error.starts_with("no preset `rum`: the presets are water, thin, "),
+        "{error}"
+    );
+    assert!(error.contains("glass-bottle"), "{error}");
+    // The name is the preset's id, as its file is named, not its menu name.
+    assert!(Live::preset(48_000.0, "Water", 1).is_err());
+    let glug = unsafe { sake_glug_create_preset(48_000.0, std::ptr::null(), 1) };
+    assert!(glug.is_null());
+    assert!(last_error().starts_with("the preset's name is NULL"));
+    let error = Live::preset(999.0, "water", 1).err().unwrap();
+    assert!(error.contains("`sample_rate` = 999"), "{error}");
+    drop(Live::preset(48_000.0, "syrup", 1).unwrap());
+    assert_eq!(last_error(), "");
+}
+
+#[test]
 fn the_error_message_is_cut_to_the_buffer_at_a_character() {
     assert!(Live::create(48_000.0, Some("ä = 1"), 1).is_err());
     let full = last_error();

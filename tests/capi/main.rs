@@ -29,6 +29,17 @@ impl Live {
         }
     }
 
+    /// A handle playing the shipped preset `name`, or the library's message.
+    pub fn preset(sample_rate: f64, name: &str, seed: u64) -> Result<Self, String> {
+        let name = CString::new(name).unwrap();
+        let glug = unsafe { sake_glug_create_preset(sample_rate, name.as_ptr(), seed) };
+        if glug.is_null() {
+            Err(last_error())
+        } else {
+            Ok(Self(glug))
+        }
+    }
+
     /// The paper's bottle with the default seed.
     pub fn paper(sample_rate: f64) -> Self {
         Self::create(sample_rate, None, sake_glug_default_seed()).unwrap()

@@ -4,7 +4,7 @@
 //! the renderer's.
 
 use sake_glug::*;
-use sake_glug_engine::{Engine, UnitOnset, Voicing};
+use sake_glug_engine::{Engine, UnitOnset, Voicing, PRESETS};
 use sake_glug_model_file::ModelFile;
 use sake_glug_render::{render_scene, RenderError, Scene, DEFAULT_SCENE};
 
@@ -143,6 +143,54 @@ fn steps_and_ramps_are_the_lanes_of_a_scene() {
     assert!(expected_units.len() > 10);
 }
 
+/// Renders `frames` frames in calls of `block` frames (the last one shorter).
+fn run_in_calls_of(live: &Live, block: usize, frames: usize, samples: &mut Vec<f32>) {
+    let mut buffer = vec![0.0; block];
+    let mut done = 0;
+    while done < frames {
+        let len = block.min(frames - done);
+        live.process(&mut buffer[..len]);
+        samples.extend_from_slice(&buffer[..len]);
+        done += len;
+    }
+}
+
+#[test]
+fn a_change_after_many_unchanged_small_calls_acts_at_its_sample() {
+    // Thousands of 16-frame calls under the same controls (pouring, then the emptied bottle's
+    // silence), each change arriving in the middle of a grid period (12 000 = 187.5 × 64).
+    let scene = Scene::parse(
+        "pour_time_s = 1.0
+         tilt_deg = [[0.0, 135.0], [0.25, 135.0], [0.25, 100.0], [0.5, 100.0], [0.5, 150.0]]
+         output.gain_db = [[0.0, -6.0], [0.25, -6.0], [0.25, -12.0]]
+         fill_percent = [[0.0, 100.0], [3.25, 100.0], [3.25, 40.0]]
+",
+    )
+    .unwrap();
+    let (expected, expected_units) = offline(&scene);
+    let live = Live::paper(48_000.0);
+    live.set(SakeGlugControl::PourTime, 1.0);
+    live.set(SakeGlugControl::Tilt, 135.0);
+    let mut samples = Vec::new();
+    run_in_calls_of(&live, 16, 12_000, &mut samples);
+    live.set(SakeGlugControl::Tilt, 100.0);
+    live.set(SakeGlugControl::Gain, -12.0);
+    run_in_calls_of(&live, 16, 12_000, &mut samples);
+    live.set(SakeGlugControl::Tilt, 150.0);
+    run_in_calls_of(&live, 16, 132_000, &mut samples);
+    assert_eq!(
+        live.state().settled,
+        1,
+        "the bottle emptied before the refill"
+    );
+    live.set(SakeGlugControl::Fill, 40.0);
+    let (rest, _) = live.until_settled(16);
+    samples.extend(rest);
+    samples.truncate(live.state().active_until as usize);
+    assert_same_samples(&samples, &expected, "changes after unchanged calls");
+    assert!(expected_units.len() > 10);
+}
+
 #[test]
 fn a_ramp_to_its_own_value_and_a_ramp_of_no_samples_are_steps() {
     let (expected, _) = offline(&Scene::parse("tilt_deg = 135.0\n").unwrap());
@@ -175,6 +223,21 @@ fn a_model_plays_as_the_renderers(name: &str) {
     // The seed matters: another gives other glugs.
     let other = Live::create(48_000.0, Some(&text), seed + 1).unwrap();
     assert_ne!(builtin_pour(&other, 48_000, 4096).0, expected);
+}
+
+#[test]
+fn every_shipped_preset_plays_as_the_renderers_file_of_it() {
+    // The preset files hold the built-in pour's tilt; the handle is given it by calls.
+    for preset in &PRESETS {
+        let seed = 5;
+        let file = std::fs::read_to_string(format!("presets/{}.toml", preset.id)).unwrap();
+        let scene = Scene::parse(&format!("seed = {seed}\n{file}")).unwrap();
+        let (expected, expected_units) = offline(&scene);
+        let live = Live::preset(48_000.0, preset.id, seed).unwrap();
+        let (samples, units) = builtin_pour(&live, 48_000, 4096);
+        assert_same_samples(&samples, &expected, preset.id);
+        assert_same_units(&units, &expected_units, preset.id);
+    }
 }
 
 #[test]

@@ -161,3 +161,25 @@ def test_a_bad_model_text_raises_the_librarys_message():
     pour = ctypes_example()
     with pytest.raises(RuntimeError, match="`tilt_deg` does not belong in a model"):
         pour.render_pour(pour.load(str(SHARED)), 48000, model_text="tilt_deg = [[0.0, 90.0]]")
+
+
+def test_a_shipped_preset_plays_as_the_clis_render_of_its_file(tmp_path):
+    assert CLI.exists() and SHARED.exists()
+    path = tmp_path / "syrup.wav"
+    subprocess.run(
+        [str(CLI), "render", str(REPO / "presets" / "syrup.toml"), "-o", str(path),
+         "--sample-format", "f32"],
+        check=True,
+    )
+    rate, expected = read_f32(path)
+    pour = ctypes_example()
+    samples = np.array(pour.render_pour(pour.load(str(SHARED)), rate, preset="syrup"),
+                       dtype=np.float32)
+    assert samples.shape == expected.shape
+    assert np.array_equal(samples.view(np.uint32), expected.view(np.uint32))
+
+
+def test_an_unknown_preset_raises_the_librarys_message():
+    pour = ctypes_example()
+    with pytest.raises(RuntimeError, match="no preset `rum`: the presets are water, "):
+        pour.render_pour(pour.load(str(SHARED)), 48000, preset="rum")

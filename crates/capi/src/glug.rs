@@ -8,7 +8,7 @@ use crossbeam_queue::ArrayQueue;
 use sake_glug_engine::config::SAMPLE_RATE_HZ;
 use sake_glug_engine::{
     sample_time_s, ActuatorResponse, Control, ControlValues, Controls, Engine, Lane, LinearSegment,
-    PerControl, UnitOnset, Voicing,
+    ModelConfig, PerControl, Preset, UnitOnset, Voicing,
 };
 use sake_glug_model_file::{ModelFile, MAX_MODEL_BYTES};
 
@@ -59,6 +59,20 @@ impl Ramp {
     }
 }
 
+/// `sample_rate` if the engine takes it: in range and a whole number.
+fn checked_sample_rate(sample_rate: f64) -> Result<f64, CreateError> {
+    let sample_rate = SAMPLE_RATE_HZ
+        .check("sample_rate", sample_rate)
+        .map_err(|error| error.to_string())?;
+    if sample_rate.fract() != 0.0 {
+        return Err(format!(
+            "`sample_rate` = {sample_rate} is not a whole number: a sample rate counts whole \
+             samples per second"
+        ));
+    }
+    Ok(sample_rate)
+}
+
 /// What only the audio thread touches.
 struct Audio {
     engine: Engine,
@@ -101,15 +115,7 @@ impl SakeGlug {
     /// `model_text` (a model file's text, MODEL.md §12.1) or the paper's bottle, seeded with
     /// `seed`. Every control starts at the model's value or the engine's default.
     pub fn new(sample_rate: f64, model_text: Option<&str>, seed: u64) -> Result<Self, CreateError> {
-        let sample_rate = SAMPLE_RATE_HZ
-            .check("sample_rate", sample_rate)
-            .map_err(|error| error.to_string())?;
-        if sample_rate.fract() != 0.0 {
-            return Err(format!(
-                "`sample_rate` = {sample_rate} is not a whole number: a sample rate counts whole \
-                 samples per second"
-            ));
-        }
+        let sample_rate = checked_sample_rate(sample_rate)?;
         let model = match model_text {
             None => None,
             Some(text) if text.len() as u64 > MAX_MODEL_BYTES => {
@@ -122,18 +128,43 @@ impl SakeGlug {
                 ModelFile::parse("model", text).map_err(|error| format!("model text: {error}"))?,
             ),
         };
-        let mut config = model
+        let config = model
             .as_ref()
             .map(|model| *model.config())
             .unwrap_or_default();
-        config.seed = seed;
         let held = ControlValues::from_fn(|control| {
             model
                 .as_ref()
                 .and_then(|model| model.controls()[control])
                 .unwrap_or(control.range().default)
         });
-        Ok(Self {
+        Ok(Self::with(sample_rate, config, held, seed))
+    }
+
+    /// A handle playing the shipped preset `id` (presets/<id>.toml, written from the engine's
+    /// table of presets): its bottle, glug and liquid, every other control at its default.
+    pub fn preset(sample_rate: f64, id: &str, seed: u64) -> Result<Self, CreateError> {
+        let sample_rate = checked_sample_rate(sample_rate)?;
+        let preset = Preset::find(id).ok_or_else(|| {
+            format!(
+                "no preset `{}`: the presets are {} (`sake-glug presets` describes them)",
+                id.escape_debug(),
+                Preset::ids()
+            )
+        })?;
+        Ok(Self::with(
+            sample_rate,
+            preset.config(ModelConfig::default()),
+            preset.controls(ControlValues::default()),
+            seed,
+        ))
+    }
+
+    /// A handle at a checked sample rate under `config` (its seed replaced by `seed`), every
+    /// control held at `held`.
+    fn with(sample_rate: f64, mut config: ModelConfig, held: ControlValues, seed: u64) -> Self {
+        config.seed = seed;
+        Self {
             commands: ArrayQueue::new(SAKE_GLUG_MAX_QUEUED_CONTROLS),
             actuator: ArrayQueue::new(1),
             failed: AtomicBool::new(false),
@@ -150,7 +181,7 @@ impl SakeGlug {
                 lost: 0,
                 last_tilt_deg: Control::Tilt.range().sanitize(held.tilt_deg),
             }),
-        })
+        }
     }
 
     /// Queues a control call for the next process call; any thread. Checks nothing but room.
@@ -265,7 +296,8 @@ impl Audio {
         commands: &ArrayQueue<Command>,
         actuator: &ArrayQueue<Option<ActuatorResponse>>,
     ) {
-        while let Some(command) = commands.pop() {
+        // An empty queue (the usual call) is two loads, where a pop that finds nothing is more.
+        while let Some(command) = (!commands.is_empty()).then(|| commands.pop()).flatten() {
             if command == Command::Actuator {
                 // Every profile set by now is in the slot: a later marker finds it empty.
                 if let Some(response) = actuator.pop() {
@@ -338,22 +370,28 @@ impl Audio {
             last_tilt_deg,
             ..
         } = self;
-        let controls: Controls = lanes.each_mut().into_map(|control, lane| {
-            match &mut ramps[control] {
-                Some(ramp) if position < ramp.end_sample => {
-                    let lane = &mut lane[..out.len()];
-                    for (index, value) in lane.iter_mut().enumerate() {
-                        *value = ramp.value_at(position + index as u64, sample_rate);
+        // No ramp under way (the usual call): every control is its held value.
+        let ramping = ramps.iter().any(|(_, ramp)| ramp.is_some());
+        let controls: Controls = if !ramping {
+            Controls::constant(*held)
+        } else {
+            lanes.each_mut().into_map(|control, lane| {
+                match &mut ramps[control] {
+                    Some(ramp) if position < ramp.end_sample => {
+                        let lane = &mut lane[..out.len()];
+                        for (index, value) in lane.iter_mut().enumerate() {
+                            *value = ramp.value_at(position + index as u64, sample_rate);
+                        }
+                        Lane::Samples(lane)
                     }
-                    Lane::Samples(lane)
+                    // A ramp that has ended holds its target, as a lane past its last point.
+                    ramp => {
+                        *ramp = None;
+                        Lane::Constant(held[control])
+                    }
                 }
-                // A ramp that has ended holds its target, as a lane past its last point.
-                ramp => {
-                    *ramp = None;
-                    Lane::Constant(held[control])
-                }
-            }
-        });
+            })
+        };
         engine.process_observed(
             &controls,
             out,
@@ -366,7 +404,7 @@ impl Audio {
             },
         );
         if let Some(last) = out.len().checked_sub(1) {
-            *last_tilt_deg = controls.values_at(last).sanitized().tilt_deg;
+            *last_tilt_deg = Control::Tilt.range().sanitize(controls.tilt_deg.at(last));
         }
     }
 

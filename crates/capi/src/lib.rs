@@ -26,7 +26,8 @@ fn guarded<T>(on_panic: T, body: impl FnOnce() -> T) -> T {
 }
 
 thread_local! {
-    /// Why the last `sake_glug_create` on this thread failed, or `sake_glug_set_actuator`.
+    /// Why the last `sake_glug_create` or `sake_glug_create_preset` on this thread failed, or
+    /// `sake_glug_set_actuator`.
     static LAST_ERROR: RefCell<String> = const { RefCell::new(String::new()) };
 }
 
@@ -137,6 +138,43 @@ pub unsafe extern "C" fn sake_glug_create(
         };
         SakeGlug::new(sample_rate, text, seed)
     });
+    handle_or_null(created, "sake_glug_create")
+}
+
+/// A new handle at `sample_rate` (Hz, as `sake_glug_create` takes it) playing the shipped preset
+/// named `name` (a file name of presets/ without `.toml`, such as "syrup": the presets of the
+/// command line and the plugin's menu, from one table in the engine): its
+/// bottle, its glug and its liquid's viscosity and pour time; tilt, fill and gain start at their
+/// defaults (the preset file's tilt automation is a scene's, for the game to play). Seeded with
+/// `seed`. Allocates: not on the audio thread. NULL if the name is unknown or anything else was
+/// wrong: `sake_glug_last_error` then says what (an unknown name's message lists the presets).
+///
+/// # Safety
+/// `name` is NULL or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn sake_glug_create_preset(
+    sample_rate: f64,
+    name: *const c_char,
+    seed: u64,
+) -> *mut SakeGlug {
+    let created = catch_unwind(|| {
+        if name.is_null() {
+            return Err(format!(
+                "the preset's name is NULL: the presets are {}",
+                sake_glug_engine::Preset::ids()
+            ));
+        }
+        let name = unsafe { CStr::from_ptr(name) }.to_string_lossy();
+        SakeGlug::preset(sample_rate, &name, seed)
+    });
+    handle_or_null(created, "sake_glug_create_preset")
+}
+
+/// The handle a create call made, or NULL with the reason kept for `sake_glug_last_error`.
+fn handle_or_null(
+    created: std::thread::Result<Result<SakeGlug, glug::CreateError>>,
+    function: &str,
+) -> *mut SakeGlug {
     match created {
         Ok(Ok(glug)) => {
             set_last_error("");
@@ -147,13 +185,13 @@ pub unsafe extern "C" fn sake_glug_create(
             std::ptr::null_mut()
         }
         Err(_) => {
-            set_last_error("the library failed inside sake_glug_create (a bug)");
+            set_last_error(&format!("the library failed inside {function} (a bug)"));
             std::ptr::null_mut()
         }
     }
 }
 
-/// Why the last `sake_glug_create` on this thread returned NULL, or the last
+/// Why the last `sake_glug_create` or `sake_glug_create_preset` on this thread returned NULL, or the last
 /// `sake_glug_set_actuator` refused its profile ("" after one that succeeded):
 /// copied into `buffer` as NUL-terminated UTF-8, cut at a character to fit `capacity` bytes.
 /// Returns the message's full length in bytes (without the NUL), as snprintf does; `buffer` may

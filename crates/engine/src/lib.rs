@@ -72,6 +72,43 @@ pub struct Engine<S: Synthesis = AnchoredF32> {
     /// The actuator the output drives, if a profile is given: each unit's components are
     /// compensated for it as the unit starts (MODEL.md §18).
     actuator: Option<ActuatorResponse>,
+    /// The pour's inputs of the last span that held them constant.
+    held_pour: HeldPour,
+}
+
+/// The inputs that drove the pour over the last span that held them constant: as given, and
+/// brought into range. A span under the very same constants (the usual one: a host's next block,
+/// nothing changed) takes them as they are, without reading and bringing each into range again.
+#[derive(Debug, Clone, Copy, Default)]
+struct HeldPour(Option<(ControlValues, ControlValues)>);
+
+impl HeldPour {
+    /// The pour's inputs over the first `len` samples of `controls` if they hold the very same
+    /// values over them (as constants, or samples that do not change: a ramp's end inside the
+    /// block), as given and brought into range.
+    #[inline]
+    fn inputs(
+        &mut self,
+        controls: &Controls,
+        len: usize,
+    ) -> Option<(ControlValues, ControlValues)> {
+        if let Some(held) = self.0 {
+            let same = |control: Control| match controls[control] {
+                // Bit for bit: NaN is held as NaN, and −0 is not 0.
+                Lane::Constant(value) => value.to_bits() == held.0[control].to_bits(),
+                Lane::Samples(_) => false,
+            };
+            if Control::pour().all(same) {
+                return Some(held);
+            }
+        }
+        let values = controls
+            .pour_is_constant_over(len)
+            .then(|| controls.values_at(0))?;
+        let held = (values, values.sanitized());
+        self.0 = Some(held);
+        Some(held)
+    }
 }
 
 impl Engine {
@@ -98,6 +135,7 @@ impl<S: Synthesis> Engine<S> {
             block_end: 0,
             deferred: [None; MAX_ONSETS_PER_SAMPLE as usize],
             actuator: None,
+            held_pour: HeldPour::default(),
         };
         engine.reset();
         engine
@@ -265,17 +303,10 @@ impl<S: Synthesis> Engine<S> {
         if out.is_empty() {
             return;
         }
-        for deferred in &mut self.deferred {
-            if let Some((onset, voicing)) = deferred.take() {
-                let output_gain = self.output.gain_ahead(&controls.gain_db, 0);
-                on_unit(
-                    &onset,
-                    Voicing {
-                        output_gain,
-                        ..voicing
-                    },
-                );
-            }
+        // The slots fill in order: an empty first one (the usual block) means none waits, and
+        // the slots are not read.
+        if self.deferred[0].is_some() {
+            self.report_units_deferred_to(controls, on_unit);
         }
         self.block_end = self.sample + out.len() as u64;
         if self.synthesis.is_empty() && self.rests_under(controls) {
@@ -310,6 +341,27 @@ impl<S: Synthesis> Engine<S> {
         }
     }
 
+    /// Tells `on_unit` of the units that started in the last sample of the last block, at the
+    /// gain of this block's first sample.
+    fn report_units_deferred_to(
+        &mut self,
+        controls: &Controls,
+        on_unit: &mut impl FnMut(&UnitOnset, Voicing),
+    ) {
+        for deferred in &mut self.deferred {
+            if let Some((onset, voicing)) = deferred.take() {
+                let output_gain = self.output.gain_ahead(&controls.gain_db, 0);
+                on_unit(
+                    &onset,
+                    Voicing {
+                        output_gain,
+                        ..voicing
+                    },
+                );
+            }
+        }
+    }
+
     /// Tells `on_unit` of the units that started in the last sample rendered, heard at the gain
     /// as it would hold on (there is no next block to say otherwise): called after the last
     /// block of a render.
@@ -326,10 +378,10 @@ impl<S: Synthesis> Engine<S> {
         out: &mut [f32],
         on_unit: &mut impl FnMut(&UnitOnset, Voicing),
     ) {
-        out.fill(0.0);
         self.step_pour(controls, out.len(), on_unit);
         let ceiling = self.ceiling();
         if self.synthesis.is_empty() {
+            out.fill(0.0);
             self.output
                 .pass_silence(&controls.gain_db, ceiling, out.len());
             self.advance_position(out.len());
@@ -359,6 +411,7 @@ impl<S: Synthesis> Engine<S> {
             block_end,
             deferred,
             actuator,
+            held_pour,
             ..
         } = self;
         let (span_start, block_end) = (*span_start, *block_end);
@@ -390,20 +443,13 @@ impl<S: Synthesis> Engine<S> {
                 *free = Some((*onset, voicing));
             }
         };
-        // Constant over the span, as constants or as samples that do not change (a ramp's end
-        // inside the block).
-        let constant = controls
-            .pour_is_constant_over(len)
-            .then(|| controls.values_at(0));
+        let constant = held_pour.inputs(controls, len);
         let advanced = match constant {
             // Under constant controls the pour takes the span at once (plain samples in closed
             // form, the same numbers as one step per sample).
-            Some(values) => pour.advance(
-                self.sample,
-                len as u64,
-                &values.sanitized(),
-                &mut start_unit,
-            ),
+            Some((_, sanitized)) => {
+                pour.advance(self.sample, len as u64, &sanitized, &mut start_unit)
+            }
             // Otherwise the levels of the span are worked out at once, and the rest stepped
             // sample by sample (the same numbers as `Pour::step`).
             None => pour.advance_varying(self.sample, controls, len, &mut start_unit),
@@ -416,7 +462,7 @@ impl<S: Synthesis> Engine<S> {
             self.last_outflow = step;
         }
         self.resting_under = match last_step {
-            Some(step) if step.amount_ml == 0.0 && !step.refilled => constant,
+            Some(step) if step.amount_ml == 0.0 && !step.refilled => constant.map(|(raw, _)| raw),
             _ => None,
         };
     }

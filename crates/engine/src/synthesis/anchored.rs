@@ -98,8 +98,67 @@ impl BankComponent for AnchoredComponent {
         true
     }
 
-    fn add_all(components: &mut [Self], span_start: u64, out: &mut [f32]) {
-        add_components(components, span_start, out);
+    type PeriodSum = PeriodSum;
+
+    fn write_all(
+        components: &mut [Self],
+        period_sum: &mut PeriodSum,
+        span_start: u64,
+        out: &mut [f32],
+    ) {
+        if let Ok(period) = <&mut [f32; GRID]>::try_from(&mut *out) {
+            if components
+                .iter()
+                .all(|component| component.anchor_sample == span_start)
+            {
+                sum_period(components, period);
+                return;
+            }
+        }
+        // A span shorter than a period (a host's small block), or a period in which a component
+        // starts: the components that sound from the period's start are summed over the whole
+        // period once, in registers, and each span of the period takes its part of that sum, then
+        // adds the components that started since.
+        let period_start = span_start / GRID as u64 * GRID as u64;
+        if period_sum.period_start != Some(period_start) {
+            // They lead the bank: a component joins at its end, and one that starts at a
+            // period's first sample joined in the period before.
+            let leading = components
+                .iter()
+                .take_while(|component| component.anchor_sample == period_start)
+                .count();
+            sum_period(&components[..leading], &mut period_sum.samples);
+            period_sum.components = leading;
+            period_sum.period_start = Some(period_start);
+        }
+        let offset = (span_start - period_start) as usize;
+        out.copy_from_slice(&period_sum.samples[offset..offset + out.len()]);
+        let started_since = &components[period_sum.components..];
+        if !started_since.is_empty() {
+            add_each(started_since, span_start, out);
+        }
+    }
+}
+
+/// The sum over one grid period of the components that sound from its first sample: see
+/// [`AnchoredComponent::write_all`].
+#[derive(Clone)]
+pub struct PeriodSum {
+    samples: [f32; GRID],
+    /// The period summed; `None` before the first sum, and whenever the bank's components
+    /// changed other than by one joining at the end.
+    period_start: Option<u64>,
+    /// How many components lead the bank in the sum.
+    components: usize,
+}
+
+impl Default for PeriodSum {
+    fn default() -> Self {
+        Self {
+            samples: [0.0; GRID],
+            period_start: None,
+            components: 0,
+        }
     }
 }
 
@@ -135,10 +194,6 @@ impl AnchoredComponent {
     }
 
     /// The first sample of the period being rendered, or of the component if it starts later.
-    fn anchor_sample(&self) -> u64 {
-        self.anchor_sample
-    }
-
     fn set_anchor(&mut self, state: [f64; 2]) {
         self.anchor = [state[0] as f32, state[1] as f32];
         self.anchor_f64 = state;
@@ -163,29 +218,28 @@ impl AnchoredComponent {
     }
 }
 
-/// Adds every component into `out`, in the bank's order. The loops are compiled for x86-64's
-/// baseline (SSE2: 4 f32 an instruction) and again for AVX2 (8) and AVX-512 (16), and the widest
-/// the processor has runs. Every lane does the same IEEE multiplications and additions in the
-/// same order (Rust never fuses them), so the samples are the same bits on every path.
+/// The sum of `components` over a whole period, each anchored at its first sample, written to
+/// `out`, in the bank's order from +0 (as adding each into a period of zeros would make it).
+/// The loops are compiled for x86-64's baseline (SSE2: 4 f32 an instruction) and again for AVX2
+/// (8) and AVX-512 (16), and the widest the processor has runs. Every lane does the same IEEE
+/// multiplications and additions in the same order (Rust never fuses them), so the samples are
+/// the same bits on every path.
 ///
-/// A whole period in which no component starts is summed with the period held in registers (64
-/// f32: 8 AVX2 or 4 AVX-512 registers), so each component costs its multiplications and additions
-/// and no loads and stores of the output.
+/// The period is held in registers (64 f32: 8 AVX2 or 4 AVX-512 registers), so each component
+/// costs its multiplications and additions and no loads and stores of the output.
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
-fn add_components(components: &[AnchoredComponent], span_start: u64, out: &mut [f32]) {
-    if let Ok(period) = <&mut [f32; GRID]>::try_from(&mut *out) {
-        if components
-            .iter()
-            .all(|component| component.anchor_sample() == span_start)
-        {
-            let mut sum = *period;
-            for component in components {
-                component.synthesize_period(&mut sum);
-            }
-            *period = sum;
-            return;
-        }
+fn sum_period(components: &[AnchoredComponent], out: &mut [f32; GRID]) {
+    let mut sum = [0.0; GRID];
+    for component in components {
+        component.synthesize_period(&mut sum);
     }
+    *out = sum;
+}
+
+/// Adds each component's samples into `out`, which starts at absolute sample `span_start` and
+/// lies within one grid period, in the bank's order; compiled as [`sum_period`] is.
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
+fn add_each(components: &[AnchoredComponent], span_start: u64, out: &mut [f32]) {
     for component in components {
         component.synthesize(span_start, out);
     }

@@ -22,15 +22,25 @@ pub const STARTS_PER_SECOND: f64 = 6000.0;
 
 /// A component as one synthesis path renders it: what its [`Bank`] holds.
 pub trait BankComponent: Sized {
+    /// What the path keeps between the spans of one grid period (the anchored path: the period
+    /// summed over the components that sound from its start, so that a period cut into small
+    /// spans is summed once); `()` for none. The bank starts it afresh whenever its components
+    /// change other than by one joining at the end.
+    type PeriodSum: Default;
     /// The component from its first sample on.
     fn start(component: Component) -> Self;
     /// Any measure that orders components by loudness.
     fn level(&self) -> f64;
     /// Moves to the grid period starting at `period_start`; false once the component is silent.
     fn advance(&mut self, period_start: u64) -> bool;
-    /// Adds every component of a bank into `out`, which starts at absolute sample `span_start`
-    /// and lies within one grid period.
-    fn add_all(components: &mut [Self], span_start: u64, out: &mut [f32]);
+    /// Writes the sum of every component of a bank, in its order and from +0, to `out`, which
+    /// starts at absolute sample `span_start` and lies within one grid period.
+    fn write_all(
+        components: &mut [Self],
+        period_sum: &mut Self::PeriodSum,
+        span_start: u64,
+        out: &mut [f32],
+    );
 }
 
 /// The start budget of MODEL.md §11: a bucket of at most [`START_BURST_UNITS`] units that refills
@@ -63,8 +73,9 @@ impl StartBudget {
 }
 
 /// A synthesis path: the sounding components of kind `C`, allocation-free after `new()`.
-pub struct Bank<C> {
+pub struct Bank<C: BankComponent> {
     sounding: Vec<C>,
+    period_sum: C::PeriodSum,
     sample_rate: f64,
     /// Components given up because the bank was full or the start budget was spent (both
     /// components of a unit refused by the budget count).
@@ -78,6 +89,7 @@ impl<C: BankComponent> Synthesis for Bank<C> {
     fn new(sample_rate: f64) -> Self {
         Self {
             sounding: Vec::with_capacity(MAX_COMPONENTS),
+            period_sum: C::PeriodSum::default(),
             sample_rate,
             given_up: 0,
             budget: StartBudget::FULL,
@@ -87,6 +99,7 @@ impl<C: BankComponent> Synthesis for Bank<C> {
 
     fn clear(&mut self) {
         self.sounding.clear();
+        self.period_sum = C::PeriodSum::default();
         self.given_up = 0;
         self.budget = StartBudget::FULL;
     }
@@ -128,7 +141,7 @@ impl<C: BankComponent> Synthesis for Bank<C> {
 
     #[inline]
     fn synthesize(&mut self, span_start: u64, out: &mut [f32]) {
-        C::add_all(&mut self.sounding, span_start, out);
+        C::write_all(&mut self.sounding, &mut self.period_sum, span_start, out);
     }
 
     fn advance(&mut self, period_start: u64) {
@@ -155,6 +168,8 @@ impl<C: BankComponent> Bank<C> {
         let louder = weakest.level() < new.level();
         if louder {
             *weakest = new;
+            // A component replaced in the middle of the bank: the period's sum is not its own.
+            self.period_sum = C::PeriodSum::default();
         }
         louder
     }

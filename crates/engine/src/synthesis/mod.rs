@@ -42,8 +42,8 @@ pub trait Synthesis {
     /// any of them sounds (MODEL.md §6, §11: none does for a unit given up, or whose components
     /// are all omitted).
     fn start_unit(&mut self, onset: &UnitOnset) -> bool;
-    /// Adds every component into `out`, which starts at absolute sample `span_start` and lies
-    /// within one grid period.
+    /// Writes the sum of every component, from +0 in the bank's order, to `out` (whatever it
+    /// held), which starts at absolute sample `span_start` and lies within one grid period.
     fn synthesize(&mut self, span_start: u64, out: &mut [f32]);
     /// Steps every component to the period starting at `period_start`, dropping silent ones.
     fn advance(&mut self, period_start: u64);

@@ -72,15 +72,18 @@ impl<T: Float> BankComponent for RecursiveComponent<T> {
         true
     }
 
-    fn add_all(components: &mut [Self], span_start: u64, out: &mut [f32]) {
+    type PeriodSum = ();
+
+    fn write_all(components: &mut [Self], _: &mut (), span_start: u64, out: &mut [f32]) {
         // The span's sum in the path's own precision, before it meets the f32 output.
         let mut sum = [T::zero(); GRID];
         let sum = &mut sum[..out.len()];
         for component in components {
             component.synthesize(span_start, sum);
         }
+        // From +0, as the bank writes every path's sum: −0 becomes +0.
         for (y, &value) in out.iter_mut().zip(sum.iter()) {
-            *y += value.to_f32().unwrap_or(0.0);
+            *y = 0.0 + value.to_f32().unwrap_or(0.0);
         }
     }
 }
