@@ -521,6 +521,35 @@ def test_osc_tilt_from_loopback_pours_and_garbage_is_counted(jack_server, app):
     quits_cleanly(process, log, jack_server, signal.SIGINT)
 
 
+def test_midi_learn_takes_the_next_cc_and_the_tilt_follows_it(jack_server, app):
+    """`--learn tilt`, MIDI learn without the editor (as the MIDI panel's Learn button): the
+    first CC the device sends, CC 20 on channel 4, is taken for tilt with its channel, and the
+    app says so; the bottle then follows CC 20 on channel 4, and no longer the default CC 16."""
+    process, log = app("--learn", "tilt")
+    rig = Rig(jack_server)
+    try:
+        rig.connect()
+        rig.send([0xB3, 20, 0])  # channel 4: status B0 + 3
+        wait_for(lambda: "MIDI learn: " in read(log), 5, "the app to say what it learnt")
+        learnt = [line for line in read(log).splitlines() if "MIDI learn: " in line]
+        assert learnt[-1].endswith("MIDI learn: Tilt CC (MSB) = CC 20 on channel 4"), learnt
+        # The old tilt CC, 135° on CC 16 and its LSB, on the learnt channel: the bottle stays up.
+        rig.send(*[[0xB3, cc, value] for _, cc, value in tilt_ccs(TILT_VALUE)])
+        _, upright = rig.record(0.4, gaps=True)
+        assert np.all(upright == 0.0), f"CC 16 still tilts: peak {np.abs(upright).max()}"
+        # The learnt CC on another channel: still up.
+        rig.send([0xB0, 20, TILT_VALUE >> 7])
+        _, other_channel = rig.record(0.4, gaps=True)
+        assert np.all(other_channel == 0.0), "channel 1 is not listened to any more"
+        # The learnt CC on its channel tilts it to 135°: it glugs.
+        rig.send([0xB3, 20, TILT_VALUE >> 7])
+        _, poured = rig.record(0.8, gaps=True)
+        assert np.abs(poured).max() > 0.01, "the learnt CC tilts the bottle"
+    finally:
+        rig.close()
+    quits_cleanly(process, log, jack_server, signal.SIGINT)
+
+
 def test_osc_listens_on_loopback_unless_asked(jack_server, app):
     port = free_udp_port()
     process, log = app("--osc-port", str(port))
