@@ -176,13 +176,8 @@ fn every_float_parameter_is_continuous_to_vst3_and_clap_hosts() {
     let mut class: PClassInfo2 = unsafe { std::mem::zeroed() };
     assert_eq!(unsafe { factory2.getClassInfo2(0, &mut class) }, kResultOk);
     let mut object = std::ptr::null_mut();
-    let created = unsafe {
-        factory.createInstance(
-            class.cid.as_ptr(),
-            IComponent_iid.as_ptr() as *const c_char,
-            &mut object,
-        )
-    };
+    let created =
+        unsafe { factory.createInstance(class.cid.as_ptr(), IComponent_iid.as_ptr(), &mut object) };
     assert_eq!(created, kResultOk);
     let component = unsafe { ComPtr::from_raw(object as *mut IComponent) }.expect("IComponent");
     let controller = component
@@ -200,12 +195,7 @@ fn every_float_parameter_is_continuous_to_vst3_and_clap_hosts() {
             unsafe { controller.getParameterInfo(index, &mut info) },
             kResultOk
         );
-        let title: Vec<u16> = info
-            .title
-            .iter()
-            .map(|&c| c as u16)
-            .take_while(|&c| c != 0)
-            .collect();
+        let title: Vec<u16> = info.title.iter().copied().take_while(|&c| c != 0).collect();
         let title = String::from_utf16(&title).unwrap();
         let float = floats[&title];
         assert_eq!(

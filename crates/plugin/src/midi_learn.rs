@@ -5,6 +5,7 @@
 use std::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
 use sake_glug_device::midi::{MidiMap, MidiSetting};
+use sake_glug_engine::Control;
 
 /// No row is armed.
 const DISARMED: u8 = u8::MAX;
@@ -91,6 +92,10 @@ impl MidiLearn {
     pub fn take(&self, map: &mut MidiMap, channel: u8, cc: u8) -> Option<Learnt> {
         let index = self.armed.load(Ordering::Acquire);
         let setting = setting_at(index)?;
+        // A 14-bit device sends tilt's MSB before its LSB: the LSB row waits past the MSB.
+        if setting == MidiSetting::TiltLsb && map.cc[Control::Tilt] == Some(cc) {
+            return None;
+        }
         self.armed
             .compare_exchange(index, DISARMED, Ordering::AcqRel, Ordering::Acquire)
             .ok()?;
@@ -123,7 +128,6 @@ impl MidiLearn {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sake_glug_engine::Control;
 
     #[test]
     fn an_armed_row_takes_one_cc_and_its_channel() {
@@ -139,6 +143,17 @@ mod tests {
         assert_eq!(learn.last_learnt(), Some(learnt));
         assert_eq!(learnt.to_string(), "Tilt CC (MSB) = CC 20 on channel 4");
         assert_eq!(learn.take(&mut map, 3, 21), None);
+    }
+
+    #[test]
+    fn the_lsb_row_waits_past_tilts_msb() {
+        let learn = MidiLearn::default();
+        let mut map = MidiMap::default();
+        learn.arm(MidiSetting::TiltLsb);
+        assert_eq!(learn.take(&mut map, 0, 16), None, "CC 16 is tilt's MSB");
+        assert_eq!(learn.armed(), Some(MidiSetting::TiltLsb));
+        assert!(learn.take(&mut map, 0, 52).is_some());
+        assert_eq!((map.cc[Control::Tilt], map.tilt_lsb), (Some(16), Some(52)));
     }
 
     #[test]
