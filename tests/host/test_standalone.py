@@ -5,7 +5,8 @@ sends the tilt device's CCs to the app, another client ("recorder") records the 
 in the same JACK cycles, so frame times compare directly. Checked: the upright bottle is silent;
 tilted past the pouring point it glugs, and the first glug sample comes when the model says
 (the offline renderer, fed the same tilt, is the yardstick), with no delay added by the app;
-OSC over loopback tilts it too, garbage packets are counted, and OSC listens on loopback
+MIDI learn (`--learn tilt`) takes the next CC and the bottle follows it; OSC over loopback tilts
+it too, garbage packets are counted, and OSC listens on loopback
 unless asked; any sequence of SIGINT, SIGTERM and SIGHUP ends it within half a second, with exit
 status 0 and its JACK client gone, also with its editor open (under Xvfb); a JACK server that
 goes away is logged and ends it with exit status 1. Every process started here is stopped, also
