@@ -5,7 +5,8 @@ sends the tilt device's CCs to the app, another client ("recorder") records the 
 in the same JACK cycles, so frame times compare directly. Checked: the upright bottle is silent;
 tilted past the pouring point it glugs, and the first glug sample comes when the model says
 (the offline renderer, fed the same tilt, is the yardstick), with no delay added by the app;
-OSC over loopback tilts it too, garbage packets are counted, and OSC listens on loopback
+MIDI learn (`--learn tilt`) takes the next CC and the bottle follows it; OSC over loopback tilts
+it too, garbage packets are counted, and OSC listens on loopback
 unless asked; any sequence of SIGINT, SIGTERM and SIGHUP ends it within half a second, with exit
 status 0 and its JACK client gone, also with its editor open (under Xvfb); a JACK server that
 goes away is logged and ends it with exit status 1. Every process started here is stopped, also
@@ -435,6 +436,35 @@ def test_osc_tilt_from_loopback_pours_and_garbage_is_counted(jack_server, app):
         _, poured = rig.record(0.6, gaps=True)
         assert np.abs(poured).max() > 0.01, "OSC tilt made the bottle glug"
         wait_for(lambda: "1 malformed packet" in read(log), 5, "the malformed packet's log line")
+    finally:
+        rig.close()
+    quits_cleanly(process, log, jack_server, signal.SIGINT)
+
+
+def test_midi_learn_takes_the_next_cc_and_the_tilt_follows_it(jack_server, app):
+    """`--learn tilt`, MIDI learn without the editor (as the MIDI panel's Learn button): the
+    first CC the device sends, CC 20 on channel 4, is taken for tilt with its channel, and the
+    app says so; the bottle then follows CC 20 on channel 4, and no longer the default CC 16."""
+    process, log = app("--learn", "tilt")
+    rig = Rig(jack_server)
+    try:
+        rig.connect()
+        rig.send([0xB3, 20, 0])  # channel 4: status B0 + 3
+        wait_for(lambda: "MIDI learn: " in read(log), 5, "the app to say what it learnt")
+        learnt = [line for line in read(log).splitlines() if "MIDI learn: " in line]
+        assert learnt[-1].endswith("MIDI learn: Tilt CC (MSB) = CC 20 on channel 4"), learnt
+        # The old tilt CC, 135° on CC 16 and its LSB, on the learnt channel: the bottle stays up.
+        rig.send(*[[0xB3, cc, value] for _, cc, value in tilt_ccs(TILT_VALUE)])
+        _, upright = rig.record(0.4, gaps=True)
+        assert np.all(upright == 0.0), f"CC 16 still tilts: peak {np.abs(upright).max()}"
+        # The learnt CC on another channel: still up.
+        rig.send([0xB0, 20, TILT_VALUE >> 7])
+        _, other_channel = rig.record(0.4, gaps=True)
+        assert np.all(other_channel == 0.0), "channel 1 is not listened to any more"
+        # The learnt CC on its channel tilts it to 135°: it glugs.
+        rig.send([0xB3, 20, TILT_VALUE >> 7])
+        _, poured = rig.record(0.8, gaps=True)
+        assert np.abs(poured).max() > 0.01, "the learnt CC tilts the bottle"
     finally:
         rig.close()
     quits_cleanly(process, log, jack_server, signal.SIGINT)

@@ -10,8 +10,8 @@ use std::ptr;
 
 use clap_sys::audio_buffer::clap_audio_buffer;
 use clap_sys::events::{
-    clap_event_header, clap_event_param_value, clap_input_events, clap_output_events,
-    CLAP_CORE_EVENT_SPACE_ID, CLAP_EVENT_PARAM_VALUE,
+    clap_event_header, clap_event_midi, clap_event_param_value, clap_input_events,
+    clap_output_events, CLAP_CORE_EVENT_SPACE_ID, CLAP_EVENT_MIDI, CLAP_EVENT_PARAM_VALUE,
 };
 use clap_sys::ext::audio_ports_config::{
     clap_audio_ports_config, clap_plugin_audio_ports_config, CLAP_EXT_AUDIO_PORTS_CONFIG,
@@ -203,6 +203,20 @@ impl ClapInstance {
             .into_owned()
     }
 
+    /// Every parameter as (name, CLAP flags).
+    pub fn parameter_infos(&self) -> Vec<(String, u32)> {
+        let params: &clap_plugin_params = self.extension(CLAP_EXT_PARAMS);
+        let count = unsafe { (params.count.unwrap())(self.plugin) };
+        (0..count)
+            .map(|index| {
+                let mut info: clap_param_info = unsafe { std::mem::zeroed() };
+                assert!(unsafe { (params.get_info.unwrap())(self.plugin, index, &mut info) });
+                let name = unsafe { CStr::from_ptr(info.name.as_ptr()) };
+                (name.to_string_lossy().into_owned(), info.flags)
+            })
+            .collect()
+    }
+
     /// Every parameter as (name, CLAP value, declared min, declared max).
     pub fn parameter_values(&self) -> Vec<(std::ffi::CString, f64, f64, f64)> {
         let params: &clap_plugin_params = self.extension(CLAP_EXT_PARAMS);
@@ -289,6 +303,22 @@ impl ClapInstance {
         block: usize,
         changes: &[ParamChange],
     ) -> Vec<f32> {
+        self.render_events(total, block, changes, &[])
+    }
+
+    /// [`ClapInstance::render`] with MIDI control changes (in order of time) sent as CLAP MIDI
+    /// events, as a host passes a controller's messages on.
+    pub fn render_midi(&mut self, total: usize, block: usize, ccs: &[MidiCc]) -> Vec<f32> {
+        self.render_events(total, block, &[], ccs)
+    }
+
+    fn render_events(
+        &mut self,
+        total: usize,
+        block: usize,
+        changes: &[ParamChange],
+        ccs: &[MidiCc],
+    ) -> Vec<f32> {
         assert!(self.activated);
         let mut out = Vec::with_capacity(total);
         let mut buffers = vec![vec![0.0f32; block]; self.channels as usize];
@@ -312,7 +342,19 @@ impl ClapInstance {
                 .filter(|change| (block_start..block_start + len as u64).contains(&change.at))
                 .map(|change| change.event((change.at - block_start) as u32))
                 .collect();
-            let events = EventList(in_block.iter().map(|event| &event.header).collect());
+            let midi_in_block: Vec<clap_event_midi> = ccs
+                .iter()
+                .filter(|cc| (block_start..block_start + len as u64).contains(&cc.at))
+                .map(|cc| cc.event((cc.at - block_start) as u32))
+                .collect();
+            // One list in order of time, as CLAP asks.
+            let mut headers: Vec<&clap_event_header> = in_block
+                .iter()
+                .map(|event| &event.header)
+                .chain(midi_in_block.iter().map(|event| &event.header))
+                .collect();
+            headers.sort_by_key(|header| header.time);
+            let events = EventList(headers);
             let input = events.input();
             let output_events = no_output();
             let process = clap_process {
@@ -379,6 +421,34 @@ impl ParamChange {
             channel: -1,
             key: -1,
             value: self.value,
+        }
+    }
+}
+
+/// A MIDI control change at a sample of a render.
+#[derive(Debug, Clone, Copy)]
+pub struct MidiCc {
+    /// The sample it comes at, counted from the render's start.
+    pub at: u64,
+    /// 0–15.
+    pub channel: u8,
+    pub cc: u8,
+    /// 0–127.
+    pub value: u8,
+}
+
+impl MidiCc {
+    fn event(&self, time: u32) -> clap_event_midi {
+        clap_event_midi {
+            header: clap_event_header {
+                size: std::mem::size_of::<clap_event_midi>() as u32,
+                time,
+                space_id: CLAP_CORE_EVENT_SPACE_ID,
+                type_: CLAP_EVENT_MIDI,
+                flags: 0,
+            },
+            port_index: 0,
+            data: [0xB0 | (self.channel & 0x0F), self.cc, self.value],
         }
     }
 }

@@ -143,3 +143,74 @@ fn the_vst3_factory_shows_no_placeholder_and_leaves_the_contact_blank() {
         }
     }
 }
+
+/// The plugin's own parameters by name: whether each is a float (continuous) parameter.
+fn float_by_name() -> std::collections::HashMap<String, bool> {
+    use nice_plug::prelude::{ParamPtr, Params};
+    sake_glug_plugin::GlugParams::default()
+        .param_map()
+        .into_iter()
+        .map(|(_, param, _)| {
+            let name = unsafe { param.name() }.to_owned();
+            (name, matches!(param, ParamPtr::FloatParam(_)))
+        })
+        .collect()
+}
+
+/// Each float parameter is continuous to the host: VST3 stepCount 0 and no CLAP "stepped"
+/// flag, so a host's value (typed or automated) reaches the plugin as it is; the knob's step
+/// is only in the text the plugin shows and parses. The integer and enum parameters come out
+/// stepped, which shows that the counts read here are the plugin's own.
+#[test]
+fn every_float_parameter_is_continuous_to_vst3_and_clap_hosts() {
+    use clap_sys::ext::params::CLAP_PARAM_IS_STEPPED;
+    use nice_plug::wrapper::vst3::vst3::Steinberg::Vst::{
+        IComponent, IComponent_iid, IEditController, IEditControllerTrait, ParameterInfo,
+    };
+    let floats = float_by_name();
+    assert!(floats.values().filter(|&&float| float).count() >= 17);
+
+    let raw = sake_glug_plugin::GetPluginFactory() as *mut IPluginFactory;
+    let factory = unsafe { ComPtr::from_raw(raw) }.expect("a factory");
+    let factory2 = factory.cast::<IPluginFactory2>().expect("IPluginFactory2");
+    let mut class: PClassInfo2 = unsafe { std::mem::zeroed() };
+    assert_eq!(unsafe { factory2.getClassInfo2(0, &mut class) }, kResultOk);
+    let mut object = std::ptr::null_mut();
+    let created =
+        unsafe { factory.createInstance(class.cid.as_ptr(), IComponent_iid.as_ptr(), &mut object) };
+    assert_eq!(created, kResultOk);
+    let component = unsafe { ComPtr::from_raw(object as *mut IComponent) }.expect("IComponent");
+    let controller = component
+        .cast::<IEditController>()
+        .expect("IEditController");
+    let count = unsafe { controller.getParameterCount() };
+    assert_eq!(
+        count as usize,
+        floats.len(),
+        "the VST3 has only the real parameters"
+    );
+    for index in 0..count {
+        let mut info: ParameterInfo = unsafe { std::mem::zeroed() };
+        assert_eq!(
+            unsafe { controller.getParameterInfo(index, &mut info) },
+            kResultOk
+        );
+        let title: Vec<u16> = info.title.iter().copied().take_while(|&c| c != 0).collect();
+        let title = String::from_utf16(&title).unwrap();
+        let float = floats[&title];
+        assert_eq!(
+            info.stepCount == 0,
+            float,
+            "VST3 {title}: stepCount {}",
+            info.stepCount
+        );
+    }
+
+    let instance = crate::clap_host::ClapInstance::new();
+    let infos = instance.parameter_infos();
+    assert_eq!(infos.len(), floats.len());
+    for (name, flags) in infos {
+        let stepped = flags & CLAP_PARAM_IS_STEPPED != 0;
+        assert_eq!(!stepped, floats[&name], "CLAP {name}: flags {flags:#x}");
+    }
+}

@@ -3,7 +3,11 @@
 
 use std::sync::atomic::Ordering::Relaxed;
 
-use crate::host::{cc, note_on, Playhead, TestHost};
+use crate::clap_host::{ClapInstance, MidiCc};
+use crate::fuzz::checks::{bytes_of, json_of};
+use crate::host::{cc, note_on, peak, Playhead, TestHost};
+use nice_plug::prelude::Params;
+use sake_glug_device::midi::MidiSetting;
 use sake_glug_device::midi::{CcDecoder, MidiMap, Overrides};
 use sake_glug_engine::{Control, ControlValues, PerControl};
 
@@ -161,4 +165,83 @@ fn ccs_drive_the_plugin_and_a_note_on_refills() {
     host.plugin.glug_params().set_midi_map(map);
     host.process(64, vec![cc(0, 9, 1, 0)], Playhead::default());
     assert_eq!(host.plugin.feed().tilt_deg.load(Relaxed), 0.0);
+}
+
+/// MIDI learn: Tilt's row is armed (as the editor's Learn button or the app's `--learn` arms
+/// it; nothing in the CLAP or VST3 interface can), the next CC is taken with its channel, the
+/// tilt follows it, the saved state keeps it, and a CLAP instance that loads that state through
+/// the CLAP state extension pours when a host passes that CC as a CLAP MIDI event.
+#[test]
+fn midi_learn_takes_the_next_cc_and_its_channel_and_the_state_keeps_it() {
+    let mut host = TestHost::new(48_000.0, 2);
+    let params = host.plugin.glug_params().clone();
+    params.learn.arm(MidiSetting::Cc(Control::Tilt));
+    // The device sends CC 20 on channel 4 (3 from 0), 7-bit value 96; 14-bit tilt keeps its
+    // LSB CC, whose last value (none yet: 0) completes the angle.
+    host.process(64, vec![cc(10, 3, 20, 96)], Playhead::default());
+    let map = params.midi_map();
+    assert_eq!(map.cc[Control::Tilt], Some(20));
+    assert_eq!(map.channel, Some(3));
+    assert_eq!(params.learn.armed(), None, "one CC is learnt");
+    let tilt = |host: &TestHost| host.plugin.feed().tilt_deg.load(Relaxed) as f64;
+    let expected = |msb: u32| (msb << 7) as f64 / 16383.0 * 180.0;
+    assert!((tilt(&host) - expected(96)).abs() < 1e-4, "{}", tilt(&host));
+    // The tilt follows the learnt CC from then on, and no longer the old one.
+    host.process(64, vec![cc(0, 3, 20, 40)], Playhead::default());
+    assert!((tilt(&host) - expected(40)).abs() < 1e-4, "{}", tilt(&host));
+    host.process(64, vec![cc(0, 3, 16, 100)], Playhead::default());
+    assert!(
+        (tilt(&host) - expected(40)).abs() < 1e-4,
+        "CC 16 is not tilt any more"
+    );
+    // Another channel is not listened to.
+    host.process(64, vec![cc(0, 0, 20, 100)], Playhead::default());
+    assert!(
+        (tilt(&host) - expected(40)).abs() < 1e-4,
+        "channel 1 is not listened to"
+    );
+    let fields = params.serialize_fields();
+    assert_eq!(fields["midi_cc_tilt"], "20");
+    assert_eq!(fields["midi_channel"], "3");
+
+    // The learnt map through the CLAP state extension, as a host saves and reopens a project.
+    let learnt = ClapInstance::new();
+    let mut json = json_of(&learnt.save());
+    for (key, value) in &fields {
+        json["fields"][key] = serde_json::Value::String(value.clone());
+    }
+    assert!(learnt.load(&bytes_of(&json)));
+    let saved = json_of(&learnt.save());
+    assert_eq!(saved["fields"]["midi_cc_tilt"], "20");
+    assert_eq!(saved["fields"]["midi_channel"], "3");
+    let mut reopened = ClapInstance::new();
+    assert!(reopened.load(&learnt.save()));
+    reopened.activate(48_000.0);
+    // 135° on the learnt CC (7-bit MSB 96 → 135.0°) pours; the same on the old CC 16 does not.
+    let on = |cc| {
+        [MidiCc {
+            at: 0,
+            channel: 3,
+            cc,
+            value: 96,
+        }]
+    };
+    let poured = reopened.render_midi(48_000, 512, &on(20));
+    assert!(peak(&poured) > 0.05, "the learnt CC tilts the bottle");
+    let mut other = ClapInstance::new();
+    assert!(other.load(&learnt.save()));
+    other.activate(48_000.0);
+    let upright = other.render_midi(48_000, 512, &on(16));
+    assert_eq!(peak(&upright), 0.0, "the old CC does not");
+}
+
+#[test]
+fn learning_a_cc_another_row_had_unmaps_that_row() {
+    let mut map = MidiMap::default();
+    map.learn(MidiSetting::Cc(Control::Tilt), 0, 17);
+    assert_eq!(map.cc[Control::Tilt], Some(17));
+    assert_eq!(map.cc[Control::Viscosity], None, "CC 17 was viscosity's");
+    assert_eq!(map.channel, Some(0));
+    map.learn(MidiSetting::TiltLsb, 15, 49);
+    assert_eq!((map.tilt_lsb, map.channel), (Some(49), Some(15)));
 }

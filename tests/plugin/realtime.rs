@@ -54,6 +54,12 @@ fn process_does_not_allocate_under_a_busy_session() {
                     sake_glug_plugin::Actuator::shipped(names[index / 4 % 4], index % 8 == 2);
                 host.plugin.glug_params().actuator.set(actuator);
             }
+            // The editor arms MIDI learn now and then: process() takes the next CC for it.
+            if index % 5 == 1 {
+                let rows: Vec<_> = sake_glug_device::midi::MidiSetting::all().skip(1).collect();
+                let row = rows[index / 5 % rows.len()];
+                host.plugin.glug_params().learn.arm(row);
+            }
             let last = len as u32 - 1;
             let events = vec![
                 cc(0, 0, 16, 100),

@@ -129,6 +129,22 @@ impl MidiMap {
             .collect()
     }
 
+    /// MIDI learn: `setting` takes `cc` and the map listens on `channel` (the device's), as a
+    /// CC the device sent while the user was learning that row. Any other row that had `cc` is
+    /// unmapped, so that one CC drives one control. Learning the channel itself only sets it.
+    pub fn learn(&mut self, setting: MidiSetting, channel: u8, cc: u8) {
+        self.channel = (channel <= MidiSetting::Channel.max()).then_some(channel);
+        if setting == MidiSetting::Channel || cc > setting.max() {
+            return;
+        }
+        for other in MidiSetting::all().filter(|&other| other != MidiSetting::Channel) {
+            if other != setting && self.raw(other) == cc {
+                self.set_raw(other, OFF);
+            }
+        }
+        self.set_raw(setting, cc);
+    }
+
     fn listens_on(&self, channel: u8) -> bool {
         self.channel.is_none_or(|wanted| wanted == channel)
     }

@@ -5,6 +5,7 @@ mod actuator_setting;
 mod feed;
 mod layering;
 mod loaded_model;
+mod midi_learn;
 mod osc_input;
 mod params;
 pub mod presets;
@@ -19,6 +20,7 @@ pub use actuator_setting::{Actuator, ActuatorSetting, ACTUATOR_FELT_KEY, ACTUATO
 pub use feed::{Feed, UnitView, Visible, SCOPE_COLUMNS, SCOPE_COLUMN_S, UNIT_SLOTS};
 pub use layering::model_values;
 pub use loaded_model::{LoadedModel, ModelLayer, MODEL_KEY, MODEL_NAME_KEY};
+pub use midi_learn::{Learnt, MidiLearn};
 pub use osc_input::{OscInput, OscSettings, OscStatus, DEFAULT_AXIS, DEFAULT_OSC_INTERFACE};
 pub use params::{
     exact, float_param, format, migrate_state, parse_number, GlugParams, ModelParams, STATE_VERSION,
@@ -70,8 +72,13 @@ impl<const RAW_MIDI: bool> Default for SakeGlugPlugin<RAW_MIDI> {
         if let Some(actuator) = standalone::options().and_then(|options| options.actuator.clone()) {
             params.actuator.set(Some(actuator));
         }
+        if let Some(setting) = standalone::options().and_then(|options| options.learn) {
+            params.learn.arm(setting);
+        }
+        let params = Arc::new(params);
+        standalone::share_params(&params);
         Self {
-            params: Arc::new(params),
+            params,
             feed: Arc::new(Feed::default()),
             osc: Arc::new(OscInput::default()),
             renderer: None,
@@ -231,7 +238,7 @@ impl<const RAW_MIDI: bool> Plugin for SakeGlugPlugin<RAW_MIDI> {
     ) -> ProcessStatus {
         let len = buffer.samples();
         let channels = buffer.as_slice();
-        let settings = self.settings();
+        let mut settings = self.settings();
         let Some(renderer) = &mut self.renderer else {
             channels.iter_mut().for_each(|channel| channel.fill(0.0));
             return ProcessStatus::Normal;
@@ -251,6 +258,19 @@ impl<const RAW_MIDI: bool> Plugin for SakeGlugPlugin<RAW_MIDI> {
             while let Some(event) = next_event {
                 if event.timing() as usize > position && position < len {
                     break;
+                }
+                if let NoteEvent::MidiCC { channel, cc, .. } = event {
+                    // MIDI learn: the armed row takes this CC, which then acts as mapped.
+                    if self
+                        .params
+                        .learn
+                        .take(&mut settings.midi, channel, cc)
+                        .is_some()
+                    {
+                        self.params.set_midi_map(settings.midi);
+                        #[cfg(feature = "editor")]
+                        self.feed.repaint.request_repaint();
+                    }
                 }
                 if let Some(input) = midi_input(&event, &settings.midi) {
                     renderer.handle(input, &settings.midi);

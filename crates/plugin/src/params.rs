@@ -16,6 +16,7 @@ use nice_plug::prelude::*;
 
 use crate::actuator_setting::{saved_actuator, ActuatorSetting};
 use crate::loaded_model::{saved_model, LoadedModel, MODEL_KEY, MODEL_NAME_KEY};
+use crate::midi_learn::MidiLearn;
 use crate::osc_input::OscSettings;
 use sake_glug_device::midi::{MidiMap, MidiSetting};
 use sake_glug_engine::config::{self, CEILING_DB};
@@ -132,6 +133,8 @@ pub struct GlugParams {
     /// MIDI settings of the tilt device (saved with the state, not automatable), in the order
     /// of [`MidiSetting::all`].
     pub midi: Vec<AtomicU8>,
+    /// MIDI learn: the row of the MIDI settings waiting for the device's next CC (not saved).
+    pub learn: MidiLearn,
     /// The layout of the saved state ([`STATE_VERSION`]); older states are brought up to date
     /// by [`migrate_state`] before they load.
     pub state_version: AtomicU8,
@@ -340,6 +343,7 @@ impl Default for GlugParams {
             midi: MidiSetting::all()
                 .map(|setting| AtomicU8::new(midi.raw(setting)))
                 .collect(),
+            learn: MidiLearn::default(),
             state_version: AtomicU8::new(STATE_VERSION),
             osc: OscSettings::default(),
             loaded_model: LoadedModel::default(),

@@ -23,6 +23,9 @@ pub struct StandaloneOptions {
     pub model: Option<sake_glug_model_file::ModelFile>,
     /// The actuator to compensate for (`--actuator`, `--felt`), as the editor's menu sets it.
     pub actuator: Option<crate::actuator_setting::Actuator>,
+    /// The row of the MIDI settings that learns the device's first CC (`--learn`), as the
+    /// editor's "Learn" button arms it.
+    pub learn: Option<sake_glug_device::midi::MidiSetting>,
 }
 
 static OPTIONS: OnceLock<StandaloneOptions> = OnceLock::new();
@@ -30,6 +33,8 @@ static QUIT: LazyLock<Arc<AtomicBool>> = LazyLock::new(Arc::default);
 /// `process()` calls so far (counted only in the standalone app).
 static CYCLES: AtomicU64 = AtomicU64::new(0);
 static EDITOR_WAKE: OnceLock<Box<dyn Fn() + Send + Sync>> = OnceLock::new();
+/// The app's one plugin's parameters, for the app to report what MIDI learn took.
+static PARAMS: OnceLock<Arc<crate::GlugParams>> = OnceLock::new();
 
 /// Sets the options for this process; only the first call counts (returns whether it did).
 pub fn configure(options: StandaloneOptions) -> bool {
@@ -84,4 +89,17 @@ pub fn processing_cycles() -> u64 {
 /// The flag a quit signal sets (the app registers it for SIGINT, SIGTERM and SIGHUP).
 pub fn quit_flag() -> Arc<AtomicBool> {
     QUIT.clone()
+}
+
+/// In the standalone app, keeps the plugin's parameters for [`last_learnt`]; the first
+/// instance's only. In a DAW nothing is kept.
+pub fn share_params(params: &Arc<crate::GlugParams>) {
+    if options().is_some() {
+        let _ = PARAMS.set(params.clone());
+    }
+}
+
+/// The last CC that MIDI learn took in the standalone app, if any.
+pub fn last_learnt() -> Option<crate::Learnt> {
+    PARAMS.get()?.learn.last_learnt()
 }

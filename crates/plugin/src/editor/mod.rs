@@ -15,6 +15,7 @@ use std::sync::Arc;
 
 use nice_plug::context::gui::GuiContext;
 use nice_plug::editor::dpi::LogicalSize;
+use nice_plug::prelude::PluginApi;
 use nice_plug_egui::{
     create_egui_editor, EguiEditor, EguiEditorState, EguiNiceSettings, NiceEguiApp,
 };
@@ -46,6 +47,8 @@ pub struct GlugEditor {
     /// The MIDI settings were edited and the host is not told yet (it is, once the mouse is
     /// let go, not at every step of a drag).
     midi_edited: bool,
+    /// The MIDI panel's learn in progress.
+    midi_panel: midi_settings::MidiPanel,
     /// The model file's path field and the last refusal.
     model_field: PathField,
     /// The actuator profile's path field and the last refusal.
@@ -99,6 +102,7 @@ pub fn create(
         gui: None,
         preset: 0,
         midi_edited: false,
+        midi_panel: midi_settings::MidiPanel::default(),
         model_field: PathField::default(),
         actuator_field: PathField::default(),
     };
@@ -150,7 +154,14 @@ impl NiceEguiApp for GlugEditor {
                             actuator::show(ui, &self.params, Some(gui), &mut self.actuator_field);
                             controls::show(ui, &self.params, &self.feed, &setter);
                             ui.separator();
-                            self.midi_edited |= midi_settings::show(ui, &self.params);
+                            // VST3 hosts pass no CCs (see `SakeGlugPlugin`).
+                            let raw_midi = gui.plugin_api() != PluginApi::Vst3;
+                            self.midi_edited |= midi_settings::show(
+                                ui,
+                                &self.params,
+                                &mut self.midi_panel,
+                                raw_midi,
+                            );
                             ui.separator();
                             osc_settings::show(ui, &self.params, &self.osc);
                         });
@@ -188,7 +199,7 @@ mod tests {
             bottle::show(ui, feed, egui::vec2(420.0, 220.0));
             scope::show(ui, feed, egui::vec2(370.0, 200.0));
             envelopes::show(ui, feed, egui::vec2(370.0, 200.0));
-            midi_settings::show(ui, params);
+            midi_settings::show(ui, params, &mut midi_settings::MidiPanel::default(), true);
             osc_settings::show(ui, params, &OscInput::default());
             actuator::show(ui, params, None, &mut PathField::default());
         });

@@ -5,6 +5,7 @@ use std::net::IpAddr;
 use std::path::PathBuf;
 
 use clap::{CommandFactory, Parser};
+use sake_glug_device::midi::MidiSetting;
 use sake_glug_device::Axis;
 use sake_glug_plugin::{DEFAULT_AXIS, DEFAULT_OSC_INTERFACE};
 
@@ -38,10 +39,32 @@ pub struct AppArgs {
     /// With --actuator: equalises the level over the skin's threshold (the editor's "felt").
     #[arg(long, requires = "actuator")]
     pub felt: bool,
+    /// MIDI learn without the editor: the first CC the device sends is taken for this row of
+    /// the MIDI settings (tilt, tilt_lsb, viscosity or fill), with its channel, as the MIDI
+    /// panel's "Learn" button takes it; the app prints what it took.
+    #[arg(long, value_name = "ROW", value_parser = parse_learn_row)]
+    pub learn: Option<MidiSetting>,
+}
+
+/// A row of the MIDI settings by its name: its saved key without `midi_cc_`.
+fn learn_row_name(setting: MidiSetting) -> Option<&'static str> {
+    setting.key().strip_prefix("midi_cc_")
+}
+
+fn parse_learn_row(name: &str) -> Result<MidiSetting, String> {
+    MidiSetting::all()
+        .find(|&setting| learn_row_name(setting) == Some(name))
+        .ok_or_else(|| {
+            let rows: Vec<&str> = MidiSetting::all().filter_map(learn_row_name).collect();
+            format!(
+                "{name:?} is not a row of the MIDI settings: {}",
+                rows.join(", ")
+            )
+        })
 }
 
 /// Our options and whether each takes a value.
-const OWN: [(&str, bool); 7] = [
+const OWN: [(&str, bool); 8] = [
     ("--osc-port", true),
     ("--osc-bind", true),
     ("--osc-axis", true),
@@ -49,6 +72,7 @@ const OWN: [(&str, bool); 7] = [
     ("--model", true),
     ("--actuator", true),
     ("--felt", false),
+    ("--learn", true),
 ];
 
 /// Splits the command line into our options (as `--name=value`, after the program name) and
@@ -172,6 +196,24 @@ mod tests {
         // --felt alone means nothing.
         let error = parse(&strings(&["app", "--felt"])).unwrap_err().to_string();
         assert!(error.contains("--actuator"), "{error}");
+    }
+
+    #[test]
+    fn the_learn_row_is_taken_out_by_its_name() {
+        use sake_glug_engine::Control;
+        let (own, rest) = split(strings(&["app", "--learn", "tilt", "--backend", "jack"]));
+        assert_eq!(own, strings(&["app", "--learn=tilt"]));
+        assert_eq!(rest, strings(&["app", "--backend", "jack"]));
+        assert_eq!(
+            parse(&own).unwrap().learn,
+            Some(MidiSetting::Cc(Control::Tilt))
+        );
+        let lsb = parse(&strings(&["app", "--learn=tilt_lsb"])).unwrap();
+        assert_eq!(lsb.learn, Some(MidiSetting::TiltLsb));
+        let error = parse(&strings(&["app", "--learn=channel"]))
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("tilt, tilt_lsb, viscosity, fill"), "{error}");
     }
 
     #[test]

@@ -14,7 +14,10 @@
 //! - `--model MODEL.toml`: play a model file's bottle and liquid (MODEL.md §12.1); a model that
 //!   is refused ends the app at once (status 2) with the reason;
 //! - `--actuator NAME|PROFILE.toml [--felt]`: compensate for an actuator (MODEL.md §18), as the
-//!   editor's Actuator menu does; a profile that is refused ends the app at once (status 2).
+//!   editor's Actuator menu does; a profile that is refused ends the app at once (status 2);
+//! - `--learn ROW`: MIDI learn without the editor: the first CC the device sends is taken for
+//!   that row of the MIDI settings (`tilt`, `tilt_lsb`, `viscosity`, `fill`), with its channel,
+//!   and printed on stderr (`MIDI learn: Tilt CC (MSB) = CC 20 on channel 4`).
 //!
 //! If the audio stops coming (the JACK server or the audio device went away) the app says so and
 //! exits with status 1.
@@ -82,6 +85,7 @@ fn main() -> ExitCode {
         osc_interface: options.osc_bind,
         model,
         actuator,
+        learn: options.learn,
     });
     #[cfg(unix)]
     watch::spawn_watch(QUIT_GRACE, AUDIO_LOST_AFTER);

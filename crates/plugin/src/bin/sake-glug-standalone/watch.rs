@@ -6,7 +6,8 @@ use sake_glug_plugin::standalone;
 /// How often the watch looks at the quit flag and the audio callbacks.
 const WATCH_POLL: std::time::Duration = std::time::Duration::from_millis(10);
 
-/// Once the wrapper runs, watches two things nice-plug's wrapper does not:
+/// Once the wrapper runs, says on stderr what MIDI learn takes, and watches two things
+/// nice-plug's wrapper does not:
 ///
 /// - Quit signals, however many come. SIGINT, SIGTERM and SIGHUP also ask the editor to close
 ///   (the wrapper's own handler, ctrlc's, only ends a headless run), and the process ends `grace`
@@ -33,8 +34,17 @@ pub fn spawn_watch(grace: std::time::Duration, audio_lost_after: std::time::Dura
             watch_signals();
             let silent_polls_allowed = audio_lost_after.as_millis() / WATCH_POLL.as_millis();
             let (mut cycles, mut silent_polls) = (0, 0);
+            let mut learnt_shown = None;
             while !standalone::quit_requested() {
                 std::thread::sleep(WATCH_POLL);
+                // What MIDI learn took, said once (the audio thread cannot print).
+                let learnt = standalone::last_learnt();
+                if learnt != learnt_shown {
+                    if let Some(learnt) = learnt {
+                        eprintln!("MIDI learn: {learnt}");
+                    }
+                    learnt_shown = learnt;
+                }
                 let now = standalone::processing_cycles();
                 silent_polls = if now == cycles { silent_polls + 1 } else { 0 };
                 cycles = now;
