@@ -8,13 +8,17 @@ use sake_glug_engine::{Constant, Control};
 /// Steps of the tilt searched for where a bottle starts to pour (°).
 const TILT_STEP_DEG: f64 = 0.1;
 
-/// Why `scene`, rendered as `summary` says, is silent, or `None` if something sounded. The
-/// reason is the first that holds: the bottle is empty, it never tilts past where its liquid
-/// pours, it pours without a glug, every glug it makes is silent.
+/// Why `scene`, rendered as `summary` says, is silent (`nothing sounds: …`), or `None` if
+/// something sounded. The reason is the first that holds: the bottle is empty, it never tilts
+/// past where its liquid pours, it pours without a glug, every glug it makes is silent.
 pub fn why_silent(scene: &Scene, summary: &RenderSummary) -> Option<String> {
     if summary.peak > 0.0 {
         return None;
     }
+    reason(scene, summary).map(|reason| format!("nothing sounds: {reason}"))
+}
+
+fn reason(scene: &Scene, summary: &RenderSummary) -> Option<String> {
     let fill_key = Control::Fill.quantity().scene_key;
     let tilt_key = Control::Tilt.quantity().scene_key;
     let fills: Vec<f64> = scene.lanes.fill_percent.values().collect();
@@ -35,7 +39,9 @@ pub fn why_silent(scene: &Scene, summary: &RenderSummary) -> Option<String> {
         let pours_at = |tilt: f64| fraction > rest.at(tilt);
         let reached = tilt_grid(lowest, highest);
         if !reached.into_iter().any(pours_at) {
-            let first_pouring = tilt_grid(0.0, 180.0).into_iter().find(|&tilt| pours_at(tilt));
+            let first_pouring = tilt_grid(0.0, 180.0)
+                .into_iter()
+                .find(|&tilt| pours_at(tilt));
             let tilt_range = if lowest == highest {
                 format!("stays at {lowest}°")
             } else {

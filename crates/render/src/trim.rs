@@ -72,10 +72,11 @@ pub fn check_trim_db(level_db: f64) -> Result<f64, TrimLevelError> {
 /// When a unit of the units table has decayed below `threshold` (in output units) for good:
 /// its onset plus the time its two components' sum A1·e^(−B1·τ) + A2·e^(−B2·τ) takes to fall to
 /// the threshold; a component the engine omits (at or above Nyquist, or at 0 Hz) counts for
-/// nothing. `None` for a unit that never falls below (a decay rate of 0); its onset for a unit
-/// that starts below.
+/// nothing. `None` for a unit that starts at or below the threshold (it keeps nothing audible);
+/// infinity for one that never falls below it (a decay rate of 0).
 pub fn unit_decayed_s(unit: &UnitRow, threshold: f64, sample_rate: f64) -> Option<f64> {
-    let sounds = |frequency_hz: f64| unit.audible && frequency_hz > 0.0 && frequency_hz < sample_rate / 2.0;
+    let sounds =
+        |frequency_hz: f64| unit.audible && frequency_hz > 0.0 && frequency_hz < sample_rate / 2.0;
     let components: Vec<(f64, f64)> = [
         (unit.f1_hz, unit.a1.abs(), unit.b1_per_s),
         (unit.f2_hz, unit.a2.abs(), unit.b2_per_s),
@@ -91,10 +92,10 @@ pub fn unit_decayed_s(unit: &UnitRow, threshold: f64, sample_rate: f64) -> Optio
             .sum()
     };
     if level(0.0) <= threshold {
-        return Some(unit.onset_s);
+        return None;
     }
     if components.iter().any(|&(_, decay)| decay <= 0.0) {
-        return None;
+        return Some(f64::INFINITY);
     }
     // Each component below half the threshold by then: the sum is below it.
     let mut high = components
@@ -131,11 +132,13 @@ impl RenderObserver for UnitsAndPeak {
 /// below `level_db` re the peak (rounded up), or `None` if one never does.
 pub fn trim_point(units: &[UnitRow], peak: f64, sample_rate: f64, level_db: f64) -> Option<u64> {
     let threshold = peak * 10f64.powf(level_db / 20.0);
-    let mut last_s: f64 = 0.0;
-    for unit in units {
-        last_s = last_s.max(unit_decayed_s(unit, threshold, sample_rate)?);
-    }
-    Some((last_s * sample_rate).ceil() as u64)
+    let last_s = units
+        .iter()
+        .filter_map(|unit| unit_decayed_s(unit, threshold, sample_rate))
+        .fold(0.0, f64::max);
+    last_s
+        .is_finite()
+        .then(|| (last_s * sample_rate).ceil() as u64)
 }
 
 /// `scene` ending where its last unit has decayed below `level_db` re its peak, with a fade of

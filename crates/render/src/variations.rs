@@ -56,7 +56,11 @@ impl Varied {
                     .filter(|&&control| control != Control::Tilt)
                     .map(|&control| Varied::Control(control)),
             )
-            .chain(Constant::ALL.iter().map(|&constant| Varied::Constant(constant)))
+            .chain(
+                Constant::ALL
+                    .iter()
+                    .map(|&constant| Varied::Constant(constant)),
+            )
     }
 
     /// Its key in `[variations]` and its column in a manifest: the control's or the constant's
@@ -220,7 +224,10 @@ fn range_of(varied: Varied, value: &toml::Value) -> Result<[f64; 2], VariationEr
     let numbers: Option<Vec<f64>> = value.as_array().and_then(|items| {
         items
             .iter()
-            .map(|item| item.as_float().or_else(|| item.as_integer().map(|i| i as f64)))
+            .map(|item| {
+                item.as_float()
+                    .or_else(|| item.as_integer().map(|i| i as f64))
+            })
             .collect()
     });
     let [low, high] = numbers
@@ -231,7 +238,9 @@ fn range_of(varied: Varied, value: &toml::Value) -> Result<[f64; 2], VariationEr
         return Err(bad("a range's ends are numbers, not NaN".into()));
     }
     if low > high {
-        return Err(bad(format!("its low end {low} is above its high end {high}")));
+        return Err(bad(format!(
+            "its low end {low} is above its high end {high}"
+        )));
     }
     let allowed = varied.range();
     for end in [low, high] {
@@ -324,6 +333,39 @@ impl Take {
             values,
         })
     }
+}
+
+/// The name of a set whose first file is `path`: its file name up to the first dot
+/// (`pour.wav` and `pour.units.csv` are of the set `pour`).
+pub fn set_name_of(path: &Path) -> String {
+    let file_name = path
+        .file_name()
+        .map_or(String::new(), |name| name.to_string_lossy().into_owned());
+    let (stem, _) = split_at_first_dot(&file_name);
+    stem.to_owned()
+}
+
+/// The file of a take beside `path`: the take's number after the set's name, before the
+/// extensions (`pour.units.csv` → `pour_07.units.csv`).
+pub fn take_path(path: &Path, take_name: &str) -> std::path::PathBuf {
+    let file_name = path
+        .file_name()
+        .map_or(String::new(), |name| name.to_string_lossy().into_owned());
+    let (_, extensions) = split_at_first_dot(&file_name);
+    path.with_file_name(format!("{take_name}{extensions}"))
+}
+
+/// A file name cut before its first dot (a leading dot is part of the name).
+fn split_at_first_dot(file_name: &str) -> (&str, &str) {
+    match file_name.char_indices().skip(1).find(|&(_, c)| c == '.') {
+        Some((index, _)) => file_name.split_at(index),
+        None => (file_name, ""),
+    }
+}
+
+/// The manifests of a set named `set_name` in `folder`: `NAME.variations.csv` and `.json`.
+pub fn manifest_paths(folder: &Path, set_name: &str) -> [std::path::PathBuf; 2] {
+    ["csv", "json"].map(|extension| folder.join(format!("{set_name}.variations.{extension}")))
 }
 
 /// `count` takes drawn from `master_seed`: take k's seed, then each of `ranges` in order,
@@ -509,7 +551,9 @@ mod tests {
 
     #[test]
     fn a_row_written_reads_back_as_the_same_take() {
-        let ranges = spec("ramp_s = [0.2, 0.9]\nviscosity_c = [0.1, 0.6]\n").unwrap().ranges;
+        let ranges = spec("ramp_s = [0.2, 0.9]\nviscosity_c = [0.1, 0.6]\n")
+            .unwrap()
+            .ranges;
         let takes = draw_takes(&ranges, 12, 99);
         let csv = manifest_csv("pour", &takes);
         let json = manifest_json("pour", None, 99, &ranges, &takes);
