@@ -658,6 +658,7 @@ fn render_job(
     let Some(count) = count else {
         let rendered = render_one(
             job.name.clone(),
+            &job.name,
             scene,
             &job.outputs,
             args,
@@ -693,6 +694,7 @@ fn render_job(
         let share = |fraction: f64| (index as f64 + fraction) / count as f64;
         rendered.push(render_one(
             name,
+            &job.name,
             take_scene,
             &outputs,
             args,
@@ -768,8 +770,10 @@ fn write_manifests(
 }
 
 /// Renders one scene (a take's, or the job's own) to `outputs`, trimmed if asked.
+#[allow(clippy::too_many_arguments)]
 fn render_one(
     name: String,
+    clip_name: &str,
     scene: Scene,
     outputs: &[Output],
     args: &RenderArgs,
@@ -786,7 +790,9 @@ fn render_one(
         progress,
         stop,
     };
-    let report = render_to_files(&scene, &name, outputs, options, observer)?;
+    // A clip's metadata names the scene, so that a take rendered again from its row (under
+    // any file name) is the set's take byte for byte.
+    let report = render_to_files(&scene, clip_name, outputs, options, observer)?;
     let outside = scene
         .inputs
         .iter()
@@ -794,7 +800,7 @@ fn render_one(
         .map(|input| input.path.clone())
         .collect();
     let fidelity = if args.fidelity {
-        Some(fidelity::measure(&scene, &name, options)?)
+        Some(fidelity::measure(&scene, clip_name, options)?)
     } else {
         None
     };
