@@ -431,7 +431,7 @@ fn render_variations<'py>(
     trim: Option<&Bound<'py, PyAny>>,
     actuator: Option<&Bound<'py, PyAny>>,
     felt: bool,
-) -> PyResult<Vec<(Bound<'py, PyDict>, Bound<'py, PyArray1<f32>>)>> {
+) -> PyResult<TakeRows<'py>> {
     let source = SceneSource::of(scene)?;
     let actuator = actuator_profile(actuator, felt)?;
     let trim_db = trim_of(trim)?;
@@ -618,6 +618,9 @@ fn render_tables<'py>(
         columns(py, StateRow::COLUMNS, &tables.states)?,
     ))
 }
+
+/// A set's takes: each one's row of the manifest and its samples.
+type TakeRows<'py> = Vec<(Bound<'py, PyDict>, Bound<'py, PyArray1<f32>>)>;
 
 /// (samples, units, state), as `__init__.py` makes its `Tables` of them.
 type TablesTuple<'py> = (

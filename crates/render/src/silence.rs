@@ -82,7 +82,8 @@ fn reason(scene: &Scene, summary: &RenderSummary) -> Option<String> {
 
 /// Tilts from `low` to `high` (°) in steps of [`TILT_STEP_DEG`], both ends included.
 fn tilt_grid(low: f64, high: f64) -> Vec<f64> {
-    if !(low <= high) {
+    // NaN or an empty range (no tilt reached) gives no tilt.
+    if low.partial_cmp(&high).is_none_or(|order| order.is_gt()) {
         return Vec::new();
     }
     let steps = ((high - low) / TILT_STEP_DEG).floor() as usize;
