@@ -16,7 +16,13 @@ use sake_glug_io::text::{printable, quoted};
 use sake_glug_model_file::ModelFile;
 use sake_glug_render::clips::HapticBand;
 use sake_glug_render::fidelity::{self, fidelity_table, Fidelity};
+use sake_glug_render::silence::why_silent;
 use sake_glug_render::sinks::{AudioChannels, DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
+use sake_glug_render::trim::{check_trim_db, trimmed, DEFAULT_TRIM_DB, TRIM_FADE_S};
+use sake_glug_render::variations::{
+    draw_takes, manifest_csv, manifest_json, manifest_paths, read_take, set_name_of, take_path,
+    Take, VariationError, MAX_TAKES,
+};
 use sake_glug_render::{
     human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions,
     PlatformOptions, RenderError, RenderObserver, RenderReport, SampleFormat, Scene, SceneError,
@@ -124,6 +130,29 @@ pub struct RenderArgs {
     /// to stderr.
     #[arg(long)]
     fidelity: bool,
+    /// Overrides the scene's seed of its random draws (MODEL.md §7); with --variations, the
+    /// set's master seed, from which each take draws its own.
+    #[arg(long, value_name = "N")]
+    seed: Option<u64>,
+    #[arg(long, value_name = "N", value_parser = take_count, help = format!(
+        "Renders a set of N takes of each scene (1 to {MAX_TAKES}; default: its [variations] \
+         table's count), each with its own seed and values drawn from the ranges of the table \
+         (MODEL.md §10.2): every file is NAME_01 … NAME_NN, and NAME.variations.csv and .json \
+         list what each take drew"
+    ))]
+    variations: Option<u32>,
+    /// Renders one take of a set again, bit for bit, from its row in the set's manifest:
+    /// NAME.variations.csv:7 (or .json:7) for take 7, applied to the scene given
+    #[arg(long, value_name = "MANIFEST:N", value_parser = take_reference, conflicts_with = "variations")]
+    take_from: Option<(PathBuf, u32)>,
+    #[arg(long, value_name = "DB", num_args = 0..=1, allow_negative_numbers = true,
+        value_parser = trim_level, help = format!(
+        "Ends each file once its last glug has decayed below DB re the file's peak (default \
+         {DEFAULT_TRIM_DB}; write --trim=-40 before a scene file), with a {} ms fade after that \
+         point (MODEL.md §10.2)",
+        TRIM_FADE_S * 1000.0
+    ))]
+    trim: Option<Option<f64>>,
     /// The old name of --sample-format, which sat beside --formats: refused, naming the new one.
     #[arg(long = "format", hide = true, num_args = 0..=1, default_missing_value = "")]
     renamed_format: Option<String>,
@@ -143,6 +172,18 @@ enum JobError {
     Scene(#[from] SceneError),
     #[error(transparent)]
     Output(#[from] OutputError),
+    #[error("--take-from: {0}")]
+    Take(VariationError),
+    #[error(transparent)]
+    Variation(#[from] VariationError),
+    #[error(transparent)]
+    Write(#[from] sake_glug_io::WriteError),
+}
+
+impl From<RenderError> for JobError {
+    fn from(error: RenderError) -> Self {
+        Self::Output(OutputError::Render(error))
+    }
 }
 
 /// Runs the command: every scene is rendered, a bad one is reported and skipped; the exit
@@ -203,29 +244,51 @@ pub fn run(args: RenderArgs) -> ExitCode {
             actuator: actuator.as_ref(),
         };
         match render_job(job, &args, inputs, &options, &stop, progress) {
-            Ok(Rendered {
-                report,
-                outside,
-                fidelity,
-            }) => {
-                for leftover in &report.leftovers {
-                    out.error(&format!(
-                        "warning: {} looks left by an interrupted render; remove it unless a \
-                         render is writing it",
-                        leftover.display()
-                    ));
-                }
-                match fidelity {
-                    Some(rows) => {
-                        out.error(&summary(job, &report, &outside));
-                        let heading = if jobs.len() > 1 {
-                            format!("{}:\n\n", job.name)
-                        } else {
-                            String::new()
-                        };
-                        out.summary(&(heading + fidelity_table(&rows).trim_end()));
+            Ok(JobDone { takes, manifests }) => {
+                let several = jobs.len() > 1 || takes.len() > 1;
+                for Rendered {
+                    name,
+                    report,
+                    outside,
+                    fidelity,
+                    silent,
+                } in takes
+                {
+                    for leftover in &report.leftovers {
+                        out.error(&format!(
+                            "warning: {} looks left by an interrupted render; remove it unless \
+                             a render is writing it",
+                            leftover.display()
+                        ));
                     }
-                    None => out.summary(&summary(job, &report, &outside)),
+                    if let Some(reason) = silent {
+                        out.error(&format!("warning: {name}: {reason}"));
+                    }
+                    match fidelity {
+                        Some(rows) => {
+                            out.error(&summary(&name, &report, &outside));
+                            let heading = if several {
+                                format!("{name}:\n\n")
+                            } else {
+                                String::new()
+                            };
+                            out.summary(&(heading + fidelity_table(&rows).trim_end()));
+                        }
+                        None => out.summary(&summary(&name, &report, &outside)),
+                    }
+                }
+                if !manifests.is_empty() {
+                    let files: Vec<String> = manifests
+                        .iter()
+                        .map(|(path, bytes)| {
+                            format!("{} ({})", path.display(), human_bytes(*bytes))
+                        })
+                        .collect();
+                    out.summary(&format!(
+                        "{}: the set's manifest → {}",
+                        job.name,
+                        files.join(", ")
+                    ));
                 }
             }
             Err(JobError::Output(OutputError::Render(RenderError::Interrupted))) => {
@@ -483,17 +546,63 @@ fn rumble_rate(text: &str) -> Result<f64, String> {
     }
 }
 
+/// `--variations`' value parser: a count of takes from 1 to [`MAX_TAKES`].
+fn take_count(text: &str) -> Result<u32, String> {
+    match text.trim().parse::<u32>() {
+        Ok(count) if (1..=MAX_TAKES).contains(&count) => Ok(count),
+        _ => Err(format!(
+            "`{text}` is not a number of takes from 1 to {MAX_TAKES}"
+        )),
+    }
+}
+
+/// `--take-from`'s value parser: `MANIFEST:N`, a take's number after the last colon.
+fn take_reference(text: &str) -> Result<(PathBuf, u32), String> {
+    let bad =
+        || format!("`{text}`: give the manifest and the take's number, as pour.variations.csv:7");
+    let (path, number) = text.rsplit_once(':').ok_or_else(bad)?;
+    let number = number
+        .trim()
+        .parse::<u32>()
+        .ok()
+        .filter(|&n| n >= 1)
+        .ok_or_else(bad)?;
+    if path.is_empty() {
+        return Err(bad());
+    }
+    Ok((PathBuf::from(path), number))
+}
+
+/// `--trim`'s value parser: a level in dB below 0.
+fn trim_level(text: &str) -> Result<f64, String> {
+    let level: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a level in dB, such as -60"))?;
+    check_trim_db(level).map_err(|error| error.to_string())
+}
+
 /// `-o`'s value parser: `NAME:FILE` or a file its extension names.
 fn output(argument: &str) -> Result<Output, String> {
     Output::parse(argument).map_err(|error| error.to_string())
 }
 
-/// What a job did: its report, the files it read from outside its scene's folder, and, with
-/// --fidelity, what every format keeps.
+/// What one file set of a job did (a scene's, or one take's of a set): its name, its report,
+/// the files it read from outside its scene's folder, with --fidelity what every format keeps,
+/// and why it is silent, if it is.
 struct Rendered {
+    name: String,
     report: RenderReport,
     outside: Vec<PathBuf>,
     fidelity: Option<Vec<Fidelity>>,
+    silent: Option<String>,
+}
+
+/// What a job did: one file set, or a set of takes with its manifests.
+struct JobDone {
+    takes: Vec<Rendered>,
+    /// The set's manifests with their sizes; none for a single render.
+    manifests: Vec<(PathBuf, u64)>,
 }
 
 /// A built-in scene (the default pour or a preset's), on `model`'s bottle if one is given.
@@ -517,8 +626,8 @@ fn render_job(
     JobInputs { model, actuator }: JobInputs,
     options: &OutputOptions,
     stop: &Stop,
-    progress: impl FnMut(f64),
-) -> Result<Rendered, JobError> {
+    mut progress: impl FnMut(f64),
+) -> Result<JobDone, JobError> {
     let preset = args.preset.as_deref().and_then(Preset::find);
     let mut scene = match (&job.scene, preset, model) {
         (Some(path), _, None) => Scene::load(path)?,
@@ -533,12 +642,157 @@ fn render_job(
         scene = scene.with_sample_rate(sample_rate)?;
     }
     scene.actuator = actuator.map(ActuatorProfile::response);
+    if let Some(seed) = args.seed {
+        scene.config.seed = seed;
+    }
+    if let Some((manifest, number)) = &args.take_from {
+        let take = read_take(manifest, *number).map_err(JobError::Take)?;
+        scene = take.apply(scene).map_err(JobError::Take)?;
+    }
+    let count = args.variations.or_else(|| {
+        args.take_from
+            .is_none()
+            .then_some(())
+            .and(scene.variations.as_ref()?.count)
+    });
+    let Some(count) = count else {
+        let rendered = render_one(
+            job.name.clone(),
+            &job.name,
+            scene,
+            &job.outputs,
+            args,
+            options,
+            stop,
+            progress,
+        )?;
+        return Ok(JobDone {
+            takes: vec![rendered],
+            manifests: Vec::new(),
+        });
+    };
+    // Every take is drawn and checked before the first is rendered.
+    let ranges = scene
+        .variations
+        .as_ref()
+        .map_or(Vec::new(), |spec| spec.ranges.clone());
+    let master_seed = scene.config.seed;
+    let takes = draw_takes(&ranges, count, master_seed);
+    let set_name = job
+        .outputs
+        .first()
+        .filter(|_| args.out_dir.is_none())
+        .map_or(job.name.clone(), |output| set_name_of(&output.path));
+    let scenes = takes
+        .iter()
+        .map(|take| take.apply(scene.clone()))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut rendered = Vec::with_capacity(takes.len());
+    for (index, (take, take_scene)) in takes.iter().zip(scenes).enumerate() {
+        let name = take.name(&set_name, count);
+        let outputs = take_outputs(&job.outputs, &name);
+        let share = |fraction: f64| (index as f64 + fraction) / count as f64;
+        rendered.push(render_one(
+            name,
+            &job.name,
+            take_scene,
+            &outputs,
+            args,
+            options,
+            stop,
+            |fraction| progress(share(fraction)),
+        )?);
+    }
+    let folder = match (&args.out_dir, job.outputs.first()) {
+        (Some(directory), _) => directory.clone(),
+        (None, Some(output)) => output
+            .path
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default(),
+        (None, None) => PathBuf::new(),
+    };
+    let manifests = write_manifests(
+        &folder,
+        &set_name,
+        job.scene.as_deref(),
+        master_seed,
+        &ranges,
+        &takes,
+    )?;
+    Ok(JobDone {
+        takes: rendered,
+        manifests,
+    })
+}
+
+/// The files of take `name`: each of the job's, named for the take.
+fn take_outputs(outputs: &[Output], name: &str) -> Vec<Output> {
+    outputs
+        .iter()
+        .map(|output| Output {
+            format: output.format,
+            path: take_path(&output.path, name),
+        })
+        .collect()
+}
+
+/// Writes a set's manifests (CSV and JSON) together, all or nothing.
+fn write_manifests(
+    folder: &Path,
+    set_name: &str,
+    scene_file: Option<&Path>,
+    master_seed: u64,
+    ranges: &[(sake_glug_render::variations::Varied, [f64; 2])],
+    takes: &[Take],
+) -> Result<Vec<(PathBuf, u64)>, JobError> {
+    let [csv_path, json_path] = manifest_paths(folder, set_name);
+    let texts = [
+        (csv_path, manifest_csv(set_name, takes)),
+        (
+            json_path,
+            manifest_json(set_name, scene_file, master_seed, ranges, takes),
+        ),
+    ];
+    let mut files = Vec::new();
+    for (path, text) in texts {
+        let file = sake_glug_io::PendingFile::beside(&path, ".tmp")
+            .map_err(sake_glug_io::WriteError::at(&path))?;
+        let mut writer = file.writer().map_err(sake_glug_io::WriteError::at(&path))?;
+        writer
+            .write_all(text.as_bytes())
+            .and_then(|()| writer.flush())
+            .map_err(sake_glug_io::WriteError::at(&path))?;
+        drop(writer);
+        files.push(file);
+    }
+    Ok(sake_glug_io::PendingFile::commit_all(files)?)
+}
+
+/// Renders one scene (a take's, or the job's own) to `outputs`, trimmed if asked.
+#[allow(clippy::too_many_arguments)]
+fn render_one(
+    name: String,
+    clip_name: &str,
+    scene: Scene,
+    outputs: &[Output],
+    args: &RenderArgs,
+    options: &OutputOptions,
+    stop: &Stop,
+    progress: impl FnMut(f64),
+) -> Result<Rendered, JobError> {
+    let scene = match args.trim {
+        Some(level) => trimmed(scene, level.unwrap_or(DEFAULT_TRIM_DB))?,
+        None => scene,
+    };
     let observer = JobObserver {
         total: scene.duration_samples(),
         progress,
         stop,
     };
-    let report = render_to_files(&scene, &job.name, &job.outputs, options, observer)?;
+    // A clip's metadata names the scene, so that a take rendered again from its row (under
+    // any file name) is the set's take byte for byte.
+    let report = render_to_files(&scene, clip_name, outputs, options, observer)?;
     let outside = scene
         .inputs
         .iter()
@@ -546,14 +800,17 @@ fn render_job(
         .map(|input| input.path.clone())
         .collect();
     let fidelity = if args.fidelity {
-        Some(fidelity::measure(&scene, &job.name, options)?)
+        Some(fidelity::measure(&scene, clip_name, options)?)
     } else {
         None
     };
+    let silent = why_silent(&scene, &report.summary);
     Ok(Rendered {
+        name,
         report,
         outside,
         fidelity,
+        silent,
     })
 }
 
@@ -581,7 +838,7 @@ impl<P: FnMut(f64)> RenderObserver for JobObserver<'_, P> {
 /// The line printed for a finished scene.
 /// The line a finished scene prints; files the scene read from outside its own folder are named
 /// at its end, so a scene from elsewhere cannot read one unseen.
-fn summary(job: &Job, report: &RenderReport, outside: &[PathBuf]) -> String {
+fn summary(name: &str, report: &RenderReport, outside: &[PathBuf]) -> String {
     let summary = &report.summary;
     let files: Vec<String> = report
         .files
@@ -590,7 +847,7 @@ fn summary(job: &Job, report: &RenderReport, outside: &[PathBuf]) -> String {
         .collect();
     format!(
         "{}: {:.2} s at {} Hz, {} glug units, peak {:.1} dBFS, {:.0}× faster than real time → {}",
-        job.name,
+        name,
         summary.duration_s(),
         summary.sample_rate,
         summary.units,

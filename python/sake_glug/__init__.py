@@ -9,6 +9,9 @@ The offline renderer of the ``sake-glug`` command line, for Python::
   ``float32`` array, bit for bit the samples ``sake-glug render`` writes to an f32 WAV, and
   with ``actuator=`` (a shipped profile's name or a profile file) compensated for a device as
   ``--actuator`` does;
+- :func:`render_variations` renders a set of takes of a scene, each drawing its seed and the
+  values its ``[variations]`` table gives ranges for (``sake-glug render --variations``), with
+  each take's row, which ``render(scene, take=row)`` renders again bit for bit;
 - :func:`render_tables` renders the same samples with the glug data: one row per unit and the
   bottle's state at a fixed rate, the tables of ``sake-glug render --units/--state``;
 - :func:`fit` fits a model to a session's recordings (``sake-glug fit``), and
@@ -37,6 +40,7 @@ from ._sake_glug import (
     analyze_paired,
     fit,
     render,
+    render_variations,
 )
 from ._sake_glug import presets as _presets
 from ._sake_glug import render_tables as _render_tables
@@ -53,6 +57,7 @@ __all__ = [
     "presets",
     "render",
     "render_tables",
+    "render_variations",
 ]
 
 

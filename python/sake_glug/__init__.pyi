@@ -1,5 +1,5 @@
 import os
-from typing import Any, Callable, Dict, List, Mapping, NamedTuple, Optional, Union
+from typing import Any, Callable, Dict, List, Mapping, NamedTuple, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -16,6 +16,7 @@ __all__ = [
     "presets",
     "render",
     "render_tables",
+    "render_variations",
 ]
 
 _Scene = Union[str, "os.PathLike[str]", Mapping[str, Any], None]
@@ -43,6 +44,9 @@ def render(
     progress: Optional[Callable[[int, Optional[int]], object]] = None,
     actuator: _Actuator = None,
     felt: bool = False,
+    seed: Optional[int] = None,
+    take: Optional[Mapping[str, Union[int, float, str]]] = None,
+    trim: Union[bool, float, None] = None,
 ) -> npt.NDArray[np.float32]:
     """Renders a scene and returns its samples (mono, float32), bit for bit those of
     `sake-glug render` of the same scene.
@@ -59,11 +63,34 @@ def render(
     profile's name (flat, haptuator-mark2, lra, phone, dualsense, vr-controller; a str names a
     shipped one first) or a profile file's path; felt (with actuator) equalises over the
     skin's threshold instead, as --felt does. A refused profile raises SakeGlugError naming
-    the file and the key.
+    the file and the key. seed overrides the scene's seed (--seed); take renders one take of a
+    set again, bit for bit, from its row of the set's manifest (a row of render_variations(),
+    or of NAME.variations.json), as --take-from does; trim ends the samples once the last glug
+    has decayed below a level re their peak, with a 10 ms fade (--trim): True for -60 dB, or a
+    level in dB below 0. A render in which nothing sounds warns (UserWarning) with the command
+    line's reason.
 
     The samples are held in memory: a render that cannot fit (a day at 48 kHz is 16.6 GB) is
     refused before it starts, or, without duration_s, as soon as it outgrows the memory
     available, with the figure. Ctrl-C stops it. Raises SakeGlugError for what it refuses."""
+
+def render_variations(
+    scene: _Scene = None,
+    *,
+    count: Optional[int] = None,
+    seed: Optional[int] = None,
+    sample_rate: Optional[float] = None,
+    preset: Optional[str] = None,
+    trim: Union[bool, float, None] = None,
+    actuator: _Actuator = None,
+    felt: bool = False,
+) -> List[Tuple[Dict[str, Union[int, float]], npt.NDArray[np.float32]]]:
+    """Renders a set of takes of a scene, as `sake-glug render --variations COUNT` does, and
+    returns [(row, samples)] in take order: row is the take's row of the set's manifest
+    ({"take": k, "seed": ..., and each drawn value by its key}), samples those of the command
+    line's take k, bit for bit; render(scene, take=row) renders it again. count defaults to the
+    scene's [variations] count; seed is the master seed (default: the scene's seed); the
+    other arguments are render()'s, for every take."""
 
 def presets() -> List[Preset]:
     """Every preset, in the order of the plugin's menu."""
@@ -83,10 +110,13 @@ def render_tables(
     state_rate: float = 1000.0,
     actuator: _Actuator = None,
     felt: bool = False,
+    seed: Optional[int] = None,
+    take: Optional[Mapping[str, Union[int, float, str]]] = None,
+    trim: Union[bool, float, None] = None,
 ) -> Tables:
     """Renders a scene as render() does and returns its samples with its units and state
     tables (a float64 array per column, named as the columns of `sake-glug render --units` and
-    `--state`); actuator and felt as render()'s. The scene renders twice: once keeping nothing, to count the tables' rows and
+    `--state`); actuator, felt, seed, take and trim as render()'s. The scene renders twice: once keeping nothing, to count the tables' rows and
     refuse them with the figure if they cannot fit in memory, then into the tables. Ctrl-C
     stops it. Raises SakeGlugError for what it refuses."""
 

@@ -25,6 +25,11 @@ use sake_glug_analysis::{
 };
 use sake_glug_engine::{Preset, UnitOnset, Voicing, PRESETS};
 use sake_glug_fit::{fit_json, fit_session, FitSession};
+use sake_glug_render::silence::why_silent;
+use sake_glug_render::trim::{check_trim_db, trimmed, DEFAULT_TRIM_DB};
+use sake_glug_render::variations::{
+    draw_takes, Take, VariationError, Varied, MAX_TAKES, NAME_COLUMN, SEED_COLUMN, TAKE_COLUMN,
+};
 use sake_glug_render::{
     render_scene, render_tables_until, Column, RenderError, RenderObserver, Scene, SceneError,
     StateRate, StateRow, TablesError, UnitRow, MAX_SCENE_BYTES,
@@ -162,6 +167,123 @@ fn actuator_profile(
     Ok(Some(profile.felt_if(felt)))
 }
 
+/// What `render` and `render_tables` change in a scene once it is read, in the command line's
+/// order: `seed=` (--seed), `take=` (--take-from, a manifest's row as a dict), `trim=` (--trim).
+struct Shaping {
+    seed: Option<u64>,
+    take: Option<Take>,
+    trim_db: Option<f64>,
+}
+
+impl Shaping {
+    fn of(
+        seed: Option<u64>,
+        take: Option<&Bound<'_, PyAny>>,
+        trim: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        Ok(Self {
+            seed,
+            take: take_of(take)?,
+            trim_db: trim_of(trim)?,
+        })
+    }
+
+    fn apply(&self, mut scene: Scene) -> Result<Scene, Refused> {
+        if let Some(seed) = self.seed {
+            scene.config.seed = seed;
+        }
+        if let Some(take) = &self.take {
+            scene = take
+                .apply(scene)
+                .map_err(|error| Refused::Message(format!("take: {error}")))?;
+        }
+        trim_scene(scene, self.trim_db)
+    }
+}
+
+/// `scene` trimmed at `trim_db`, if given.
+fn trim_scene(scene: Scene, trim_db: Option<f64>) -> Result<Scene, Refused> {
+    Ok(match trim_db {
+        Some(level) => trimmed(scene, level)?,
+        None => scene,
+    })
+}
+
+/// `trim=`: None or False for no trim, True for --trim's default level, or a level in dB
+/// below 0, as --trim takes it.
+fn trim_of(trim: Option<&Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
+    let Some(trim) = trim.filter(|trim| !trim.is_none()) else {
+        return Ok(None);
+    };
+    // A bool is an int to Python: it is read first.
+    if let Ok(on) = trim.cast::<pyo3::types::PyBool>() {
+        return Ok(on.is_true().then_some(DEFAULT_TRIM_DB));
+    }
+    let level: f64 = trim.extract().map_err(|_| {
+        PyTypeError::new_err("trim must be None, a bool or a level in dB (a float below 0)")
+    })?;
+    check_trim_db(level)
+        .map(Some)
+        .map_err(|error| SakeGlugError::new_err(format!("trim: {error}")))
+}
+
+/// `take=`: a row of a set's manifest as a dict (a row of `render_variations`, or of
+/// NAME.variations.json), read as --take-from reads one.
+fn take_of(take: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Take>> {
+    let Some(take) = take.filter(|take| !take.is_none()) else {
+        return Ok(None);
+    };
+    let row = take.cast::<PyDict>().map_err(|_| {
+        PyTypeError::new_err("take must be a dict (a row of a set's manifest) or None")
+    })?;
+    let mut number = 1;
+    let mut fields = Vec::new();
+    for (key, value) in row.iter() {
+        let key: String = key
+            .extract()
+            .map_err(|_| PyTypeError::new_err("take: its keys are str"))?;
+        let text = match key.as_str() {
+            NAME_COLUMN => continue,
+            TAKE_COLUMN => {
+                number = value.extract::<u32>().map_err(|_| {
+                    SakeGlugError::new_err("take: `take` is the take's number, an int from 1")
+                })?;
+                continue;
+            }
+            SEED_COLUMN => value
+                .extract::<u64>()
+                .map_err(|_| {
+                    SakeGlugError::new_err(format!(
+                        "take: `seed` is a whole number from 0 to {}",
+                        u64::MAX
+                    ))
+                })?
+                .to_string(),
+            _ => value
+                .extract::<f64>()
+                .map_err(|_| {
+                    SakeGlugError::new_err(format!("take: `{}` is no number", shown(&key)))
+                })?
+                .to_string(),
+        };
+        fields.push((key, text));
+    }
+    Take::from_fields(
+        number,
+        fields
+            .iter()
+            .map(|(key, text)| (key.as_str(), text.as_str())),
+    )
+    .map(Some)
+    .map_err(|error| SakeGlugError::new_err(format!("take: {error}")))
+}
+
+/// Warns that a render is silent, with the command line's reason.
+fn warn_silent(py: Python<'_>, reason: &str) -> PyResult<()> {
+    let message = std::ffi::CString::new(reason.replace('\0', " ")).expect("no NUL is left");
+    PyErr::warn(py, &py.get_type::<PyUserWarning>(), &message, 1)
+}
+
 /// A scene and a preset given together (`sake-glug render` refuses `--preset` with a scene).
 const NOT_BOTH: &str =
     "give a scene or a preset, not both: a preset is the default pour with its liquid and bottle";
@@ -175,6 +297,8 @@ enum Refused {
     Render(#[from] RenderError),
     #[error(transparent)]
     Tables(#[from] TablesError),
+    #[error(transparent)]
+    Variation(#[from] VariationError),
     #[error("{0}")]
     Message(String),
     /// Python raised an exception while the render ran (KeyboardInterrupt, or the progress
@@ -211,7 +335,7 @@ impl Refused {
 ///     most 32 deep, values bool, int, float, str, list or tuple), or None for the built-in
 ///     pour. MODEL.md §10 lists the keys. An empty scene ({}, or text of comments alone) is
 ///     every key's default, an upright bottle that never pours: 0 samples, as
-///     `sake-glug render` renders an empty scene file (with a UserWarning here); None is the
+///     `sake-glug render` renders an empty scene file (with a UserWarning); None is the
 ///     built-in pour, 90° to 135° in 0.5 s.
 /// sample_rate: overrides the scene's sample rate (Hz), as --sample-rate does.
 /// preset: renders a preset (see presets()) instead of a scene, as --preset does.
@@ -223,6 +347,14 @@ impl Refused {
 ///     or a profile file's path (str or os.PathLike); a str names a shipped profile first.
 /// felt: with actuator, equalises over the skin's threshold instead of the acceleration, as
 ///     --felt does.
+/// seed: overrides the scene's seed, as --seed does.
+/// take: renders one take of a set again, bit for bit, as --take-from does: its row of the
+///     set's manifest as a dict (a row of render_variations(), or of NAME.variations.json).
+/// trim: ends the samples once the last glug has decayed below a level re their peak, with a
+///     10 ms fade, as --trim does: True for -60 dB, or a level in dB below 0.
+///
+/// A render in which nothing sounds warns (UserWarning) with the command line's reason (the
+/// bottle never tilts past where it pours, the bottle is empty, …).
 ///
 /// The sample rate of the result is the scene's (or sample_rate if given). The GIL is
 /// released while rendering; Ctrl-C stops it. The samples are held in memory: a render
@@ -232,8 +364,10 @@ impl Refused {
 /// refuses.
 #[pyfunction]
 #[pyo3(signature = (
-    scene=None, *, sample_rate=None, preset=None, progress=None, actuator=None, felt=false
+    scene=None, *, sample_rate=None, preset=None, progress=None, actuator=None, felt=false,
+    seed=None, take=None, trim=None
 ))]
+#[allow(clippy::too_many_arguments)]
 fn render<'py>(
     py: Python<'py>,
     scene: Option<&Bound<'py, PyAny>>,
@@ -242,12 +376,16 @@ fn render<'py>(
     progress: Option<&Bound<'py, PyAny>>,
     actuator: Option<&Bound<'py, PyAny>>,
     felt: bool,
+    seed: Option<u64>,
+    take: Option<&Bound<'py, PyAny>>,
+    trim: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray1<f32>>> {
     let source = SceneSource::of(scene)?;
     let progress = callback("progress", progress)?;
     let actuator = actuator_profile(actuator, felt)?;
+    let shaping = Shaping::of(seed, take, trim)?;
     let rendered = py.detach(|| {
-        let scene = source.load(preset, sample_rate, actuator.as_ref())?;
+        let scene = shaping.apply(source.load(preset, sample_rate, actuator.as_ref())?)?;
         let total = scene.duration_samples();
         let mut samples = match total {
             Some(total) => Samples::with_room(total, scene.sample_rate),
@@ -257,21 +395,103 @@ fn render<'py>(
         let mut ticks = Ticks::new(progress, total);
         let sink = |block: &[f32]| samples.push(block).map_err(Refused::Message);
         match render_scene(&scene, sink, &mut ticks) {
-            Ok(_) => Ok(samples.into_vec()),
+            Ok(summary) => Ok((samples.into_vec(), why_silent(&scene, &summary))),
             Err(refused) => Err(refused.stopped_by(ticks)),
         }
     });
-    let samples = rendered.map_err(Refused::into_py)?;
-    if samples.is_empty() {
-        PyErr::warn(
-            py,
-            &py.get_type::<PyUserWarning>(),
-            c"the scene renders no samples: its bottle never pours (an empty scene is an \
-              upright bottle, as in `sake-glug render`); render(None) is the built-in pour",
-            1,
-        )?;
+    let (samples, silent) = rendered.map_err(Refused::into_py)?;
+    if let Some(reason) = silent {
+        warn_silent(py, &reason)?;
     }
     Ok(PyArray1::from_vec(py, samples))
+}
+
+/// Renders a set of takes of a scene, as `sake-glug render --variations COUNT` does, and returns
+/// [(row, samples)] in the order of the takes: row is the take's row of the set's manifest
+/// ({"take": k, "seed": …, and each value drawn, by its key}), samples those of
+/// `sake-glug render` of take k, bit for bit; render(scene, take=row) renders it again.
+///
+/// count: takes in the set (1 to 9999); default: the count of the scene's [variations]
+///     table, which gives the ranges drawn from (MODEL.md §10.2).
+/// seed: the master seed (default: the scene's seed), as --seed with --variations.
+/// trim, sample_rate, preset, actuator, felt: as render()'s, for every take.
+#[pyfunction]
+#[pyo3(signature = (
+    scene=None, *, count=None, seed=None, sample_rate=None, preset=None, trim=None,
+    actuator=None, felt=false
+))]
+#[allow(clippy::too_many_arguments)]
+fn render_variations<'py>(
+    py: Python<'py>,
+    scene: Option<&Bound<'py, PyAny>>,
+    count: Option<u32>,
+    seed: Option<u64>,
+    sample_rate: Option<f64>,
+    preset: Option<&str>,
+    trim: Option<&Bound<'py, PyAny>>,
+    actuator: Option<&Bound<'py, PyAny>>,
+    felt: bool,
+) -> PyResult<TakeRows<'py>> {
+    let source = SceneSource::of(scene)?;
+    let actuator = actuator_profile(actuator, felt)?;
+    let trim_db = trim_of(trim)?;
+    if let Some(count) = count.filter(|count| !(1..=MAX_TAKES).contains(count)) {
+        return Err(SakeGlugError::new_err(format!(
+            "count = {count}: a set has 1 to {MAX_TAKES} takes"
+        )));
+    }
+    let rendered = py.detach(|| {
+        let mut scene = source.load(preset, sample_rate, actuator.as_ref())?;
+        if let Some(seed) = seed {
+            scene.config.seed = seed;
+        }
+        let spec = scene.variations.clone();
+        let count = count.or_else(|| spec.as_ref()?.count).ok_or_else(|| {
+            Refused::Message(
+                "how many takes? give count=, or a count in the scene's [variations] table".into(),
+            )
+        })?;
+        let ranges = spec.map_or(Vec::new(), |spec| spec.ranges);
+        let takes = draw_takes(&ranges, count, scene.config.seed);
+        let scenes = takes
+            .iter()
+            .map(|take| take.apply(scene.clone()))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut rendered = Vec::with_capacity(takes.len());
+        for (take, take_scene) in takes.into_iter().zip(scenes) {
+            let take_scene = trim_scene(take_scene, trim_db)?;
+            let total = take_scene.duration_samples();
+            let mut samples = match total {
+                Some(total) => Samples::with_room(total, take_scene.sample_rate),
+                None => Ok(Samples::growing(take_scene.sample_rate)),
+            }
+            .map_err(Refused::Message)?;
+            let mut ticks = Ticks::new(None, total);
+            let sink = |block: &[f32]| samples.push(block).map_err(Refused::Message);
+            let summary = match render_scene(&take_scene, sink, &mut ticks) {
+                Ok(summary) => summary,
+                Err(refused) => return Err(refused.stopped_by(ticks)),
+            };
+            let silent = why_silent(&take_scene, &summary);
+            rendered.push((take, samples.into_vec(), silent));
+        }
+        Ok(rendered)
+    });
+    let rendered = rendered.map_err(Refused::into_py)?;
+    let mut set = Vec::with_capacity(rendered.len());
+    for (take, samples, silent) in rendered {
+        if let Some(reason) = silent {
+            warn_silent(py, &format!("take {}: {reason}", take.number))?;
+        }
+        let row = PyDict::new(py);
+        row.set_item(TAKE_COLUMN, take.number)?;
+        row.set_item(SEED_COLUMN, take.seed)?;
+        for (varied, value) in &take.values {
+            row.set_item(Varied::key(*varied), value)?;
+        }
+        set.push((row, PyArray1::from_vec(py, samples)));
+    }
+    Ok(set)
 }
 
 /// `value` if it is None or callable, for `name`.
@@ -314,13 +534,16 @@ impl RenderObserver for CountingUnits {
 ///
 /// state_rate: rows a second of the state table (Hz, above 0 and at most the sample rate).
 /// actuator, felt: as render()'s; the tables are then those `sake-glug render --actuator` writes.
+/// seed, take, trim: as render()'s.
 ///
 /// The scene renders twice: once keeping nothing, to count what the tables will hold and
 /// refuse them with the figure if they cannot fit in memory, then into the tables.
 #[pyfunction]
 #[pyo3(signature = (
-    scene=None, *, sample_rate=None, preset=None, state_rate=1000.0, actuator=None, felt=false
+    scene=None, *, sample_rate=None, preset=None, state_rate=1000.0, actuator=None, felt=false,
+    seed=None, take=None, trim=None
 ))]
+#[allow(clippy::too_many_arguments)]
 fn render_tables<'py>(
     py: Python<'py>,
     scene: Option<&Bound<'py, PyAny>>,
@@ -329,13 +552,17 @@ fn render_tables<'py>(
     state_rate: f64,
     actuator: Option<&Bound<'py, PyAny>>,
     felt: bool,
+    seed: Option<u64>,
+    take: Option<&Bound<'py, PyAny>>,
+    trim: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<TablesTuple<'py>> {
     let source = SceneSource::of(scene)?;
     let state_rate = StateRate::new(state_rate)
         .map_err(|error| SakeGlugError::new_err(format!("state_rate: {error}")))?;
     let actuator = actuator_profile(actuator, felt)?;
+    let shaping = Shaping::of(seed, take, trim)?;
     let rendered = py.detach(|| {
-        let scene = source.load(preset, sample_rate, actuator.as_ref())?;
+        let scene = shaping.apply(source.load(preset, sample_rate, actuator.as_ref())?)?;
         // A bound: row k is at sample ⌈k·fs/R⌉, before the end.
         let state_rows =
             |samples: u64| (samples as f64 * state_rate.hz() / scene.sample_rate as f64) as u64 + 2;
@@ -391,6 +618,9 @@ fn render_tables<'py>(
         columns(py, StateRow::COLUMNS, &tables.states)?,
     ))
 }
+
+/// A set's takes: each one's row of the manifest and its samples.
+type TakeRows<'py> = Vec<(Bound<'py, PyDict>, Bound<'py, PyArray1<f32>>)>;
 
 /// (samples, units, state), as `__init__.py` makes its `Tables` of them.
 type TablesTuple<'py> = (
@@ -513,6 +743,7 @@ fn _sake_glug(module: &Bound<'_, PyModule>) -> PyResult<()> {
     PyArray1::<f32>::zeros(module.py(), 0, false);
     module.add_function(wrap_pyfunction!(render, module)?)?;
     module.add_function(wrap_pyfunction!(render_tables, module)?)?;
+    module.add_function(wrap_pyfunction!(render_variations, module)?)?;
     module.add_function(wrap_pyfunction!(fit, module)?)?;
     module.add_function(wrap_pyfunction!(analyze_paired, module)?)?;
     module.add_function(wrap_pyfunction!(analyze_constant, module)?)?;

@@ -25,3 +25,4 @@ mod scene_files;
 mod study;
 mod tables;
 mod takes;
+mod variations;

@@ -53,9 +53,12 @@ impl InputKind {
     /// An actuator profile (64 KiB): a name, a few dozen [Hz, dB] points and their spread, with
     /// the comments that cite them.
     pub const ACTUATOR: Self = Self::new("actuator profile", 64 * 1024);
+    /// A set's manifest of takes (16 MiB): a row of a few hundred bytes per take, at most
+    /// 9,999 takes.
+    pub const VARIATIONS: Self = Self::new("variations manifest", 16 * MIB);
 
     /// Every kind of input, for a test that tries each.
-    pub const ALL: [Self; 10] = [
+    pub const ALL: [Self; 11] = [
         Self::SCENE,
         Self::MODEL,
         Self::MIDI_TAKE,
@@ -66,6 +69,7 @@ impl InputKind {
         Self::STUDY_SPEC,
         Self::STUDY_LOG,
         Self::ACTUATOR,
+        Self::VARIATIONS,
     ];
 
     const fn new(name: &'static str, max_bytes: u64) -> Self {

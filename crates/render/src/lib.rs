@@ -12,9 +12,12 @@ mod outputs;
 mod render;
 mod resample;
 mod scene;
+pub mod silence;
 pub mod sinks;
 pub mod steps;
 mod tables;
+pub mod trim;
+pub mod variations;
 
 pub use automation::Automation;
 pub use memory::{available_bytes, human_bytes};

@@ -165,6 +165,10 @@ pub fn render_scene<E: From<RenderError>>(
         engine.process_observed(&controls, block, &mut |onset, voicing| {
             observer.unit_started(onset, voicing)
         });
+        // The output stage after synthesis: a trimmed render's fade (crate::trim).
+        if let Some(fade) = &scene.fade_out {
+            fade.apply(position, block);
+        }
         observer.progress(engine.position());
         if report_at.is_some() {
             observer.bottle(&BottleReport {

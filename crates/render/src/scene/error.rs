@@ -70,6 +70,9 @@ pub enum SceneError {
         /// What was wrong.
         source: TakeError,
     },
+    /// A `[variations]` table that cannot be drawn from: its message names the key.
+    #[error(transparent)]
+    Variations(#[from] crate::variations::VariationError),
     /// A value that must be a whole number (the sample rate) has a fraction.
     #[error("`{key}` = {value} is not a whole number: {what}")]
     NotWhole {

@@ -15,6 +15,8 @@ mod validate;
 use std::path::Path;
 
 use super::automation::Automation;
+use super::trim::FadeOut;
+use super::variations::VariationSpec;
 use sake_glug_device::midi::MidiMap;
 use sake_glug_engine::{
     sample_time_s, ActuatorResponse, Control, ControlSource, ControlValues, Controls, ModelConfig,
@@ -61,6 +63,12 @@ pub struct Scene {
     /// The actuator the render is compensated for (MODEL.md §18): no scene key, set by the
     /// caller (`--actuator`); `None` plays the model's drive as it is.
     pub actuator: Option<ActuatorResponse>,
+    /// The fade a trimmed render ends with ([`crate::trim`]): no scene key, set by
+    /// [`crate::trim::trimmed`].
+    pub fade_out: Option<FadeOut>,
+    /// The scene's `[variations]` table (MODEL.md §10.2), if it has one: what a set of takes of
+    /// it draws.
+    pub variations: Option<VariationSpec>,
 }
 
 /// A scene file's text, read as a regular file within [`MAX_SCENE_BYTES`], in UTF-8.

@@ -7,6 +7,7 @@ use super::error::syntax;
 use super::lanes::{automation, resolve};
 use super::{InputFile, MidiTake, Scene, SceneError, MAX_DURATION_S};
 use crate::automation::LaneSpec;
+use crate::variations::VariationSpec;
 use sake_glug_device::midi::{MidiMap, MidiSetting};
 use sake_glug_engine::config;
 use sake_glug_engine::{
@@ -22,6 +23,8 @@ const SEED: &str = config::SEED.scene_key;
 const DETERMINISTIC: &str = "deterministic";
 pub(super) const MIDI_TAKE: &str = "midi_take";
 const DRAIN: &str = config::DRAIN.scene_key;
+/// The table of what a set of takes draws (MODEL.md §10.2).
+const VARIATIONS: &str = crate::variations::VARIATIONS_KEY;
 /// The table of the plugin's saved MIDI settings, by their names in the state.
 const MIDI_SECTION: &str = "midi";
 
@@ -144,6 +147,10 @@ impl SceneFile {
             }
         };
         let midi = self.midi_map()?;
+        let variations = match self.take::<toml::Table>(VARIATIONS)? {
+            Some(table) => Some(VariationSpec::from_table(table)?),
+            None => None,
+        };
         self.refuse_unknown()?;
         Ok(Scene {
             sample_rate,
@@ -154,6 +161,8 @@ impl SceneFile {
             midi,
             inputs,
             actuator: None,
+            fade_out: None,
+            variations,
         })
     }
 }

@@ -1,0 +1,566 @@
+//! Sets of takes of one scene (`--variations`, MODEL.md §10.2): each take draws its seed and
+//! every value the scene's `[variations]` table gives a range for, from one master seed; a
+//! manifest (`NAME.variations.csv` and `.json`) lists what each take drew, and one of its rows
+//! ([`Take`]) applied to the scene renders that take again, bit for bit.
+//!
+//! What may vary is a table ([`Varied::ALL`]): the tilt the scene's tilt lane ends at and the
+//! time it gets there, each control but the tilt (a constant through the take), and each model
+//! constant, by the keys and within the ranges of their own tables.
+
+use std::path::Path;
+
+use rand::{RngExt, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+use super::automation::Automation;
+use super::scene::{Scene, MAX_DURATION_S};
+use sake_glug_engine::{config, Constant, Control, Range, ValueError};
+use sake_glug_io::keys;
+use sake_glug_io::read::{self, InputKind, ReadError};
+use sake_glug_io::text::printable;
+
+/// The scene's table of ranges.
+pub const VARIATIONS_KEY: &str = "variations";
+/// The key of the table's number of takes.
+pub const COUNT_KEY: &str = "count";
+/// The most takes a set may have.
+pub const MAX_TAKES: u32 = 9999;
+/// The manifest's columns before the drawn values: the take's number, its name, its seed.
+pub const TAKE_COLUMN: &str = "take";
+/// The column of the take's file name (without extension).
+pub const NAME_COLUMN: &str = "name";
+/// The column of the take's seed.
+pub const SEED_COLUMN: &str = "seed";
+
+/// What a take may draw.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Varied {
+    /// The value the tilt lane ends at: its last point's (a constant tilt is replaced).
+    TiltEnd,
+    /// The time of the tilt lane's last point: every point's time scaled to it.
+    RampTime,
+    /// A control other than the tilt, held at the drawn value through the take.
+    Control(Control),
+    /// A model constant.
+    Constant(Constant),
+}
+
+impl Varied {
+    /// Every varied value, in the order a take draws them and a manifest lists them.
+    pub fn all() -> impl Iterator<Item = Varied> {
+        [Varied::TiltEnd, Varied::RampTime]
+            .into_iter()
+            .chain(
+                Control::ALL
+                    .iter()
+                    .filter(|&&control| control != Control::Tilt)
+                    .map(|&control| Varied::Control(control)),
+            )
+            .chain(
+                Constant::ALL
+                    .iter()
+                    .map(|&constant| Varied::Constant(constant)),
+            )
+    }
+
+    /// Its key in `[variations]` and its column in a manifest: the control's or the constant's
+    /// scene key.
+    pub fn key(self) -> &'static str {
+        match self {
+            Varied::TiltEnd => "tilt_end_deg",
+            Varied::RampTime => "ramp_s",
+            Varied::Control(control) => control.quantity().scene_key,
+            Varied::Constant(constant) => constant.quantity().scene_key,
+        }
+    }
+
+    /// The values it may take.
+    pub fn range(self) -> Range {
+        match self {
+            Varied::TiltEnd => Control::Tilt.range(),
+            Varied::RampTime => Range::new(0.0, MAX_DURATION_S, 0.5),
+            Varied::Control(control) => control.range(),
+            Varied::Constant(constant) => constant.range(),
+        }
+    }
+
+    /// The varied value of `key`, if any.
+    pub fn of_key(key: &str) -> Option<Varied> {
+        Varied::all().find(|varied| varied.key() == key)
+    }
+
+    /// Sets `value` in `scene`; refused, naming the key, where the scene cannot take it.
+    fn apply(self, scene: &mut Scene, value: f64) -> Result<(), VariationError> {
+        let key = self.key();
+        self.range().check(key, value)?;
+        let tilt = &mut scene.lanes.tilt_deg;
+        match self {
+            Varied::TiltEnd => match tilt {
+                Automation::Constant(end) => *end = value,
+                Automation::Points(points) => {
+                    if let Some(last) = points.last_mut() {
+                        last.1 = value;
+                    }
+                }
+            },
+            Varied::RampTime => {
+                let end_s = tilt.last_time_s();
+                let Automation::Points(points) = tilt else {
+                    return Err(VariationError::NoRamp { key });
+                };
+                if end_s <= 0.0 {
+                    return Err(VariationError::NoRamp { key });
+                }
+                for point in points.iter_mut() {
+                    point.0 *= value / end_s;
+                }
+            }
+            Varied::Control(control) => scene.lanes[control] = Automation::Constant(value),
+            Varied::Constant(constant) => {
+                constant.set(&mut scene.config, value);
+                scene.config.check_silent_below()?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Why a `[variations]` table, a take's row or a manifest was refused; each names its key.
+#[derive(Debug, thiserror::Error)]
+pub enum VariationError {
+    /// A key that names nothing a take may vary.
+    #[error(
+        "unknown key `{}` in [variations]: use `count` or a range for one of {}",
+        printable(key),
+        known_keys()
+    )]
+    UnknownKey {
+        /// The key as written.
+        key: String,
+    },
+    /// A range that is not `[low, high]` of two finite numbers in order.
+    #[error("`variations.{key}` = {written}: {why}")]
+    BadRange {
+        /// The varied key.
+        key: &'static str,
+        /// The value as written.
+        written: String,
+        /// What is wrong with it.
+        why: String,
+    },
+    /// A count out of its range.
+    #[error("`variations.count` = {0}: a set has 1 to {MAX_TAKES} takes")]
+    Count(String),
+    /// A value the model cannot take (out of its range, V0 not below the capacity).
+    #[error(transparent)]
+    Value(#[from] ValueError),
+    /// `ramp_s` on a scene whose tilt lane has no point after 0 s.
+    #[error(
+        "`{key}`: the scene's tilt_deg has no ramp to time (a constant, or points all at 0 s); \
+         give it points such as [[0.0, 90.0], [0.5, 135.0]]"
+    )]
+    NoRamp {
+        /// The key.
+        key: &'static str,
+    },
+    /// A take's row that cannot be read.
+    #[error("{0}")]
+    Row(String),
+    /// A manifest that could not be read.
+    #[error(transparent)]
+    Read(#[from] ReadError),
+}
+
+fn known_keys() -> String {
+    Varied::all()
+        .map(|varied| format!("`{}`", varied.key()))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A scene's `[variations]` table: how many takes, and the range of each value drawn.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VariationSpec {
+    /// Takes in the set, unless the command line says.
+    pub count: Option<u32>,
+    /// Each varied value with its `[low, high]`, in [`Varied::all`]'s order.
+    pub ranges: Vec<(Varied, [f64; 2])>,
+}
+
+impl VariationSpec {
+    /// The table read key by key: `count`, and `[low, high]` ranges at the keys of
+    /// [`Varied::all`] (dotted or in sub-tables: `glug.f1_hz = [70, 90]`).
+    pub fn from_table(table: toml::Table) -> Result<Self, VariationError> {
+        let mut count = None;
+        let mut ranges = Vec::new();
+        for (key, value) in keys::flatten(&table) {
+            if key == COUNT_KEY {
+                count = Some(take_count(&value)?);
+                continue;
+            }
+            let varied = Varied::of_key(&key).ok_or(VariationError::UnknownKey { key })?;
+            ranges.push((varied, range_of(varied, &value)?));
+        }
+        ranges.sort_by_key(|(varied, _)| Varied::all().position(|other| other == *varied));
+        Ok(Self { count, ranges })
+    }
+}
+
+fn take_count(value: &toml::Value) -> Result<u32, VariationError> {
+    match value.as_integer() {
+        Some(count) if (1..=MAX_TAKES as i64).contains(&count) => Ok(count as u32),
+        _ => Err(VariationError::Count(value.to_string())),
+    }
+}
+
+/// `[low, high]` for `varied`: two numbers, in order, within its range.
+fn range_of(varied: Varied, value: &toml::Value) -> Result<[f64; 2], VariationError> {
+    let key = varied.key();
+    let bad = |why: String| VariationError::BadRange {
+        key,
+        written: printable(&value.to_string()).into_owned(),
+        why,
+    };
+    let numbers: Option<Vec<f64>> = value.as_array().and_then(|items| {
+        items
+            .iter()
+            .map(|item| {
+                item.as_float()
+                    .or_else(|| item.as_integer().map(|i| i as f64))
+            })
+            .collect()
+    });
+    let [low, high] = numbers
+        .as_deref()
+        .and_then(|numbers| <[f64; 2]>::try_from(numbers).ok())
+        .ok_or_else(|| bad("a range is [low, high], two numbers".into()))?;
+    if low.is_nan() || high.is_nan() {
+        return Err(bad("a range's ends are numbers, not NaN".into()));
+    }
+    if low > high {
+        return Err(bad(format!(
+            "its low end {low} is above its high end {high}"
+        )));
+    }
+    let allowed = varied.range();
+    for end in [low, high] {
+        if !allowed.contains(end) {
+            return Err(bad(format!(
+                "{end} lies outside `{key}`'s range, {} to {}",
+                allowed.min, allowed.max
+            )));
+        }
+    }
+    Ok([low, high])
+}
+
+/// One take of a set: its number (from 1), its seed and what it drew. A manifest's row, and
+/// all that is needed, with the scene, to render the take again.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Take {
+    /// Its number in the set, from 1 (its file's suffix).
+    pub number: u32,
+    /// The seed of its random draws (MODEL.md §7).
+    pub seed: u64,
+    /// Each drawn value, in [`Varied::all`]'s order.
+    pub values: Vec<(Varied, f64)>,
+}
+
+impl Take {
+    /// `scene` as this take plays it: its seed and every drawn value set, each checked as a
+    /// scene's; the scene's own `[variations]` table is dropped (a take is one render).
+    pub fn apply(&self, mut scene: Scene) -> Result<Scene, VariationError> {
+        scene.config.seed = self.seed;
+        for &(varied, value) in &self.values {
+            varied.apply(&mut scene, value)?;
+        }
+        scene.variations = None;
+        Ok(scene)
+    }
+
+    /// The name of its files: the set's name and its number, `NAME_07`, at least two digits.
+    pub fn name(&self, set_name: &str, count: u32) -> String {
+        let width = count.to_string().len().max(2);
+        format!("{set_name}_{:0width$}", self.number)
+    }
+
+    /// A take from a row's fields (column name, text): `seed` and the varied keys; `take` and
+    /// `name` are the row's own and change nothing. Unknown columns and unreadable numbers are
+    /// refused by name.
+    pub fn from_fields<'a>(
+        number: u32,
+        fields: impl IntoIterator<Item = (&'a str, &'a str)>,
+    ) -> Result<Self, VariationError> {
+        let mut seed = None;
+        let mut values = Vec::new();
+        for (column, text) in fields {
+            let text = text.trim();
+            match column {
+                TAKE_COLUMN | NAME_COLUMN => {}
+                SEED_COLUMN => {
+                    seed = Some(text.parse::<u64>().map_err(|_| {
+                        VariationError::Row(format!(
+                            "`seed` = {}: not a whole number from 0 to {}",
+                            printable(text),
+                            u64::MAX
+                        ))
+                    })?)
+                }
+                column => {
+                    let varied = Varied::of_key(column).ok_or_else(|| {
+                        VariationError::Row(format!(
+                            "unknown column `{}` in a take's row: use `seed` and {}",
+                            printable(column),
+                            known_keys()
+                        ))
+                    })?;
+                    let value = text.parse::<f64>().map_err(|_| {
+                        VariationError::Row(format!(
+                            "`{column}` = {}: not a number",
+                            printable(text)
+                        ))
+                    })?;
+                    values.push((varied, value));
+                }
+            }
+        }
+        let seed =
+            seed.ok_or_else(|| VariationError::Row("a take's row needs its `seed`".into()))?;
+        values.sort_by_key(|(varied, _)| Varied::all().position(|other| other == *varied));
+        Ok(Self {
+            number,
+            seed,
+            values,
+        })
+    }
+}
+
+/// The name of a set whose first file is `path`: its file name up to the first dot
+/// (`pour.wav` and `pour.units.csv` are of the set `pour`).
+pub fn set_name_of(path: &Path) -> String {
+    let file_name = path
+        .file_name()
+        .map_or(String::new(), |name| name.to_string_lossy().into_owned());
+    let (stem, _) = split_at_first_dot(&file_name);
+    stem.to_owned()
+}
+
+/// The file of a take beside `path`: the take's number after the set's name, before the
+/// extensions (`pour.units.csv` → `pour_07.units.csv`).
+pub fn take_path(path: &Path, take_name: &str) -> std::path::PathBuf {
+    let file_name = path
+        .file_name()
+        .map_or(String::new(), |name| name.to_string_lossy().into_owned());
+    let (_, extensions) = split_at_first_dot(&file_name);
+    path.with_file_name(format!("{take_name}{extensions}"))
+}
+
+/// A file name cut before its first dot (a leading dot is part of the name).
+fn split_at_first_dot(file_name: &str) -> (&str, &str) {
+    match file_name.char_indices().skip(1).find(|&(_, c)| c == '.') {
+        Some((index, _)) => file_name.split_at(index),
+        None => (file_name, ""),
+    }
+}
+
+/// The manifests of a set named `set_name` in `folder`: `NAME.variations.csv` and `.json`.
+pub fn manifest_paths(folder: &Path, set_name: &str) -> [std::path::PathBuf; 2] {
+    ["csv", "json"].map(|extension| folder.join(format!("{set_name}.variations.{extension}")))
+}
+
+/// `count` takes drawn from `master_seed`: take k's seed, then each of `ranges` in order,
+/// uniform in [low, high]; the first takes of a larger set are the takes of a smaller one. A
+/// seed lies within the range of the plugin's Seed parameter, so a take plays there too.
+pub fn draw_takes(ranges: &[(Varied, [f64; 2])], count: u32, master_seed: u64) -> Vec<Take> {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(master_seed);
+    let seeds = config::SEED.range;
+    (1..=count)
+        .map(|number| {
+            let seed = rng.random_range(seeds.min as u64..=seeds.max as u64);
+            let values = ranges
+                .iter()
+                .map(|&(varied, [low, high])| {
+                    let value = if low == high {
+                        low
+                    } else {
+                        rng.random_range(low..=high)
+                    };
+                    (varied, value)
+                })
+                .collect();
+            Take {
+                number,
+                seed,
+                values,
+            }
+        })
+        .collect()
+}
+
+/// The manifest of a set as CSV: a header (`take,name,seed`, then the varied keys) and a row per
+/// take, each number written as the shortest text that reads back as the same f64.
+pub fn manifest_csv(set_name: &str, takes: &[Take]) -> String {
+    let count = takes.len() as u32;
+    let mut header = vec![TAKE_COLUMN, NAME_COLUMN, SEED_COLUMN];
+    if let Some(first) = takes.first() {
+        header.extend(first.values.iter().map(|(varied, _)| varied.key()));
+    }
+    let mut text = header.join(",") + "\n";
+    for take in takes {
+        let mut cells = vec![
+            take.number.to_string(),
+            take.name(set_name, count),
+            take.seed.to_string(),
+        ];
+        cells.extend(take.values.iter().map(|(_, value)| value.to_string()));
+        text += &(cells.join(",") + "\n");
+    }
+    text
+}
+
+/// The manifest of a set as JSON: the set's name, scene, master seed and ranges, and its takes,
+/// each an object of the CSV row's columns.
+pub fn manifest_json(
+    set_name: &str,
+    scene_file: Option<&Path>,
+    master_seed: u64,
+    ranges: &[(Varied, [f64; 2])],
+    takes: &[Take],
+) -> String {
+    let count = takes.len() as u32;
+    let rows: Vec<serde_json::Value> = takes
+        .iter()
+        .map(|take| {
+            let mut row = serde_json::Map::new();
+            row.insert(TAKE_COLUMN.into(), take.number.into());
+            row.insert(NAME_COLUMN.into(), take.name(set_name, count).into());
+            row.insert(SEED_COLUMN.into(), take.seed.into());
+            for &(varied, value) in &take.values {
+                row.insert(varied.key().into(), value.into());
+            }
+            serde_json::Value::Object(row)
+        })
+        .collect();
+    let ranges: serde_json::Map<String, serde_json::Value> = ranges
+        .iter()
+        .map(|&(varied, range)| (varied.key().to_owned(), serde_json::json!(range)))
+        .collect();
+    let manifest = serde_json::json!({
+        "name": set_name,
+        "scene": scene_file.map(|path| path.display().to_string()),
+        "master_seed": master_seed,
+        "count": count,
+        "ranges": ranges,
+        "takes": rows,
+    });
+    serde_json::to_string_pretty(&manifest).expect("a JSON value is written") + "\n"
+}
+
+/// Take `number` of the manifest at `path` (`.json`, else CSV), read as the renderer reads any
+/// input file.
+pub fn read_take(path: &Path, number: u32) -> Result<Take, VariationError> {
+    let text = read::read_text(path, InputKind::VARIATIONS)?;
+    let in_file = |message: String| {
+        VariationError::Row(format!(
+            "{}: {message}",
+            printable(&path.display().to_string())
+        ))
+    };
+    let is_json = path
+        .extension()
+        .is_some_and(|extension| extension.eq_ignore_ascii_case("json"));
+    let take = if is_json {
+        take_from_json(&text, number)
+    } else {
+        take_from_csv(&text, number)
+    };
+    take.map_err(|error| match error {
+        VariationError::Row(message) => in_file(message),
+        other => other,
+    })
+}
+
+fn take_from_csv(text: &str, number: u32) -> Result<Take, VariationError> {
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let header = reader
+        .headers()
+        .map_err(|error| VariationError::Row(error.to_string()))?
+        .clone();
+    let take_index = header.iter().position(|column| column == TAKE_COLUMN);
+    for (index, record) in reader.records().enumerate() {
+        let record = record.map_err(|error| VariationError::Row(error.to_string()))?;
+        let row_number = match take_index.and_then(|column| record.get(column)) {
+            Some(text) => text.parse::<u32>().ok(),
+            None => Some(index as u32 + 1),
+        };
+        if row_number == Some(number) {
+            return Take::from_fields(number, header.iter().zip(record.iter()));
+        }
+    }
+    Err(VariationError::Row(format!("no take {number} in it")))
+}
+
+fn take_from_json(text: &str, number: u32) -> Result<Take, VariationError> {
+    let manifest: serde_json::Value =
+        serde_json::from_str(text).map_err(|error| VariationError::Row(error.to_string()))?;
+    let rows = manifest
+        .get("takes")
+        .and_then(serde_json::Value::as_array)
+        .ok_or_else(|| VariationError::Row("no `takes` list in it".into()))?;
+    let row = rows
+        .iter()
+        .filter_map(serde_json::Value::as_object)
+        .find(|row| row.get(TAKE_COLUMN).and_then(serde_json::Value::as_u64) == Some(number as u64))
+        .ok_or_else(|| VariationError::Row(format!("no take {number} in it")))?;
+    let fields: Vec<(String, String)> = row
+        .iter()
+        .map(|(column, value)| {
+            let text = match value {
+                serde_json::Value::String(text) => text.clone(),
+                other => other.to_string(),
+            };
+            (column.clone(), text)
+        })
+        .collect();
+    Take::from_fields(
+        number,
+        fields
+            .iter()
+            .map(|(column, text)| (column.as_str(), text.as_str())),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(text: &str) -> Result<VariationSpec, VariationError> {
+        VariationSpec::from_table(toml::from_str(text).unwrap())
+    }
+
+    #[test]
+    fn ranges_are_read_by_their_tables_keys() {
+        let spec = spec("count = 3\nfill_percent = [60, 100]\ntilt_end_deg = [120, 150]\nglug.f1_hz = [70.0, 90.0]\n")
+            .unwrap();
+        assert_eq!(spec.count, Some(3));
+        let keys: Vec<&str> = spec.ranges.iter().map(|(varied, _)| varied.key()).collect();
+        assert_eq!(keys, ["tilt_end_deg", "fill_percent", "glug.f1_hz"]);
+    }
+
+    #[test]
+    fn a_row_written_reads_back_as_the_same_take() {
+        let ranges = spec("ramp_s = [0.2, 0.9]\nviscosity_c = [0.1, 0.6]\n")
+            .unwrap()
+            .ranges;
+        let takes = draw_takes(&ranges, 12, 99);
+        let csv = manifest_csv("pour", &takes);
+        let json = manifest_json("pour", None, 99, &ranges, &takes);
+        for take in &takes {
+            assert_eq!(&take_from_csv(&csv, take.number).unwrap(), take);
+            assert_eq!(&take_from_json(&json, take.number).unwrap(), take);
+        }
+        assert_eq!(takes[6].name("pour", 12), "pour_07");
+    }
+}
