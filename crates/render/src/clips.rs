@@ -49,7 +49,8 @@ pub struct ClipSource<'a> {
     pub duration_s: f64,
     /// The glugs of the render, in any order.
     pub glugs: &'a [Glug],
-    /// The output limiter's ceiling (≤ 1.0): the felt envelope never exceeds it.
+    /// The output limiter's ceiling (≤ 1.0, or scaled with the glugs by `--haptic-peak`): the
+    /// felt envelope never exceeds it.
     pub ceiling: f64,
     /// Name of the scene that was rendered, recorded in the clip's metadata.
     pub scene_name: &'a str,
@@ -370,9 +371,11 @@ impl<'a> EnvelopeSum<'a> {
         (total.min(self.limit()), frequency_hz)
     }
 
-    /// The largest value the envelope takes: the ceiling, at most 1 (full scale).
+    /// The largest value the envelope takes: the ceiling (at most 1, full scale, unless
+    /// `--haptic-peak` scaled it with the glugs: the format then writes no value above its
+    /// drive, its own strongest one being the drive asked for).
     pub(crate) fn limit(&self) -> f64 {
-        self.ceiling.clamp(0.0, 1.0)
+        self.ceiling.max(0.0)
     }
 
     /// The last time in `from_s..to_s` at which the decaying envelope is still at its limit,

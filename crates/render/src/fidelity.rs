@@ -10,6 +10,7 @@
 use std::path::Path;
 
 use super::clips::{clip_onsets, ClipSource, Glug};
+use super::loudness::Loudness;
 use super::render::{RenderObserver, RenderSummary};
 use super::scene::Scene;
 use super::sinks::read_back::{ReadBack, Reading, WrittenClip};
@@ -47,6 +48,19 @@ pub struct Fidelity {
     pub limits: String,
     /// With an actuator profile, the c its device delivers of this format (`None` without one).
     pub delivered_c: Option<DeliveredC>,
+    /// Its level: a waveform's loudness, a clip's peak drive.
+    pub level: Level,
+}
+
+/// The level of a format's file (MODEL.md §19).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Level {
+    /// A waveform: its integrated loudness, loudness range and true peak.
+    Loudness(Loudness),
+    /// A clip: the strongest drive it carries (0..1 of full scale), read back.
+    PeakDrive(f64),
+    /// Not measured.
+    None,
 }
 
 /// The c a device delivers of a format, against the model's (MODEL.md §18).
@@ -166,6 +180,10 @@ pub fn measure(
         driven: Vec::new(),
         sample_rate: scene.sample_rate,
     };
+    let options = &OutputOptions {
+        measure_loudness: true,
+        ..*options
+    };
     let report = super::render_to_files(scene, scene_name, &outputs, options, &mut glugs)?;
     let source = ClipSource {
         duration_s: report.summary.duration_s(),
@@ -196,23 +214,38 @@ pub fn measure(
                 bytes: *bytes,
                 limits,
                 delivered_c,
+                level: Level::None,
             };
             Ok(match read_back {
-                ReadBack::Waveform { limits } => {
-                    fidelity(None, None, limits(scene), delivered(true))
-                }
-                ReadBack::Clip(read) => {
+                ReadBack::Waveform { limits } => Fidelity {
+                    level: report
+                        .levelled
+                        .map_or(Level::None, |levelled| Level::Loudness(levelled.after)),
+                    ..fidelity(None, None, limits(scene), delivered(true))
+                },
+                ReadBack::Clip(read, _) => {
+                    let path = &output.path;
+                    let text = std::fs::read_to_string(path).map_err(OutputError::io(path))?;
+                    // The model's glugs at the drive the clip was written at (--haptic-peak),
+                    // found as its sink found it, so the envelope is compared shape to shape.
+                    let drive = format.clip_drive_gain(path, &source, options)?;
+                    let glugs = drive.glugs(&glugs.glugs);
+                    let source = drive.source(&source, &glugs);
                     let clip = WrittenClip {
-                        path: &output.path,
+                        path,
+                        text: &text,
                         source: &source,
                     };
                     let reading = read(&clip)?;
-                    fidelity(
-                        onset_error_ms(&source, &reading),
-                        envelope_error_db(&source, &report.summary, &*reading.envelope),
-                        reading.limits,
-                        delivered(false),
-                    )
+                    Fidelity {
+                        level: Level::PeakDrive(reading.peak_drive(source.duration_s)),
+                        ..fidelity(
+                            onset_error_ms(&source, &reading),
+                            envelope_error_db(&source, &report.summary, &*reading.envelope),
+                            reading.limits,
+                            delivered(false),
+                        )
+                    }
                 }
             })
         })

@@ -9,7 +9,7 @@ use serde::Serialize;
 use serde_json::Value;
 
 use super::read_back::{array, held, number, ReadBack, Reading, WrittenClip};
-use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
+use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
 use crate::clips::{
     clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, transient_intensity,
     ClipSource, HapticBand, ENVELOPE_FLOOR,
@@ -22,13 +22,18 @@ pub(super) const FORMAT: OutputFormat = OutputFormat {
     by_extension: true,
     built: true,
     open,
-    read_back: Some(ReadBack::Clip(read_back)),
+    read_back: Some(ReadBack::Clip(read_back, document)),
     carries_c: "HapticSharpness (the felt frequency: 1 − c by default)",
 };
 
 /// The sink of an `.ahap` output (its sharpness always on the default band).
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    ClipSink::open(context, |source, _| ahap_json(source), BYTES_PER_GLUG)
+    ClipSink::open(context, document, BYTES_PER_GLUG)
+}
+
+/// The pattern of `source` (its sharpness always on the default band).
+fn document(source: &ClipSource, _: &OutputOptions) -> String {
+    ahap_json(source)
 }
 
 /// Memory a glug takes until the pattern is written: the glug, its events and their text (a

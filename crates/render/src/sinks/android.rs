@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use super::read_back::{array, held, ReadBack, Reading, WrittenClip};
-use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
+use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
 use crate::clips::{clip_onsets, ClipSource};
 use crate::steps::{android_steps, ANDROID_FULL_AMPLITUDE, ANDROID_STEP_MS};
 
@@ -19,7 +19,7 @@ pub(super) const XML_FORMAT: OutputFormat = OutputFormat {
     by_extension: true,
     built: true,
     open: open_xml,
-    read_back: Some(ReadBack::Clip(read_back_xml)),
+    read_back: Some(ReadBack::Clip(read_back_xml, xml_document)),
     carries_c: CARRIES_C,
 };
 
@@ -30,7 +30,7 @@ pub(super) const WAVEFORM_FORMAT: OutputFormat = OutputFormat {
     by_extension: false,
     built: true,
     open: open_waveform,
-    read_back: Some(ReadBack::Clip(read_back_waveform)),
+    read_back: Some(ReadBack::Clip(read_back_waveform, waveform_document)),
     carries_c: CARRIES_C,
 };
 
@@ -43,18 +43,24 @@ const BYTES_PER_GLUG: u64 = 1024;
 
 /// The sink of an Android vibration XML output.
 pub(super) fn open_xml<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    ClipSink::open(context, |source, _| android_xml(source), BYTES_PER_GLUG)
+    ClipSink::open(context, xml_document, BYTES_PER_GLUG)
+}
+
+/// The XML of `source`.
+fn xml_document(source: &ClipSource, _: &OutputOptions) -> String {
+    android_xml(source)
+}
+
+/// The waveform JSON of `source`.
+fn waveform_document(source: &ClipSource, _: &OutputOptions) -> String {
+    android_waveform_json(source)
 }
 
 /// The sink of an Android waveform (JSON) output.
 pub(super) fn open_waveform<'a>(
     context: SinkContext<'a>,
 ) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    ClipSink::open(
-        context,
-        |source, _| android_waveform_json(source),
-        BYTES_PER_GLUG,
-    )
+    ClipSink::open(context, waveform_document, BYTES_PER_GLUG)
 }
 
 /// The clip as Android's vibration XML (schema `vibration.xsd`, root `<vibration-effect>` as

@@ -5,7 +5,7 @@
 use serde::Serialize;
 
 use super::read_back::{array, linear, number, ReadBack, Reading, WrittenClip};
-use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
+use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
 use crate::clips::{clip_end_s, clip_onsets, envelope_breakpoints, ClipSource};
 
 /// `.haps`: an Interhaptics / Razer Haptic Composer file (version 5).
@@ -15,7 +15,7 @@ pub(super) const FORMAT: OutputFormat = OutputFormat {
     by_extension: true,
     built: true,
     open,
-    read_back: Some(ReadBack::Clip(read_back)),
+    read_back: Some(ReadBack::Clip(read_back, document)),
     carries_c: "frequency keyframes in Hz (the felt frequency, c·f1 + (1 − c)·f2 weighted)",
 };
 
@@ -24,7 +24,12 @@ const BYTES_PER_GLUG: u64 = 1536;
 
 /// The sink of a `.haps` output.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    ClipSink::open(context, |source, _| haps_json(source), BYTES_PER_GLUG)
+    ClipSink::open(context, document, BYTES_PER_GLUG)
+}
+
+/// The file of `source`.
+fn document(source: &ClipSource, _: &OutputOptions) -> String {
+    haps_json(source)
 }
 
 /// The file version this writes, as Haptic Composer writes it (a string).

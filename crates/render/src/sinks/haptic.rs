@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::read_back::{array, linear, number, ReadBack, Reading, WrittenClip};
-use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
+use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
 use crate::clips::{
     clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, transient_intensity,
     ClipSource, HapticBand,
@@ -17,17 +17,18 @@ pub(super) const FORMAT: OutputFormat = OutputFormat {
     by_extension: true,
     built: true,
     open,
-    read_back: Some(ReadBack::Clip(read_back)),
+    read_back: Some(ReadBack::Clip(read_back, document)),
     carries_c: "emphasis and envelope frequency (the felt frequency on the band: 1 − c by default)",
 };
 
 /// The sink of a `.haptic` output, its frequencies on the band of the options.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    ClipSink::open(
-        context,
-        |source, options| haptic_json(source, &options.haptic_band),
-        BYTES_PER_GLUG,
-    )
+    ClipSink::open(context, document, BYTES_PER_GLUG)
+}
+
+/// The clip of `source`, its frequencies on the band of the options.
+fn document(source: &ClipSource, options: &OutputOptions) -> String {
+    haptic_json(source, &options.haptic_band)
 }
 
 /// Memory a glug takes until the clip is written: the glug, its breakpoints and their text

@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::read_back::{array, held, number, ReadBack, Reading, WrittenClip};
-use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
+use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
 use crate::clips::{clip_onsets, ClipSource};
 use crate::steps::rumble_frames;
 
@@ -15,7 +15,7 @@ pub(super) const FORMAT: OutputFormat = OutputFormat {
     by_extension: false,
     built: true,
     open,
-    read_back: Some(ReadBack::Clip(read_back)),
+    read_back: Some(ReadBack::Clip(read_back, document)),
     carries_c: "the motors' balance: low = the f1 part (c·a), high = the f2 part ((1 − c)·a)",
 };
 
@@ -42,11 +42,12 @@ pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, O
             rate_hz,
         });
     }
-    ClipSink::open(
-        context,
-        |source, options| rumble_json(source, options.platforms.rumble_rate_hz),
-        BYTES_PER_GLUG,
-    )
+    ClipSink::open(context, document, BYTES_PER_GLUG)
+}
+
+/// The frames of `source` at the options' rate.
+fn document(source: &ClipSource, options: &OutputOptions) -> String {
+    rumble_json(source, options.platforms.rumble_rate_hz)
 }
 
 #[derive(Serialize)]
