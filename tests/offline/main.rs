@@ -16,6 +16,7 @@ mod fuzz;
 // FIFOs, devices and links as Unix makes them.
 #[cfg(unix)]
 mod inputs;
+mod levels;
 mod memory;
 mod model_files;
 mod presets;

@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use super::read_back::{array, held, ReadBack, Reading, WrittenClip};
 use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
-use crate::clips::{clip_onsets, ClipSource};
+use crate::clips::{glug_count, ClipSource};
 use crate::steps::{android_steps, ANDROID_FULL_AMPLITUDE, ANDROID_STEP_MS};
 
 /// `.xml`: Android's vibration XML (`VibrationXmlParser`).
@@ -73,10 +73,10 @@ pub fn android_xml(source: &ClipSource) -> String {
     xml.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n");
     let _ = writeln!(
         xml,
-        "<!-- Sake Glug {}: seed {}, {} glugs, envelope in {ANDROID_STEP_MS} ms steps -->",
+        "<!-- Sake Glug {}: seed {}, {}, envelope in {ANDROID_STEP_MS} ms steps -->",
         env!("CARGO_PKG_VERSION"),
         source.seed,
-        clip_onsets(source).len()
+        glug_count(source)
     );
     xml.push_str("<vibration-effect>\n  <waveform-effect>\n");
     for step in &steps {
@@ -123,7 +123,7 @@ fn android_reading(entries: impl Iterator<Item = (u64, u64)>, lifted: usize) -> 
         from_mark_before: false,
         onsets: spans.iter().map(|span| span.0).collect(),
         limits: format!(
-            "{} entries of whole ms and 8-bit amplitude; {lifted} at the lowest level, 1",
+            "{} entries of whole ms and 8-bit amplitude; {lifted} lifted to 1, the lowest level",
             spans.len()
         ),
         envelope: held(spans),

@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use super::read_back::{array, linear, number, ReadBack, Reading, WrittenClip};
 use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
-use crate::clips::{clip_end_s, clip_onsets, envelope_breakpoints, ClipSource};
+use crate::clips::{clip_end_s, envelope_breakpoints, glug_count, ClipSource};
 
 /// `.haps`: an Interhaptics / Razer Haptic Composer file (version 5).
 pub(super) const FORMAT: OutputFormat = OutputFormat {
@@ -176,12 +176,12 @@ pub fn haps_json(source: &ClipSource) -> String {
     let file = HapsFile {
         m_version: HAPS_VERSION,
         m_description: format!(
-            "Sake Glug {}: scene {}, seed {}, {} glugs over {} s; one note per glug, \
+            "Sake Glug {}: scene {}, seed {}, {} over {} s; one note per audible glug, \
              frequency in Hz",
             env!("CARGO_PKG_VERSION"),
             source.scene_name,
             source.seed,
-            clip_onsets(source).len(),
+            glug_count(source),
             end_s
         ),
         m_hd_flag: 0,

@@ -6,8 +6,8 @@ use serde::Serialize;
 use super::read_back::{array, linear, number, ReadBack, Reading, WrittenClip};
 use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
 use crate::clips::{
-    clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, transient_intensity,
-    ClipSource, HapticBand,
+    clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, glug_count,
+    transient_intensity, ClipSource, HapticBand,
 };
 
 /// `.haptic`: a Meta Haptics Studio 1.0 clip.
@@ -145,7 +145,6 @@ pub fn haptic_json(source: &ClipSource, band: &HapticBand) -> String {
         })
         .collect();
 
-    let glug_count = clip_onsets(source).len();
     let file = HapticFile {
         version: Version {
             major: 1,
@@ -162,11 +161,11 @@ pub fn haptic_json(source: &ClipSource, band: &HapticBand) -> String {
                 source.scene_name.to_owned(),
             ],
             description: format!(
-                "Glugs of liquid poured from a sake bottle: scene {}, seed {}, {} glugs over \
-                 {} s; frequency 0..1 spans {} Hz",
+                "Glugs of liquid poured from a sake bottle: scene {}, seed {}, {} over {} s; \
+                  frequency 0..1 spans {} Hz",
                 source.scene_name,
                 source.seed,
-                glug_count,
+                glug_count(source),
                 clip_end_s(source),
                 band,
             ),

@@ -5,7 +5,7 @@ use serde::Serialize;
 
 use super::read_back::{array, held, number, ReadBack, Reading, WrittenClip};
 use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
-use crate::clips::{clip_onsets, ClipSource};
+use crate::clips::{glug_count, ClipSource};
 use crate::steps::rumble_frames;
 
 /// `rumble` (`.json`): frames of a dual-rumble gamepad's two motors.
@@ -83,13 +83,13 @@ pub fn rumble_json(source: &ClipSource, rate_hz: f64) -> String {
         .collect();
     let rumble = Rumble {
         description: format!(
-            "Sake Glug {}: scene {}, seed {}, {} glugs; low = the f1 component's envelope \
+            "Sake Glug {}: scene {}, seed {}, {}; low = the f1 component's envelope \
              (strong, low-frequency motor), high = the f2 component's (weak, high-frequency \
              motor), each held for 1/rate_hz",
             env!("CARGO_PKG_VERSION"),
             source.scene_name,
             source.seed,
-            clip_onsets(source).len()
+            glug_count(source)
         ),
         rate_hz,
         frames,
