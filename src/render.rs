@@ -17,6 +17,7 @@ use sake_glug_model_file::ModelFile;
 use sake_glug_render::clips::HapticBand;
 use sake_glug_render::fidelity::{self, fidelity_table, Fidelity};
 use sake_glug_render::silence::why_silent;
+use sake_glug_render::loudness::{parse_loudness, parse_true_peak, HapticPeak, LevelTarget};
 use sake_glug_render::sinks::{AudioChannels, DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
 use sake_glug_render::trim::{check_trim_db, trimmed, DEFAULT_TRIM_DB, TRIM_FADE_S};
 use sake_glug_render::variations::{
@@ -125,6 +126,22 @@ pub struct RenderArgs {
     /// actuators and the haptic channel always hold the glug).
     #[arg(long, value_name = "silent|glug", default_value = "silent")]
     audio_channels: AudioChannels,
+    /// Brings every waveform file (.wav, .csv, dualsense, .ogg) to this integrated loudness
+    /// (LUFS; ITU-R BS.1770-4, gated as EBU R128), e.g. -23 for broadcast, -16 for games. A
+    /// render shorter than 0.4 s or silent is refused. Haptic clips are set by --haptic-peak.
+    #[arg(long, value_name = "LUFS", allow_negative_numbers = true, value_parser = parse_loudness)]
+    loudness: Option<f64>,
+    /// Keeps every waveform file's true peak (4× oversampled) at or under this ceiling (dBTP),
+    /// e.g. -1. With --loudness the ceiling wins: the file then ends quieter than asked, and the
+    /// summary says by how much.
+    #[arg(long, value_name = "DBTP", allow_negative_numbers = true, value_parser = parse_true_peak)]
+    true_peak: Option<f64>,
+    /// Scales every haptic clip (.haptic, .ahap, .haps, Android XML and waveform, rumble) so its
+    /// strongest moment, as the format carries it, reaches this drive: 100%, a level in dB
+    /// (-3dB) or a fraction (0.8). The actuator's compensation (--actuator) comes first. Without
+    /// it a clip keeps the model's level, output gain included.
+    #[arg(long, value_name = "DRIVE", allow_hyphen_values = true)]
+    haptic_peak: Option<HapticPeak>,
     /// Measures what every format keeps of the render (onsets, envelope, what carries c, size,
     /// platform limits) and prints it as a Markdown table on stdout; the summary line then goes
     /// to stderr.
@@ -231,6 +248,12 @@ pub fn run(args: RenderArgs) -> ExitCode {
             rumble_rate_hz: args.rumble_rate,
             audio_channels: args.audio_channels,
         },
+        level: LevelTarget {
+            loudness_lufs: args.loudness,
+            true_peak_dbtp: args.true_peak,
+        },
+        haptic_peak: args.haptic_peak,
+        measure_loudness: false,
     };
     let stop = Stop::on_signals(jobs.iter().flat_map(|job| job.outputs.clone()).collect());
     let mut out = Console::new(jobs.len());
@@ -266,7 +289,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
                     }
                     match fidelity {
                         Some(rows) => {
-                            out.error(&summary(&name, &report, &outside));
+                            out.error(&summary(&name, &report, &outside, args.haptic_peak));
                             let heading = if several {
                                 format!("{name}:\n\n")
                             } else {
@@ -274,7 +297,7 @@ pub fn run(args: RenderArgs) -> ExitCode {
                             };
                             out.summary(&(heading + fidelity_table(&rows).trim_end()));
                         }
-                        None => out.summary(&summary(&name, &report, &outside)),
+                        None => out.summary(&summary(&name, &report, &outside, args.haptic_peak)),
                     }
                 }
                 if !manifests.is_empty() {
@@ -838,7 +861,12 @@ impl<P: FnMut(f64)> RenderObserver for JobObserver<'_, P> {
 /// The line printed for a finished scene.
 /// The line a finished scene prints; files the scene read from outside its own folder are named
 /// at its end, so a scene from elsewhere cannot read one unseen.
-fn summary(name: &str, report: &RenderReport, outside: &[PathBuf]) -> String {
+fn summary(
+    name: &str,
+    report: &RenderReport,
+    outside: &[PathBuf],
+    haptic_peak: Option<HapticPeak>,
+) -> String {
     let summary = &report.summary;
     let files: Vec<String> = report
         .files
@@ -846,12 +874,15 @@ fn summary(name: &str, report: &RenderReport, outside: &[PathBuf]) -> String {
         .map(|(path, bytes)| format!("{} ({})", path.display(), human_bytes(*bytes)))
         .collect();
     format!(
-        "{}: {:.2} s at {} Hz, {} glug units, peak {:.1} dBFS, {:.0}× faster than real time → {}",
+        "{}: {:.2} s at {} Hz, {} glug units, {} audible, peak {:.1} dBFS{}, {:.0}× faster than \
+         real time → {}",
         name,
         summary.duration_s(),
         summary.sample_rate,
         summary.units,
+        report.audible_units,
         20.0 * (summary.peak.max(1e-12) as f64).log10(),
+        level_note(report, haptic_peak),
         summary.realtime_factor(),
         if files.is_empty() {
             "no file written (a report alone)".to_owned()
@@ -859,6 +890,27 @@ fn summary(name: &str, report: &RenderReport, outside: &[PathBuf]) -> String {
             files.join(", ")
         }
     ) + &outside_note(outside)
+}
+
+/// What the level stage did (MODEL.md §19): the waveform's gain and loudness, the clips' drive.
+fn level_note(report: &RenderReport, haptic_peak: Option<HapticPeak>) -> String {
+    let mut note = String::new();
+    if let Some(levelled) = &report.levelled {
+        note += &format!(
+            " before a gain of {:+.2} dB; the waveform files: {}",
+            levelled.gain_db, levelled.after
+        );
+        if levelled.held_by_peak {
+            note += &format!(
+                " (held by the true-peak ceiling: {:.1} LU quieter than the loudness asked)",
+                levelled.quieter_than_asked_lu
+            );
+        }
+    }
+    if let Some(peak) = haptic_peak {
+        note += &format!("; haptic clips at {peak} peak drive");
+    }
+    note
 }
 
 fn outside_note(outside: &[PathBuf]) -> String {

@@ -17,6 +17,7 @@ mod guide;
 // FIFOs, devices and links as Unix makes them.
 #[cfg(unix)]
 mod inputs;
+mod levels;
 mod memory;
 mod model_files;
 mod presets;

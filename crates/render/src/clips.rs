@@ -25,6 +25,10 @@ pub struct Glug {
     pub decay_per_s: [f64; 2],
     /// Viscosity `c` in 0..1 (water 0.33); the share of the low component.
     pub viscosity: f64,
+    /// The actuator's compensation gains already in `amplitudes` (`[1, 1]` without a profile,
+    /// MODEL.md §18). The felt frequency is weighted without them (§19): a platform plays a
+    /// clip's frequency or sharpness on its own actuator, which would compensate it again.
+    pub actuator_gain: [f64; 2],
 }
 
 impl Glug {
@@ -38,6 +42,7 @@ impl Glug {
             frequency_hz: unit.shape.frequency_hz,
             decay_per_s: unit.shape.decay_per_s,
             viscosity: unit.viscosity,
+            actuator_gain: unit.actuator_gain,
         }
     }
 }
@@ -49,7 +54,8 @@ pub struct ClipSource<'a> {
     pub duration_s: f64,
     /// The glugs of the render, in any order.
     pub glugs: &'a [Glug],
-    /// The output limiter's ceiling (≤ 1.0): the felt envelope never exceeds it.
+    /// The output limiter's ceiling (≤ 1.0, or scaled with the glugs by `--haptic-peak`): the
+    /// felt envelope never exceeds it.
     pub ceiling: f64,
     /// Name of the scene that was rendered, recorded in the clip's metadata.
     pub scene_name: &'a str,
@@ -197,16 +203,25 @@ pub fn envelope_at(glugs: &[Glug], ceiling: f64, t: f64) -> f64 {
 }
 
 /// A glug's felt frequency in Hz: the amplitude-weighted mean `(A1·f1 + A2·f2)/(A1 + A2)`, so
-/// a more viscous glug (more of the low component) feels lower. An inaudible glug has no
-/// weights; its viscosity `c·f1 + (1 − c)·f2` stands in.
+/// a more viscous glug (more of the low component) feels lower, the amplitudes taken without
+/// an actuator's compensation (MODEL.md §19). An inaudible glug has no weights; its viscosity
+/// `c·f1 + (1 − c)·f2` stands in.
 pub fn felt_frequency_hz(glug: &Glug) -> f64 {
-    let [a1, a2] = glug.amplitudes.map(f64::abs);
+    let [a1, a2] = model_amplitudes(glug);
     let [f1, f2] = glug.frequency_hz;
     if a1 + a2 > 0.0 {
         (a1 * f1 + a2 * f2) / (a1 + a2)
     } else {
         glug.viscosity * f1 + (1.0 - glug.viscosity) * f2
     }
+}
+
+/// `|A1|, |A2|` without the actuator's compensation: the model's balance of the components.
+fn model_amplitudes(glug: &Glug) -> [f64; 2] {
+    let [a1, a2] = glug.amplitudes.map(f64::abs);
+    let [g1, g2] = glug.actuator_gain;
+    let uncompensated = |a: f64, g: f64| if g > 0.0 { a / g } else { a };
+    [uncompensated(a1, g1), uncompensated(a2, g2)]
 }
 
 /// A glug's own peak on the envelope's 0..1 scale: `min(ceiling, |A1| + |A2|)`, clamped to 0..1.
@@ -280,6 +295,16 @@ pub fn clip_onsets(source: &ClipSource) -> Vec<usize> {
         .collect()
 }
 
+/// The glugs of a clip as every file and the summary name them: "59 units, 42 audible" (every
+/// unit the render started, and those with a above 0 that start inside the clip).
+pub fn glug_count(source: &ClipSource) -> String {
+    format!(
+        "{} units, {} audible",
+        source.glugs.len(),
+        clip_onsets(source).len()
+    )
+}
+
 /// The indices of all audible glugs, sorted by onset. A glug that started before the clip
 /// still rings into it, so the envelope sums these, not only the clip's onsets.
 fn sorted_audible(glugs: &[Glug]) -> Vec<usize> {
@@ -308,8 +333,13 @@ pub(crate) struct RingingSums {
     pub components: [f64; 2],
     /// Both together, summed glug by glug (the felt envelope before the ceiling).
     pub total: f64,
-    /// Σ of each component's amplitude × its frequency.
+    /// Σ of each component's amplitude × its frequency, the amplitudes without an actuator's
+    /// compensation ([`felt_frequency_hz`]).
     pub weighted_hz: f64,
+    /// Σ of those amplitudes: `weighted_hz / model_total` is the felt frequency.
+    pub model_total: f64,
+    /// Those amplitudes component by component: the model's balance of the two.
+    pub model_components: [f64; 2],
 }
 
 impl<'a> EnvelopeSum<'a> {
@@ -341,6 +371,8 @@ impl<'a> EnvelopeSum<'a> {
             components: [0.0; 2],
             total: 0.0,
             weighted_hz: 0.0,
+            model_total: 0.0,
+            model_components: [0.0; 2],
         };
         // Newest first: once even the largest glug would have decayed to nothing, every older
         // one has too (their contributions are below 1e-15 each).
@@ -354,7 +386,15 @@ impl<'a> EnvelopeSum<'a> {
                 let amplitude = glug.amplitudes[k].abs() * (-glug.decay_per_s[k] * tau).exp();
                 sums.components[k] += amplitude;
                 sums.total += amplitude;
-                sums.weighted_hz += amplitude * glug.frequency_hz[k];
+                let gain = glug.actuator_gain[k];
+                let model = if gain > 0.0 {
+                    amplitude / gain
+                } else {
+                    amplitude
+                };
+                sums.weighted_hz += model * glug.frequency_hz[k];
+                sums.model_total += model;
+                sums.model_components[k] += model;
             }
         }
         sums
@@ -364,15 +404,20 @@ impl<'a> EnvelopeSum<'a> {
     /// [`Breakpoint::felt_frequency_hz`]), over the audible glugs.
     fn at(&self, t: f64) -> (f64, Option<f64>) {
         let RingingSums {
-            total, weighted_hz, ..
+            total,
+            weighted_hz,
+            model_total,
+            ..
         } = self.ringing_at(t);
-        let frequency_hz = (total > 0.0).then(|| weighted_hz / total);
+        let frequency_hz = (model_total > 0.0).then(|| weighted_hz / model_total);
         (total.min(self.limit()), frequency_hz)
     }
 
-    /// The largest value the envelope takes: the ceiling, at most 1 (full scale).
+    /// The largest value the envelope takes: the ceiling (at most 1, full scale, unless
+    /// `--haptic-peak` scaled it with the glugs: the format then writes no value above its
+    /// drive, its own strongest one being the drive asked for).
     pub(crate) fn limit(&self) -> f64 {
-        self.ceiling.clamp(0.0, 1.0)
+        self.ceiling.max(0.0)
     }
 
     /// The last time in `from_s..to_s` at which the decaying envelope is still at its limit,

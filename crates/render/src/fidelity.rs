@@ -10,6 +10,7 @@
 use std::path::Path;
 
 use super::clips::{clip_onsets, ClipSource, Glug};
+use super::loudness::Loudness;
 use super::render::{RenderObserver, RenderSummary};
 use super::scene::Scene;
 use super::sinks::read_back::{ReadBack, Reading, WrittenClip};
@@ -47,6 +48,19 @@ pub struct Fidelity {
     pub limits: String,
     /// With an actuator profile, the c its device delivers of this format (`None` without one).
     pub delivered_c: Option<DeliveredC>,
+    /// Its level: a waveform's loudness, a clip's peak drive.
+    pub level: Level,
+}
+
+/// The level of a format's file (MODEL.md §19).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Level {
+    /// A waveform: its integrated loudness, loudness range and true peak.
+    Loudness(Loudness),
+    /// A clip: the strongest drive it carries (0..1 of full scale), read back.
+    PeakDrive(f64),
+    /// Not measured.
+    None,
 }
 
 /// The c a device delivers of a format, against the model's (MODEL.md §18).
@@ -60,10 +74,14 @@ pub enum DeliveredC {
         without: CShift,
         /// The same, driven as compensated.
         with: CShift,
+        /// The compensation equalises what is felt (`--felt`), while this c measures the
+        /// shaking the device delivers.
+        felt: bool,
     },
     /// The format carries c as something the platform plays on its own (a felt frequency, a
-    /// sharpness, a motor balance), not as the two components: the device's response changes
-    /// the level it plays, not the c it carries.
+    /// sharpness, a motor balance), not as the two components: the model's c, without the
+    /// compensation (MODEL.md §19), which the platform maps to its own actuator; the profile
+    /// changes only the level it plays.
     AsCarried,
 }
 
@@ -117,7 +135,11 @@ fn delivered_c(actuator: &ActuatorResponse, units: &[DrivenUnit]) -> DeliveredC 
     }));
     let with =
         CShift::of(audible().map(|unit| (c_of(unit.glug.amplitudes, unit), unit.glug.viscosity)));
-    DeliveredC::Measured { without, with }
+    DeliveredC::Measured {
+        without,
+        with,
+        felt: actuator.equalise() == sake_glug_engine::Equalise::Felt,
+    }
 }
 
 /// The formats measured: every one played that this build writes.
@@ -166,6 +188,10 @@ pub fn measure(
         driven: Vec::new(),
         sample_rate: scene.sample_rate,
     };
+    let options = &OutputOptions {
+        measure_loudness: true,
+        ..*options
+    };
     let report = super::render_to_files(scene, scene_name, &outputs, options, &mut glugs)?;
     let source = ClipSource {
         duration_s: report.summary.duration_s(),
@@ -196,23 +222,38 @@ pub fn measure(
                 bytes: *bytes,
                 limits,
                 delivered_c,
+                level: Level::None,
             };
             Ok(match read_back {
-                ReadBack::Waveform { limits } => {
-                    fidelity(None, None, limits(scene), delivered(true))
-                }
-                ReadBack::Clip(read) => {
+                ReadBack::Waveform { limits } => Fidelity {
+                    level: report
+                        .levelled
+                        .map_or(Level::None, |levelled| Level::Loudness(levelled.after)),
+                    ..fidelity(None, None, limits(scene), delivered(true))
+                },
+                ReadBack::Clip(read, _) => {
+                    let path = &output.path;
+                    let text = std::fs::read_to_string(path).map_err(OutputError::io(path))?;
+                    // The model's glugs at the drive the clip was written at (--haptic-peak),
+                    // found as its sink found it, so the envelope is compared shape to shape.
+                    let drive = format.clip_drive_gain(path, &source, options)?;
+                    let glugs = drive.glugs(&glugs.glugs);
+                    let source = drive.source(&source, &glugs);
                     let clip = WrittenClip {
-                        path: &output.path,
+                        path,
+                        text: &text,
                         source: &source,
                     };
                     let reading = read(&clip)?;
-                    fidelity(
-                        onset_error_ms(&source, &reading),
-                        envelope_error_db(&source, &report.summary, &*reading.envelope),
-                        reading.limits,
-                        delivered(false),
-                    )
+                    Fidelity {
+                        level: Level::PeakDrive(reading.peak_drive(source.duration_s)),
+                        ..fidelity(
+                            onset_error_ms(&source, &reading),
+                            envelope_error_db(&source, &report.summary, &*reading.envelope),
+                            reading.limits,
+                            delivered(false),
+                        )
+                    }
                 }
             })
         })
@@ -272,13 +313,20 @@ fn envelope_error_db(
     (!errors.is_empty()).then(|| errors.iter().sum::<f64>() / errors.len() as f64)
 }
 
-/// The measurements as the Markdown table the guide shows; with an actuator profile, two more
-/// columns: the c its device delivers without and with the compensation.
+/// The measurements as the Markdown table the guide shows, each column explained under it;
+/// with an actuator profile, two more columns: the c its device delivers without and with the
+/// compensation.
 pub fn fidelity_table(rows: &[Fidelity]) -> String {
     let on_device = rows.iter().any(|row| row.delivered_c.is_some());
+    let felt = rows.iter().any(|row| {
+        matches!(
+            row.delivered_c,
+            Some(DeliveredC::Measured { felt: true, .. })
+        )
+    });
     let mut lines = vec![
-        "| format | onset error, mean / worst (ms) | envelope error (dB) | what carries c | size | limits met |".to_owned(),
-        "|---|---|---|---|---|---|".to_owned(),
+        "| format | onset error, mean / worst (ms) | envelope error (dB) | what carries c | size | limits met | level |".to_owned(),
+        "|---|---|---|---|---|---|---|".to_owned(),
     ];
     if on_device {
         lines[0] += " delivered c − model c, mean / worst: uncompensated | compensated |";
@@ -293,8 +341,13 @@ pub fn fidelity_table(rows: &[Fidelity]) -> String {
         let envelope = row
             .envelope_error_db
             .map_or("— (the waveform)".to_owned(), |db| format!("{db:.1}"));
+        let level = match row.level {
+            Level::Loudness(loudness) => loudness.to_string(),
+            Level::PeakDrive(drive) => format!("peak drive {:.1} %", drive * 100.0),
+            Level::None => "—".to_owned(),
+        };
         let mut line = format!(
-            "| `{}` | {onset} | {envelope} | {} | {} | {} |",
+            "| `{}` | {onset} | {envelope} | {} | {} | {} | {level} |",
             row.format.name(),
             row.carries_c,
             super::human_bytes(row.bytes),
@@ -302,16 +355,57 @@ pub fn fidelity_table(rows: &[Fidelity]) -> String {
         );
         let shift = |shift: CShift| format!("{:+.3} / {:.3}", shift.mean, shift.worst);
         match row.delivered_c {
-            Some(DeliveredC::Measured { without, with }) => {
+            Some(DeliveredC::Measured { without, with, .. }) => {
                 line += &format!(" {} | {} |", shift(without), shift(with));
             }
-            Some(DeliveredC::AsCarried) => {
-                line += " as carried (the platform plays it) | as carried |"
-            }
+            Some(DeliveredC::AsCarried) => line += " model c, as carried | model c, as carried |",
             None if on_device => line += " — | — |",
             None => {}
         }
         lines.push(line);
     }
+    lines.push(String::new());
+    lines.extend(COLUMN_NOTES.iter().map(|note| format!("- {note}")));
+    if on_device {
+        lines.extend(DEVICE_NOTES.iter().map(|note| format!("- {note}")));
+    }
+    if felt {
+        lines.push(format!("- {FELT_NOTE}"));
+    }
     lines.join("\n") + "\n"
 }
+
+/// What each column of the table means, printed under it.
+const COLUMN_NOTES: &[&str] = &[
+    "**onset error**: how far (ms) the format puts each audible glug's onset from the model's: \
+     the mean over the glugs, then the worst; to the nearest mark, or for rumble to the start \
+     of the frame that carries it. A waveform holds the onsets to the sample.",
+    "**envelope error**: the mean of |20·log10(format / model)| (dB, unsigned: a step above \
+     and one below both count), every millisecond where the model's felt envelope is within \
+     40 dB of its loudest; the format floored at −60 dB.",
+    "**what carries c**: where the viscosity c lives in the file.",
+    "**limits met**: what the platform's limits made of this render (for Android, the entries \
+     lifted to amplitude 1, the lowest that vibrates, rather than rounded to 0, which stops \
+     some motors with a click).",
+    "**level**: a waveform's integrated loudness (LUFS, BS.1770-4 gated as EBU R128), its \
+     loudness range (LU) and true peak (dBTP, 4× oversampled); a clip's strongest drive as \
+     the file carries it (100 % = the motor's full drive; `--haptic-peak` sets it).",
+];
+
+/// The columns an actuator profile adds.
+const DEVICE_NOTES: &[&str] = &[
+    "**delivered c − model c**: the c the device's response makes of each audible unit, less \
+     the model's: the signed mean (below 0, the device plays the liquid thinner), then the \
+     unsigned worst; uncompensated = driven as the model says, compensated = with the \
+     profile's gains.",
+    "**model c, as carried**: a clip carries c as a parameter the platform plays on its own \
+     actuator (a sharpness, a frequency, a motors' balance); it carries the model's c, not \
+     compensated, as the platform maps it to its own hardware (iOS would compensate a second \
+     time). The profile changes only the clip's level.",
+];
+
+/// With `--felt`.
+const FELT_NOTE: &str = "**with --felt**: the compensation equalises the level above the \
+     skin's threshold, while both c columns measure the shaking the device delivers \
+     (acceleration), not what is felt: the compensated column departs from the model's c by \
+     design.";

@@ -8,6 +8,7 @@
 use std::cell::RefCell;
 use std::path::PathBuf;
 
+use super::loudness::{Levelled, LoudnessMeter};
 use super::memory::available_bytes;
 use super::render::{render_scene, BottleReport, RenderError, RenderObserver, RenderSummary};
 use super::scene::Scene;
@@ -27,6 +28,12 @@ pub struct RenderReport {
     /// Temporary files of another render found beside the targets, whose process the system
     /// could not say is gone: perhaps left by a render that was killed, to be named to the user.
     pub leftovers: Vec<PathBuf>,
+    /// The units that can be felt or heard (a above 0), as the clips count their glugs; the
+    /// summary's units include the rest.
+    pub audible_units: u64,
+    /// The level of the waveform files (their gain and loudness), when a level was asked for
+    /// ([`OutputOptions::level`]) or measured ([`OutputOptions::measure_loudness`]).
+    pub levelled: Option<Levelled>,
 }
 
 /// Renders `scene` once and writes every file of `outputs` from that pass, each in its format. `scene_name` goes into the clips' metadata; `observer` hears what the
@@ -52,18 +59,42 @@ pub fn render_to_files(
                 scene,
                 scene_name,
                 options,
+                read_back: output.format.read_back(),
             })
         })
         .collect::<Result<Vec<_>, _>>()?;
     refuse_what_cannot_fit(outputs, &sinks)?;
+    // The level stage (MODEL.md §19): a first pass measures, the second is written at its gain.
+    let level = if options.level.is_set() {
+        Some(options.level.gain_for(&measure_loudness(scene)?)?)
+    } else {
+        None
+    };
+    let gain = level.as_ref().map(Levelled::gain);
+    let mut meter = (options.measure_loudness && level.is_none())
+        .then(|| LoudnessMeter::mono(scene.sample_rate));
+    let mut scaled = Vec::new();
     let sinks = RefCell::new(sinks);
     let mut fanout = Fanout {
         sinks: &sinks,
         observer,
+        audible_units: 0,
+        sample_rate: scene.sample_rate,
     };
     let summary = render_scene(
         scene,
         |block: &[f32]| {
+            let block = match gain {
+                Some(gain) => {
+                    scaled.clear();
+                    scaled.extend(block.iter().map(|y| y * gain));
+                    &scaled[..]
+                }
+                None => block,
+            };
+            if let Some(meter) = meter.as_mut() {
+                meter.add(block);
+            }
             sinks
                 .borrow_mut()
                 .iter_mut()
@@ -71,7 +102,7 @@ pub fn render_to_files(
         },
         &mut fanout,
     )?;
-    let observer = fanout.observer;
+    let (observer, audible_units) = (fanout.observer, fanout.audible_units);
     let finished = sinks
         .into_inner()
         .into_iter()
@@ -82,11 +113,40 @@ pub fn render_to_files(
     }
     // Every file is complete: only now do they replace their targets, all together.
     let files = PendingFile::commit_all(finished)?;
+    let levelled = level.or_else(|| {
+        meter.map(|meter| {
+            let loudness = meter.loudness();
+            Levelled {
+                gain_db: 0.0,
+                held_by_peak: false,
+                quieter_than_asked_lu: 0.0,
+                before: loudness,
+                after: loudness,
+            }
+        })
+    });
     Ok(RenderReport {
         summary,
         files,
         leftovers,
+        audible_units,
+        levelled,
     })
+}
+
+/// The loudness of `scene`'s render as synthesised: a pass of its own, writing nothing (the
+/// render is deterministic, so the pass that writes hears the same samples).
+pub fn measure_loudness(scene: &Scene) -> Result<crate::loudness::Loudness, RenderError> {
+    let mut meter = LoudnessMeter::mono(scene.sample_rate);
+    render_scene(
+        scene,
+        |block: &[f32]| {
+            meter.add(block);
+            Ok::<(), RenderError>(())
+        },
+        &mut |_| {},
+    )?;
+    Ok(meter.loudness())
 }
 
 /// Removes the temporary files this process's renders to `outputs` have open, for a process
@@ -127,6 +187,9 @@ fn refuse_what_cannot_fit(
 struct Fanout<'s, 'a, O> {
     sinks: &'s RefCell<Vec<Box<dyn Sink + 'a>>>,
     observer: O,
+    /// Units with a above 0 so far ([`crate::clips::is_audible`]).
+    audible_units: u64,
+    sample_rate: u32,
 }
 
 impl<O: RenderObserver> RenderObserver for Fanout<'_, '_, O> {
@@ -135,6 +198,8 @@ impl<O: RenderObserver> RenderObserver for Fanout<'_, '_, O> {
     }
 
     fn unit_started(&mut self, onset: &UnitOnset, voicing: Voicing) {
+        let glug = crate::clips::Glug::of_unit(onset, voicing.output_gain, self.sample_rate);
+        self.audible_units += u64::from(crate::clips::is_audible(&glug));
         for sink in self.sinks.borrow_mut().iter_mut() {
             sink.unit_started(onset, voicing);
         }

@@ -37,15 +37,33 @@ impl<'a> ComponentEnvelopes<'a> {
     }
 
     /// `[low, high]`: the f1 and the f2 component's envelope at `t` (s).
+    ///
+    /// Their sum is the felt envelope as driven (an actuator's compensation included); it is
+    /// shared between them as the model balances them, without the compensation (MODEL.md §19):
+    /// the motors are the platform's, not the profiled actuator.
     pub fn at(&self, t: f64) -> [f64; 2] {
-        let sum = self.envelope.ringing_at(t).components;
-        let total = sum[0] + sum[1];
+        let sums = self.envelope.ringing_at(t);
+        let [low, high] = sums.components;
         let limit = self.envelope.limit();
-        if total > limit {
-            let scale = limit / total;
-            sum.map(|component| component * scale)
+        // Without a compensation the balance is the components' own (to the bit).
+        if sums.components == sums.model_components {
+            let scale = if low + high > limit {
+                limit / (low + high)
+            } else {
+                1.0
+            };
+            return [low * scale, high * scale];
+        }
+        let total = (low + high).min(limit);
+        let [model_low, model_high] = sums.model_components;
+        let model_total = model_low + model_high;
+        if model_total > 0.0 {
+            [
+                total * model_low / model_total,
+                total * model_high / model_total,
+            ]
         } else {
-            sum
+            [0.0; 2]
         }
     }
 

@@ -45,6 +45,7 @@ fn uniform_glug(onset_s: f64, a: f64, c: f64) -> Glug {
         frequency_hz: [80.0, 300.0],
         decay_per_s: [45.0, 40.0],
         viscosity: c,
+        actuator_gain: [1.0, 1.0],
     }
 }
 

@@ -8,8 +8,8 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use super::read_back::{array, held, ReadBack, Reading, WrittenClip};
-use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
-use crate::clips::{clip_onsets, ClipSource};
+use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
+use crate::clips::{glug_count, ClipSource};
 use crate::steps::{android_steps, ANDROID_FULL_AMPLITUDE, ANDROID_STEP_MS};
 
 /// `.xml`: Android's vibration XML (`VibrationXmlParser`).
@@ -19,7 +19,7 @@ pub(super) const XML_FORMAT: OutputFormat = OutputFormat {
     by_extension: true,
     built: true,
     open: open_xml,
-    read_back: Some(ReadBack::Clip(read_back_xml)),
+    read_back: Some(ReadBack::Clip(read_back_xml, xml_document)),
     carries_c: CARRIES_C,
 };
 
@@ -30,7 +30,7 @@ pub(super) const WAVEFORM_FORMAT: OutputFormat = OutputFormat {
     by_extension: false,
     built: true,
     open: open_waveform,
-    read_back: Some(ReadBack::Clip(read_back_waveform)),
+    read_back: Some(ReadBack::Clip(read_back_waveform, waveform_document)),
     carries_c: CARRIES_C,
 };
 
@@ -43,18 +43,24 @@ const BYTES_PER_GLUG: u64 = 1024;
 
 /// The sink of an Android vibration XML output.
 pub(super) fn open_xml<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    ClipSink::open(context, |source, _| android_xml(source), BYTES_PER_GLUG)
+    ClipSink::open(context, xml_document, BYTES_PER_GLUG)
+}
+
+/// The XML of `source`.
+fn xml_document(source: &ClipSource, _: &OutputOptions) -> String {
+    android_xml(source)
+}
+
+/// The waveform JSON of `source`.
+fn waveform_document(source: &ClipSource, _: &OutputOptions) -> String {
+    android_waveform_json(source)
 }
 
 /// The sink of an Android waveform (JSON) output.
 pub(super) fn open_waveform<'a>(
     context: SinkContext<'a>,
 ) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    ClipSink::open(
-        context,
-        |source, _| android_waveform_json(source),
-        BYTES_PER_GLUG,
-    )
+    ClipSink::open(context, waveform_document, BYTES_PER_GLUG)
 }
 
 /// The clip as Android's vibration XML (schema `vibration.xsd`, root `<vibration-effect>` as
@@ -67,10 +73,10 @@ pub fn android_xml(source: &ClipSource) -> String {
     xml.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n");
     let _ = writeln!(
         xml,
-        "<!-- Sake Glug {}: seed {}, {} glugs, envelope in {ANDROID_STEP_MS} ms steps -->",
+        "<!-- Sake Glug {}: seed {}, {}, envelope in {ANDROID_STEP_MS} ms steps -->",
         env!("CARGO_PKG_VERSION"),
         source.seed,
-        clip_onsets(source).len()
+        glug_count(source)
     );
     xml.push_str("<vibration-effect>\n  <waveform-effect>\n");
     for step in &steps {
@@ -117,7 +123,7 @@ fn android_reading(entries: impl Iterator<Item = (u64, u64)>, lifted: usize) -> 
         from_mark_before: false,
         onsets: spans.iter().map(|span| span.0).collect(),
         limits: format!(
-            "{} entries of whole ms and 8-bit amplitude; {lifted} at the lowest level, 1",
+            "{} entries of whole ms and 8-bit amplitude; {lifted} lifted to 1, the lowest level",
             spans.len()
         ),
         envelope: held(spans),

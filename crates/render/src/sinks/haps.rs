@@ -5,8 +5,8 @@
 use serde::Serialize;
 
 use super::read_back::{array, linear, number, ReadBack, Reading, WrittenClip};
-use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
-use crate::clips::{clip_end_s, clip_onsets, envelope_breakpoints, ClipSource};
+use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
+use crate::clips::{clip_end_s, envelope_breakpoints, glug_count, ClipSource};
 
 /// `.haps`: an Interhaptics / Razer Haptic Composer file (version 5).
 pub(super) const FORMAT: OutputFormat = OutputFormat {
@@ -15,7 +15,7 @@ pub(super) const FORMAT: OutputFormat = OutputFormat {
     by_extension: true,
     built: true,
     open,
-    read_back: Some(ReadBack::Clip(read_back)),
+    read_back: Some(ReadBack::Clip(read_back, document)),
     carries_c: "frequency keyframes in Hz (the felt frequency, c·f1 + (1 − c)·f2 weighted)",
 };
 
@@ -24,7 +24,12 @@ const BYTES_PER_GLUG: u64 = 1536;
 
 /// The sink of a `.haps` output.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    ClipSink::open(context, |source, _| haps_json(source), BYTES_PER_GLUG)
+    ClipSink::open(context, document, BYTES_PER_GLUG)
+}
+
+/// The file of `source`.
+fn document(source: &ClipSource, _: &OutputOptions) -> String {
+    haps_json(source)
 }
 
 /// The file version this writes, as Haptic Composer writes it (a string).
@@ -171,12 +176,12 @@ pub fn haps_json(source: &ClipSource) -> String {
     let file = HapsFile {
         m_version: HAPS_VERSION,
         m_description: format!(
-            "Sake Glug {}: scene {}, seed {}, {} glugs over {} s; one note per glug, \
+            "Sake Glug {}: scene {}, seed {}, {} over {} s; one note per audible glug, \
              frequency in Hz",
             env!("CARGO_PKG_VERSION"),
             source.scene_name,
             source.seed,
-            clip_onsets(source).len(),
+            glug_count(source),
             end_s
         ),
         m_hd_flag: 0,

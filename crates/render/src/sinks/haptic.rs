@@ -4,10 +4,10 @@
 use serde::Serialize;
 
 use super::read_back::{array, linear, number, ReadBack, Reading, WrittenClip};
-use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
+use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
 use crate::clips::{
-    clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, transient_intensity,
-    ClipSource, HapticBand,
+    clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, glug_count,
+    transient_intensity, ClipSource, HapticBand,
 };
 
 /// `.haptic`: a Meta Haptics Studio 1.0 clip.
@@ -17,17 +17,18 @@ pub(super) const FORMAT: OutputFormat = OutputFormat {
     by_extension: true,
     built: true,
     open,
-    read_back: Some(ReadBack::Clip(read_back)),
+    read_back: Some(ReadBack::Clip(read_back, document)),
     carries_c: "emphasis and envelope frequency (the felt frequency on the band: 1 − c by default)",
 };
 
 /// The sink of a `.haptic` output, its frequencies on the band of the options.
 pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError> {
-    ClipSink::open(
-        context,
-        |source, options| haptic_json(source, &options.haptic_band),
-        BYTES_PER_GLUG,
-    )
+    ClipSink::open(context, document, BYTES_PER_GLUG)
+}
+
+/// The clip of `source`, its frequencies on the band of the options.
+fn document(source: &ClipSource, options: &OutputOptions) -> String {
+    haptic_json(source, &options.haptic_band)
 }
 
 /// Memory a glug takes until the clip is written: the glug, its breakpoints and their text
@@ -144,7 +145,6 @@ pub fn haptic_json(source: &ClipSource, band: &HapticBand) -> String {
         })
         .collect();
 
-    let glug_count = clip_onsets(source).len();
     let file = HapticFile {
         version: Version {
             major: 1,
@@ -161,11 +161,11 @@ pub fn haptic_json(source: &ClipSource, band: &HapticBand) -> String {
                 source.scene_name.to_owned(),
             ],
             description: format!(
-                "Glugs of liquid poured from a sake bottle: scene {}, seed {}, {} glugs over \
-                 {} s; frequency 0..1 spans {} Hz",
+                "Glugs of liquid poured from a sake bottle: scene {}, seed {}, {} over {} s; \
+                  frequency 0..1 spans {} Hz",
                 source.scene_name,
                 source.seed,
-                glug_count,
+                glug_count(source),
                 clip_end_s(source),
                 band,
             ),

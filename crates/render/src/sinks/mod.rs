@@ -30,6 +30,7 @@ mod wav;
 use std::path::{Path, PathBuf};
 
 use super::clips::HapticBand;
+use super::loudness::{HapticPeak, LevelError, LevelTarget};
 use super::memory::human_bytes;
 use super::render::{BottleReport, RenderError, RenderSummary};
 use super::scene::Scene;
@@ -93,6 +94,8 @@ pub(crate) struct SinkContext<'a> {
     pub scene_name: &'a str,
     /// How the files are written.
     pub options: &'a OutputOptions,
+    /// How its format is read back (a clip's drive is measured so).
+    pub read_back: Option<ReadBack>,
 }
 
 /// Opens the sink of one format, refusing up front what it knows it cannot write.
@@ -187,6 +190,22 @@ impl OutputFormat {
     /// What carries the viscosity c in its file, in the fidelity table's words.
     pub fn carries_c(self) -> &'static str {
         self.carries_c
+    }
+
+    /// The gain `--haptic-peak` gives this format's clip of `source` (1 for a format that is
+    /// no clip, or without the option): the same its sink finds.
+    pub(crate) fn clip_drive_gain(
+        self,
+        path: &Path,
+        source: &crate::clips::ClipSource,
+        options: &OutputOptions,
+    ) -> Result<clip::DriveGain, OutputError> {
+        match (options.haptic_peak, self.read_back) {
+            (Some(peak), Some(ReadBack::Clip(read, document))) => {
+                clip::DriveGain::of(document, read, path, source, options, peak)
+            }
+            _ => Ok(clip::DriveGain(1.0)),
+        }
     }
 
     /// How the fidelity report reads it back, if it is played.
@@ -332,6 +351,13 @@ pub struct OutputOptions {
     pub state_rate: StateRate,
     /// How the platform formats (rumble, DualSense, Android) are written.
     pub platforms: PlatformOptions,
+    /// `--loudness` and `--true-peak`: the level of the waveform files (MODEL.md §19).
+    pub level: LevelTarget,
+    /// `--haptic-peak`: the drive the strongest moment of every haptic clip reaches; `None`
+    /// keeps the model's own level (the output gain included).
+    pub haptic_peak: Option<HapticPeak>,
+    /// Measures the waveform's loudness even with no level asked (for a report).
+    pub measure_loudness: bool,
 }
 
 /// How the platform formats are written.
@@ -376,6 +402,9 @@ pub enum OutputError {
     /// The render itself failed.
     #[error(transparent)]
     Render(#[from] RenderError),
+    /// The render cannot be brought to the loudness asked.
+    #[error(transparent)]
+    Level(#[from] LevelError),
     /// The files asked for may need more memory than the machine has: refused before the
     /// render starts.
     #[error(

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use super::OutputError;
+use super::{OutputError, OutputOptions};
 use crate::clips::ClipSource;
 use crate::scene::Scene;
 
@@ -21,8 +21,12 @@ pub(crate) enum ReadBack {
         /// The platform limits the file met.
         limits: fn(&Scene) -> String,
     },
-    /// A clip: its onsets and its envelope, read from the file.
-    Clip(fn(&WrittenClip) -> Result<Reading, OutputError>),
+    /// A clip: its onsets and its envelope, read from the file; and the document its sink
+    /// writes of a clip (so its drive can be measured before it is written, `--haptic-peak`).
+    Clip(
+        fn(&WrittenClip) -> Result<Reading, OutputError>,
+        fn(&ClipSource, &OutputOptions) -> String,
+    ),
 }
 
 /// The limits column of a waveform its platform takes as it is: "—".
@@ -32,8 +36,10 @@ pub(crate) fn no_limits(_: &Scene) -> String {
 
 /// A clip's file as written, and the model's glugs it was written from.
 pub(crate) struct WrittenClip<'a> {
-    /// The file.
+    /// The file (named in errors).
     pub path: &'a Path,
+    /// Its text.
+    pub text: &'a str,
     /// The model's glugs.
     pub source: &'a ClipSource<'a>,
 }
@@ -41,8 +47,7 @@ pub(crate) struct WrittenClip<'a> {
 impl WrittenClip<'_> {
     /// The file as JSON.
     pub fn json(&self) -> Result<Value, OutputError> {
-        let text = std::fs::read_to_string(self.path).map_err(OutputError::io(self.path))?;
-        serde_json::from_str(&text).map_err(|error| OutputError::Io {
+        serde_json::from_str(self.text).map_err(|error| OutputError::Io {
             path: self.path.to_owned(),
             source: error.into(),
         })
@@ -60,6 +65,22 @@ pub(crate) struct Reading {
     pub envelope: Box<dyn Fn(f64) -> f64>,
     /// The platform limits the file met.
     pub limits: String,
+}
+
+impl Reading {
+    /// The strongest drive the format carries (0..1 of full scale): its envelope's largest
+    /// value, looked for at every mark and every 0.25 ms (a level is held at least 1 ms, and a
+    /// line between breakpoints peaks at one, each an onset's mark).
+    pub fn peak_drive(&self, duration_s: f64) -> f64 {
+        const EVERY_S: f64 = 0.000_25;
+        let grid = (0..=(duration_s / EVERY_S).ceil() as usize).map(|n| n as f64 * EVERY_S);
+        self.onsets
+            .iter()
+            .copied()
+            .chain(grid)
+            .map(|t| (self.envelope)(t))
+            .fold(0.0, f64::max)
+    }
 }
 
 /// The number at `key` of `value`, 0 if none.

@@ -4,8 +4,8 @@
 use serde::Serialize;
 
 use super::read_back::{array, held, number, ReadBack, Reading, WrittenClip};
-use super::{ClipSink, OutputError, OutputFormat, Sink, SinkContext};
-use crate::clips::{clip_onsets, ClipSource};
+use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
+use crate::clips::{glug_count, ClipSource};
 use crate::steps::rumble_frames;
 
 /// `rumble` (`.json`): frames of a dual-rumble gamepad's two motors.
@@ -15,7 +15,7 @@ pub(super) const FORMAT: OutputFormat = OutputFormat {
     by_extension: false,
     built: true,
     open,
-    read_back: Some(ReadBack::Clip(read_back)),
+    read_back: Some(ReadBack::Clip(read_back, document)),
     carries_c: "the motors' balance: low = the f1 part (c·a), high = the f2 part ((1 − c)·a)",
 };
 
@@ -42,11 +42,12 @@ pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, O
             rate_hz,
         });
     }
-    ClipSink::open(
-        context,
-        |source, options| rumble_json(source, options.platforms.rumble_rate_hz),
-        BYTES_PER_GLUG,
-    )
+    ClipSink::open(context, document, BYTES_PER_GLUG)
+}
+
+/// The frames of `source` at the options' rate.
+fn document(source: &ClipSource, options: &OutputOptions) -> String {
+    rumble_json(source, options.platforms.rumble_rate_hz)
 }
 
 #[derive(Serialize)]
@@ -82,13 +83,13 @@ pub fn rumble_json(source: &ClipSource, rate_hz: f64) -> String {
         .collect();
     let rumble = Rumble {
         description: format!(
-            "Sake Glug {}: scene {}, seed {}, {} glugs; low = the f1 component's envelope \
+            "Sake Glug {}: scene {}, seed {}, {}; low = the f1 component's envelope \
              (strong, low-frequency motor), high = the f2 component's (weak, high-frequency \
              motor), each held for 1/rate_hz",
             env!("CARGO_PKG_VERSION"),
             source.scene_name,
             source.seed,
-            clip_onsets(source).len()
+            glug_count(source)
         ),
         rate_hz,
         frames,
