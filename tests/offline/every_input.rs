@@ -68,6 +68,11 @@ fn readers() -> Vec<(&'static str, Reader)> {
         ("a stimulus's model file", |bad, folder| {
             stimulus("model", bad, folder)
         }),
+        ("a set's manifest (--take-from)", |bad, _| {
+            sake_glug_render::variations::read_take(bad, 1)
+                .map(drop)
+                .map_err(|e| e.to_string())
+        }),
         ("paired study log", |bad, _| {
             analyze_paired_logs(&[bad])
                 .map(drop)

@@ -113,10 +113,11 @@ struct ControlPoint {
 /// Core Haptics' limit on the length of one continuous event (s): longer rings are split.
 pub const CORE_HAPTICS_MAX_EVENT_S: f64 = 30.0;
 
-/// The most control points Core Haptics takes in one parameter curve: 16 (Apple, "Expanding
-/// the Sensory Experience with Core Haptics", WWDC 2019 session 520, on
-/// `CHHapticParameterCurve`; the limit the platform notes and the AHAP validator of the tests
-/// hold). A decay with more is continued by the next curve.
+/// The most control points a Core Haptics parameter curve is given here: 16, the limit our
+/// platform notes record for `CHHapticParameterCurve` (Apple's page on it,
+/// developer.apple.com/documentation/corehaptics/chhapticparametercurve, says a curve applies to
+/// every event of the pattern) and the AHAP validator of the tests holds. A decay with more is
+/// continued by the next curve.
 pub const CORE_HAPTICS_MAX_CURVE_POINTS: usize = 16;
 
 /// The sharpness written where nothing rings: the middle of the range.
