@@ -16,8 +16,8 @@ use sake_glug_io::text::{printable, quoted};
 use sake_glug_model_file::ModelFile;
 use sake_glug_render::clips::HapticBand;
 use sake_glug_render::fidelity::{self, fidelity_table, Fidelity};
-use sake_glug_render::silence::why_silent;
 use sake_glug_render::loudness::{parse_loudness, parse_true_peak, HapticPeak, LevelTarget};
+use sake_glug_render::silence::why_silent;
 use sake_glug_render::sinks::{AudioChannels, DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
 use sake_glug_render::trim::{check_trim_db, trimmed, DEFAULT_TRIM_DB, TRIM_FADE_S};
 use sake_glug_render::variations::{
