@@ -7,10 +7,12 @@
 //! time it gets there, each control but the tilt (a constant through the take), and each model
 //! constant, by the keys and within the ranges of their own tables.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
+use serde_json::value::RawValue;
 
 use super::automation::Automation;
 use super::scene::{Scene, MAX_DURATION_S};
@@ -503,27 +505,35 @@ fn take_from_csv(text: &str, number: u32) -> Result<Take, VariationError> {
 }
 
 fn take_from_json(text: &str, number: u32) -> Result<Take, VariationError> {
-    let manifest: serde_json::Value =
-        serde_json::from_str(text).map_err(|error| VariationError::Row(error.to_string()))?;
-    let rows = manifest
+    // Each value is kept as the text the manifest holds and parsed as the CSV's are
+    // (`str::parse`, correctly rounded), so a row reads back bit for bit without serde_json's
+    // `float_roundtrip`, a feature that would change how every crate of a build parses floats.
+    type Row = BTreeMap<String, Box<RawValue>>;
+    let bad = |error: serde_json::Error| VariationError::Row(error.to_string());
+    let manifest: BTreeMap<String, Box<RawValue>> = serde_json::from_str(text).map_err(bad)?;
+    let takes = manifest
         .get("takes")
-        .and_then(serde_json::Value::as_array)
         .ok_or_else(|| VariationError::Row("no `takes` list in it".into()))?;
+    let rows: Vec<Row> = serde_json::from_str(takes.get())
+        .map_err(|_| VariationError::Row("its `takes` is not a list of rows".into()))?;
     let row = rows
         .iter()
-        .filter_map(serde_json::Value::as_object)
-        .find(|row| row.get(TAKE_COLUMN).and_then(serde_json::Value::as_u64) == Some(number as u64))
-        .ok_or_else(|| VariationError::Row(format!("no take {number} in it")))?;
-    let fields: Vec<(String, String)> = row
-        .iter()
-        .map(|(column, value)| {
-            let text = match value {
-                serde_json::Value::String(text) => text.clone(),
-                other => other.to_string(),
-            };
-            (column.clone(), text)
+        .find(|row| {
+            row.get(TAKE_COLUMN)
+                .and_then(|value| value.get().parse::<u64>().ok())
+                == Some(number as u64)
         })
-        .collect();
+        .ok_or_else(|| VariationError::Row(format!("no take {number} in it")))?;
+    let mut fields = Vec::with_capacity(row.len());
+    for (column, value) in row {
+        let raw = value.get();
+        let text = if raw.starts_with('"') {
+            serde_json::from_str::<String>(raw).map_err(bad)?
+        } else {
+            raw.to_owned()
+        };
+        fields.push((column.clone(), text));
+    }
     Take::from_fields(
         number,
         fields
