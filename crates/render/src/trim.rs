@@ -8,7 +8,7 @@
 //! the untrimmed render's, bit for bit.
 
 use super::render::{render_scene, RenderError, RenderObserver};
-use super::scene::Scene;
+use super::scene::{FadeOut, Scene};
 use super::tables::UnitRow;
 use sake_glug_engine::{UnitOnset, Voicing};
 
@@ -18,42 +18,6 @@ pub const DEFAULT_TRIM_DB: f64 = -60.0;
 /// How long the fade after the trim point lasts (s): short enough to add nothing audible, long
 /// enough that the end does not click (the 80 Hz component turns by most of a period in it).
 pub const TRIM_FADE_S: f64 = 0.010;
-
-/// A fade to silence over the samples `start..end`, where the render ends: a raised cosine
-/// whose last sample is 0.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FadeOut {
-    /// The first sample the fade lowers.
-    pub start: u64,
-    /// The sample after the last: the render's end.
-    pub end: u64,
-}
-
-impl FadeOut {
-    /// The gain of sample `sample`: 1 before the fade, 0 after it.
-    pub fn gain(&self, sample: u64) -> f32 {
-        if sample < self.start {
-            return 1.0;
-        }
-        if sample >= self.end {
-            return 0.0;
-        }
-        let step = (sample - self.start + 1) as f64 / (self.end - self.start) as f64;
-        (0.5 * (1.0 + (std::f64::consts::PI * step).cos())) as f32
-    }
-
-    /// Fades the samples of `block`, whose first sample is `position`.
-    pub(crate) fn apply(&self, position: u64, block: &mut [f32]) {
-        let block_end = position + block.len() as u64;
-        if block_end <= self.start {
-            return;
-        }
-        let first = self.start.saturating_sub(position) as usize;
-        for (index, sample) in block.iter_mut().enumerate().skip(first) {
-            *sample *= self.gain(position + index as u64);
-        }
-    }
-}
 
 /// A `--trim` level that cannot be used.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

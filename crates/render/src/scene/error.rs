@@ -72,7 +72,7 @@ pub enum SceneError {
     },
     /// A `[variations]` table that cannot be drawn from: its message names the key.
     #[error(transparent)]
-    Variations(#[from] crate::variations::VariationError),
+    Variations(#[from] super::variations_table::VariationError),
     /// A value that must be a whole number (the sample rate) has a fraction.
     #[error("`{key}` = {value} is not a whole number: {what}")]
     NotWhole {

@@ -6,17 +6,18 @@
 //! scene, [`lanes`] its automation lanes (inline or from CSV); here, the scene and what the
 //! renderer asks of it.
 
+mod duration;
 mod error;
+mod fade_out;
 mod inputs;
 mod lanes;
 mod take;
 mod validate;
+pub(crate) mod variations_table;
 
 use std::path::Path;
 
 use super::automation::Automation;
-use super::trim::FadeOut;
-use super::variations::VariationSpec;
 use sake_glug_device::midi::MidiMap;
 use sake_glug_engine::{
     sample_time_s, ActuatorResponse, Control, ControlSource, ControlValues, Controls, ModelConfig,
@@ -26,10 +27,13 @@ use sake_glug_io::keys;
 use sake_glug_io::read::{self, InputKind};
 use sake_glug_model_file::ModelFile;
 
+pub use duration::MAX_DURATION_S;
 pub use error::SceneError;
+pub use fade_out::FadeOut;
 pub use inputs::InputFile;
 pub use take::MidiTake;
 use validate::{check_sample_rate, SceneFile, MIDI_TAKE};
+use variations_table::VariationSpec;
 
 /// The built-in default scene: a full 300 ml bottle of water tilted from 90° to 135° over half a
 /// second and held until it stops pouring.
@@ -39,9 +43,6 @@ tilt_deg = [[0.0, 90.0], [0.5, 135.0]]
 
 /// The largest scene file read ([`InputKind::SCENE`]).
 pub const MAX_SCENE_BYTES: u64 = InputKind::SCENE.max_bytes;
-
-/// Longest render a scene may ask for (and the limit on one that never falls silent).
-pub const MAX_DURATION_S: f64 = 86_400.0;
 
 /// A validated scene, ready to render.
 #[derive(Debug, Clone, PartialEq)]

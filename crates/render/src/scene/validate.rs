@@ -5,9 +5,9 @@ use std::path::{Path, PathBuf};
 
 use super::error::syntax;
 use super::lanes::{automation, resolve};
+use super::variations_table::VariationSpec;
 use super::{InputFile, MidiTake, Scene, SceneError, MAX_DURATION_S};
 use crate::automation::LaneSpec;
-use crate::variations::VariationSpec;
 use sake_glug_device::midi::{MidiMap, MidiSetting};
 use sake_glug_engine::config;
 use sake_glug_engine::{
@@ -24,7 +24,7 @@ const DETERMINISTIC: &str = "deterministic";
 pub(super) const MIDI_TAKE: &str = "midi_take";
 const DRAIN: &str = config::DRAIN.scene_key;
 /// The table of what a set of takes draws (MODEL.md §10.2).
-const VARIATIONS: &str = crate::variations::VARIATIONS_KEY;
+const VARIATIONS: &str = super::variations_table::VARIATIONS_KEY;
 /// The table of the plugin's saved MIDI settings, by their names in the state.
 const MIDI_SECTION: &str = "midi";
 
