@@ -5,6 +5,7 @@
 //! answers end before the first.
 
 use std::path::Path;
+use std::process::Output;
 
 use super::{log_rows, refused, run, spec, SHORT_PAIRED};
 use sake_glug_study::{order_seed, plan_trials, Design};
@@ -44,10 +45,16 @@ fn rows(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
         .collect()
 }
 
-fn session(dir: &Path, participant: &str, log: &str, extra: &[&str], input: &str) -> String {
+/// `experiment study.toml --participant PARTICIPANT --log LOG EXTRA…` with `input` as its answers.
+fn session_output(dir: &Path, participant: &str, log: &str, extra: &[&str], input: &str) -> Output {
     let mut args = vec!["study.toml", "--participant", participant, "--log", log];
     args.extend_from_slice(extra);
-    let output = run(dir, &args, input);
+    run(dir, &args, input)
+}
+
+/// [`session_output`] of a session that must succeed: its stderr.
+fn session(dir: &Path, participant: &str, log: &str, extra: &[&str], input: &str) -> String {
+    let output = session_output(dir, participant, log, extra, input);
     let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
     assert!(output.status.success(), "{stderr}");
     stderr
@@ -161,17 +168,11 @@ fn a_triangle_and_an_abx_session_log_whether_the_answer_was_right() {
 fn a_triangle_session_resumes_in_its_order() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("study.toml"), study("triangle")).unwrap();
-    let output = run(
+    let output = session_output(
         dir.path(),
-        &[
-            "study.toml",
-            "--participant",
-            "p3",
-            "--log",
-            "cut.csv",
-            "--dry-run",
-            "a",
-        ],
+        "p3",
+        "cut.csv",
+        &["--dry-run", "a"],
         &format!("\n{}", "2\n".repeat(5)),
     );
     assert_eq!(output.status.code(), Some(1));
@@ -242,17 +243,11 @@ const NEWER: [&str; 6] = [
 fn an_earlier_runners_log_resumes_in_its_columns_or_is_refused_by_name() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("study.toml"), SHORT_PAIRED).unwrap();
-    let output = run(
+    let output = session_output(
         dir.path(),
-        &[
-            "study.toml",
-            "--participant",
-            "p1",
-            "--log",
-            "old.csv",
-            "--dry-run",
-            "d",
-        ],
+        "p1",
+        "old.csv",
+        &["--dry-run", "d"],
         &format!("\n{}", "1\n".repeat(4)),
     );
     assert_eq!(output.status.code(), Some(1));
@@ -284,34 +279,21 @@ fn an_earlier_runners_log_resumes_in_its_columns_or_is_refused_by_name() {
     );
 
     std::fs::write(dir.path().join("study.toml"), study("triangle")).unwrap();
-    let output = run(
+    let output = session_output(
         dir.path(),
-        &[
-            "study.toml",
-            "--participant",
-            "p1",
-            "--log",
-            "tri.csv",
-            "--dry-run",
-            "t",
-        ],
+        "p1",
+        "tri.csv",
+        &["--dry-run", "t"],
         &format!("\n{}", "1\n".repeat(3)),
     );
     assert_eq!(output.status.code(), Some(1));
     older(&dir.path().join("tri.csv"), &["correct"]);
     let before = std::fs::read(dir.path().join("tri.csv")).unwrap();
-    let output = run(
+    let output = session_output(
         dir.path(),
-        &[
-            "study.toml",
-            "--participant",
-            "p1",
-            "--log",
-            "tri.csv",
-            "--dry-run",
-            "t",
-            "--resume",
-        ],
+        "p1",
+        "tri.csv",
+        &["--dry-run", "t", "--resume"],
         "\n1\n",
     );
     refused(
@@ -339,17 +321,11 @@ fn a_dry_run_whose_answers_end_before_the_first_ends_there() {
         assert!(dir.path().join(&folder).join("trials.csv").exists());
         assert!(log_rows(&dir.path().join(&log)).is_empty());
     }
-    let output = run(
+    let output = session_output(
         dir.path(),
-        &[
-            "study.toml",
-            "--participant",
-            "p1",
-            "--log",
-            "later.csv",
-            "--dry-run",
-            "later",
-        ],
+        "p1",
+        "later.csv",
+        &["--dry-run", "later"],
         "\n1\n",
     );
     assert_eq!(output.status.code(), Some(1));
