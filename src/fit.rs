@@ -95,15 +95,18 @@ pub fn run(args: FitArgs) -> ExitCode {
         Ok((files, fit)) => {
             for recording in &fit.recordings {
                 eprintln!(
-                    "{}: {} of {} units used, explaining {:.0} % of its energy",
+                    "{}: {} audible glug units, {} used, explaining {:.0} % of its energy",
                     sake_glug_io::text::printable(&recording.name()),
-                    recording.units.len(),
                     recording.detected.len(),
+                    recording.units.len(),
                     100.0 * recording.explained.max(0.0)
                 );
             }
             for liquid in &fit.liquids {
-                eprintln!("{}: {} units fitted", liquid.liquid, liquid.units);
+                eprintln!(
+                    "{}: {} audible glug units fitted",
+                    liquid.liquid, liquid.units
+                );
             }
             for warning in &fit.warnings {
                 eprintln!("warning: {}", sake_glug_io::text::printable(warning));

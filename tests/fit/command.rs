@@ -135,8 +135,24 @@ fn a_good_session_writes_the_model_the_report_and_the_plot_and_the_model_renders
     assert_refused(
         &output,
         0,
-        &["units fitted", "model.toml", "fit.md", "fit.png"],
+        &[
+            "audible glug units fitted",
+            "model.toml",
+            "fit.md",
+            "fit.png",
+        ],
     );
+    // Its count names what the render's summary names: a recording carries audible units only,
+    // so they are called so, and the ones used are a part of them (issue 40).
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let counts = stderr
+        .lines()
+        .find_map(|line| line.strip_prefix("a.wav: "))
+        .and_then(|rest| rest.split_once(" audible glug units, "))
+        .and_then(|(heard, rest)| Some((heard, rest.split_once(" used, explaining ")?.0)))
+        .unwrap_or_else(|| panic!("no \"a.wav: N audible glug units, M used\" in: {stderr}"));
+    let (heard, used): (usize, usize) = (counts.0.parse().unwrap(), counts.1.parse().unwrap());
+    assert!(used <= heard && used > 10, "{stderr}");
     assert_eq!(
         files_in(dir),
         ["a.wav", "fit.md", "fit.png", "model.toml", "session.toml"]
@@ -237,7 +253,7 @@ fn a_clip_alone_is_fitted_with_every_output() {
             "--json",
         ],
     );
-    assert_refused(&output, 0, &["clip.wav", "units used", "explaining"]);
+    assert_refused(&output, 0, &["clip.wav", "audible glug units, ", "explaining"]);
     let units = std::fs::read_to_string(dir.join("units.csv")).unwrap();
     let mut lines = units.lines();
     assert_eq!(

@@ -230,13 +230,16 @@ fn draw_measures_panel(panel: &Canvas<'_>, comparison: &Comparison) -> Result<()
             String::new(),
             ["recording", "model", "default"].map(str::to_owned),
         ),
-        ("glugs".into(), each(&|h| h.onsets_s.len().to_string())),
+        (
+            "audible glug units".into(),
+            each(&|h| h.onsets_s.len().to_string()),
+        ),
         (
             "glugs a second".into(),
             each(&|h| format!("{:.1}", h.rate_per_s)),
         ),
         (
-            format!("pitch fall over {glugs} glugs"),
+            format!("pitch fall over {glugs} units"),
             each(&|h| format!("{:.2}×", h.fall_over(glugs))),
         ),
         (

@@ -38,7 +38,7 @@ pub fn report_markdown(fit: &SessionFit) -> String {
     let _ = writeln!(out, "## Recordings\n");
     let _ = writeln!(
         out,
-        "| recording | file | liquid | tilt (°) | rate (Hz) | length (s) | units detected | used | energy explained | outflow (ml/s) | from | rest (ml) |"
+        "| recording | file | liquid | tilt (°) | rate (Hz) | length (s) | audible glug units | used | energy explained | outflow (ml/s) | from | rest (ml) |"
     );
     let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for recording in &fit.recordings {
@@ -81,7 +81,7 @@ pub fn report_markdown(fit: &SessionFit) -> String {
     for liquid in &fit.liquids {
         let _ = writeln!(
             out,
-            "\n## Liquid `{}` ({} of {} detected units used)\n",
+            "\n## Liquid `{}` ({} of {} audible glug units used)\n",
             cell(&liquid.liquid),
             liquid.units,
             liquid.detected
