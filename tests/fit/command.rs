@@ -253,7 +253,11 @@ fn a_clip_alone_is_fitted_with_every_output() {
             "--json",
         ],
     );
-    assert_refused(&output, 0, &["clip.wav", "audible glug units, ", "explaining"]);
+    assert_refused(
+        &output,
+        0,
+        &["clip.wav", "audible glug units, ", "explaining"],
+    );
     let units = std::fs::read_to_string(dir.join("units.csv")).unwrap();
     let mut lines = units.lines();
     assert_eq!(

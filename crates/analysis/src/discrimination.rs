@@ -34,23 +34,28 @@ pub const MAX_D_PRIME: f64 = 15.0;
 pub const CONFIDENCE: f64 = 0.95;
 
 /// A discrimination design and its decision model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DiscriminationDesign {
     /// Three stimuli, two alike: which one is different? (oddity, differencing model).
     Triangle,
     /// Two stimuli: which one is the named one? (two-alternative forced choice).
-    #[serde(rename = "2afc")]
     TwoAfc,
     /// A, B, then X: is X the same as A or as B? (differencing model).
     Abx,
+}
+
+/// Written by its name, as the log and the command line write it.
+impl Serialize for DiscriminationDesign {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name())
+    }
 }
 
 impl DiscriminationDesign {
     /// Every design, in the order the help lists them.
     pub const ALL: [Self; 3] = [Self::Triangle, Self::TwoAfc, Self::Abx];
 
-    /// Its name in the spec, the log and the command line.
+    /// Its name in the spec, the log and the command line (the study's `Design` names it so).
     pub fn name(self) -> &'static str {
         match self {
             Self::Triangle => "triangle",

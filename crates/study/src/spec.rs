@@ -8,15 +8,18 @@ use serde::Deserialize;
 
 use super::recording::Recording;
 use super::StudyError;
+use sake_glug_analysis::DiscriminationDesign;
 use sake_glug_engine::{Constant, Control, Preset};
 use sake_glug_io::keys::{self, KeyedTable};
 use sake_glug_io::read::{self, InputKind};
 use sake_glug_io::text::{cut_quotes, quoted};
 use sake_glug_render::{Scene, DEFAULT_SCENE, MAX_DURATION_S};
 
-/// The designs: the paper's two studies, and three of discrimination.
+/// The designs: the paper's two studies, and three of discrimination. The names of the
+/// discrimination designs are the analysis's ([`DiscriminationDesign::name`]), which reads
+/// their logs: one declaration for the spec, the log, the runner and `analyze`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[serde(try_from = "String")]
 pub enum Design {
     /// Every ordered pair of named stimuli (§3).
     Paired,
@@ -24,7 +27,6 @@ pub enum Design {
     Constant,
     /// Two stimuli, the `target` first in half the trials: which one is the target?
     /// (two-alternative forced choice; `sake-glug analyze discrimination` reads its log).
-    #[serde(rename = "2afc")]
     TwoAfc,
     /// Two stimuli, three intervals, two alike: which one is different? (oddity; either
     /// stimulus the odd one, at each place).
@@ -36,12 +38,21 @@ pub enum Design {
 impl Design {
     /// Its name in the spec and the log.
     pub fn name(self) -> &'static str {
+        match self.discrimination() {
+            Some(design) => design.name(),
+            None if self == Design::Paired => "paired",
+            None => "constant",
+        }
+    }
+
+    /// The discrimination design it is, as `sake-glug analyze discrimination` reads its log;
+    /// `None` for the paper's two.
+    pub fn discrimination(self) -> Option<DiscriminationDesign> {
         match self {
-            Design::Paired => "paired",
-            Design::Constant => "constant",
-            Design::TwoAfc => "2afc",
-            Design::Triangle => "triangle",
-            Design::Abx => "abx",
+            Design::Paired | Design::Constant => None,
+            Design::TwoAfc => Some(DiscriminationDesign::TwoAfc),
+            Design::Triangle => Some(DiscriminationDesign::Triangle),
+            Design::Abx => Some(DiscriminationDesign::Abx),
         }
     }
 
@@ -77,7 +88,26 @@ impl Design {
 
     /// Whether its log rows say if the answer was right (the discrimination designs).
     pub fn discriminates(self) -> bool {
-        matches!(self, Design::TwoAfc | Design::Triangle | Design::Abx)
+        self.discrimination().is_some()
+    }
+}
+
+impl TryFrom<String> for Design {
+    type Error = String;
+
+    /// A spec's `design`, by name; else the names it could be.
+    fn try_from(name: String) -> Result<Self, String> {
+        Self::from_name(&name).ok_or_else(|| {
+            let names: Vec<String> = Self::ALL
+                .iter()
+                .map(|design| format!("`{}`", design.name()))
+                .collect();
+            format!(
+                "`{}`: not a design; expected one of {}",
+                quoted(&name),
+                names.join(", ")
+            )
+        })
     }
 }
 

@@ -49,6 +49,30 @@ fn error_of(text: &str) -> String {
     spec(text).unwrap_err().to_string()
 }
 
+/// A spec's design is one of the runner's, named as `analyze discrimination` names the
+/// discrimination designs (one declaration); an unknown one is refused with the list.
+#[test]
+fn designs_are_named_as_the_analysis_names_them() {
+    for design in Design::ALL {
+        assert_eq!(Design::from_name(design.name()), Some(design));
+        if let Some(analysed) = design.discrimination() {
+            assert_eq!(design.name(), analysed.name());
+        }
+        let parsed = spec(&SHORT_PAIRED.replace("\"paired\"", &format!("\"{}\"", design.name())));
+        if let Ok(parsed) = parsed {
+            assert_eq!(parsed.design, design);
+        }
+    }
+    let unknown = error_of(&SHORT_PAIRED.replace("\"paired\"", "\"2AFC\""));
+    assert!(
+        unknown.contains(
+            "`2AFC`: not a design; expected one of `paired`, `constant`, `2afc`, \
+                          `triangle`, `abx`"
+        ),
+        "{unknown}"
+    );
+}
+
 #[test]
 fn spec_errors_name_the_file_and_the_key() {
     let unknown = error_of(&SHORT_PAIRED.replace("seed = 9", "seeds = 9"));
