@@ -5,7 +5,7 @@
 
 use std::io::Write;
 
-use super::{answers, log_rows, run, spec, start, wait_for_rows, SHORT_PAIRED};
+use super::{answers, log_rows, run, session, spec, start, wait_for_rows, SHORT_PAIRED};
 use sake_glug_study::{order_seed, plan_practice, plan_trials};
 
 /// SHORT_PAIRED (12 trials) with instructions, 3 practice trials and a break every 5.
@@ -29,21 +29,7 @@ fn instructions_practice_and_breaks_come_as_the_spec_says() {
         "1\n".repeat(5),
         "1\n".repeat(2)
     );
-    let args = [
-        "study.toml",
-        "--participant",
-        "p1",
-        "--log",
-        "log.csv",
-        "--dry-run",
-        "dry",
-    ];
-    let output = run(dir.path(), &args, &input);
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    let output = session(dir.path(), "p1", "log.csv", &["--dry-run", "dry"], &input);
     let stdout = String::from_utf8_lossy(&output.stdout);
     let instructions = stdout.find("Feel each pour.\nThen say which.\nPress Enter to begin.");
     let first_practice = stdout.find("Practice trial 1/3");
@@ -157,20 +143,13 @@ fn a_session_killed_in_its_practice_resumes_in_its_practice() {
 fn a_spec_without_them_runs_as_before() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("study.toml"), SHORT_PAIRED).unwrap();
-    let output = run(
+    let output = session(
         dir.path(),
-        &[
-            "study.toml",
-            "--participant",
-            "p3",
-            "--log",
-            "log.csv",
-            "--dry-run",
-            "dry",
-        ],
+        "p3",
+        "log.csv",
+        &["--dry-run", "dry"],
         &answers(12),
     );
-    assert!(output.status.success());
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(
         !stdout.contains("Practice") && !stdout.contains("Break"),

@@ -310,6 +310,25 @@ fn equalized_stimuli_have_equal_levels() {
     }
 }
 
+/// `experiment study.toml --participant PARTICIPANT --log LOG EXTRA…` in `dir`, with `input` as
+/// its answers.
+fn session_output(dir: &Path, participant: &str, log: &str, extra: &[&str], input: &str) -> Output {
+    let mut args = vec!["study.toml", "--participant", participant, "--log", log];
+    args.extend_from_slice(extra);
+    run(dir, &args, input)
+}
+
+/// [`session_output`] of a session that must succeed.
+fn session(dir: &Path, participant: &str, log: &str, extra: &[&str], input: &str) -> Output {
+    let output = session_output(dir, participant, log, extra, input);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    output
+}
+
 /// Runs `sake-glug experiment ARGS` in `dir` to its end with `input` on its stdin; a run that
 /// has not ended after a minute (it waits on something: a FIFO, a lock) is killed and fails.
 fn run(dir: &Path, args: &[&str], input: &str) -> Output {

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use sake_glug_study::{level_of, render_stimuli, Equalize, Source, Spec};
 
-use super::{log_rows, run};
+use super::{log_rows, run, session};
 
 const RATE: u32 = 48_000;
 
@@ -135,23 +135,12 @@ fn a_dry_run_plays_the_same_recorded_samples_at_every_presentation() {
     let dir = tempfile::tempdir().unwrap();
     write_wav(&dir.path().join("take.wav"), RATE, tone);
     std::fs::write(dir.path().join("study.toml"), recorded_spec("")).unwrap();
-    let output = run(
+    session(
         dir.path(),
-        &[
-            "study.toml",
-            "--participant",
-            "p1",
-            "--log",
-            "log.csv",
-            "--dry-run",
-            "dry",
-        ],
+        "p1",
+        "log.csv",
+        &["--dry-run", "dry"],
         &format!("\n{}", "2\n".repeat(4)),
-    );
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
     );
     let files: Vec<_> = std::fs::read_dir(dir.path().join("dry"))
         .unwrap()

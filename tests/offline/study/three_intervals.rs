@@ -5,9 +5,8 @@
 //! answers end before the first.
 
 use std::path::Path;
-use std::process::Output;
 
-use super::{log_rows, refused, run, spec, SHORT_PAIRED};
+use super::{log_rows, refused, session, session_output, spec, SHORT_PAIRED};
 use sake_glug_study::{order_seed, plan_trials, Design};
 
 fn study(design: &str) -> String {
@@ -43,21 +42,6 @@ fn rows(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
                 .collect()
         })
         .collect()
-}
-
-/// `experiment study.toml --participant PARTICIPANT --log LOG EXTRA…` with `input` as its answers.
-fn session_output(dir: &Path, participant: &str, log: &str, extra: &[&str], input: &str) -> Output {
-    let mut args = vec!["study.toml", "--participant", participant, "--log", log];
-    args.extend_from_slice(extra);
-    run(dir, &args, input)
-}
-
-/// [`session_output`] of a session that must succeed: its stderr.
-fn session(dir: &Path, participant: &str, log: &str, extra: &[&str], input: &str) -> String {
-    let output = session_output(dir, participant, log, extra, input);
-    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
-    assert!(output.status.success(), "{stderr}");
-    stderr
 }
 
 #[test]
@@ -313,7 +297,8 @@ fn a_dry_run_whose_answers_end_before_the_first_ends_there() {
     for input in ["", "\n"] {
         let log = format!("log{}.csv", input.len());
         let folder = format!("dry{}", input.len());
-        let stderr = session(dir.path(), "p1", &log, &["--dry-run", &folder], input);
+        let output = session(dir.path(), "p1", &log, &["--dry-run", &folder], input);
+        let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(
             stderr.contains("ended before the first one") && stderr.contains("--no-answers"),
             "{stderr}"

@@ -2,7 +2,7 @@
 //! order `repetitions` times, shuffled from the participant's seed); the log says whether the
 //! target was chosen, and `sake-glug analyze discrimination` reads it.
 
-use super::{log_rows, run, spec};
+use super::{log_rows, session, spec};
 use sake_glug_study::{order_seed, plan_trials, Design};
 
 const TWO_AFC: &str = r#"
@@ -40,23 +40,12 @@ fn a_2afc_session_logs_whether_the_target_was_chosen_and_is_analysed() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("study.toml"), TWO_AFC).unwrap();
     // Always the first: right exactly when the target came first.
-    let output = run(
+    session(
         dir.path(),
-        &[
-            "study.toml",
-            "--participant",
-            "p1",
-            "--log",
-            "log.csv",
-            "--dry-run",
-            "dry",
-        ],
+        "p1",
+        "log.csv",
+        &["--dry-run", "dry"],
         &format!("\n{}", "1\n".repeat(8)),
-    );
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
     );
     let rows = log_rows(&dir.path().join("log.csv"));
     let header = csv::Reader::from_path(dir.path().join("log.csv"))
