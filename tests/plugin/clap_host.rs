@@ -203,14 +203,24 @@ impl ClapInstance {
             .into_owned()
     }
 
-    /// Every parameter as (name, CLAP flags).
-    pub fn parameter_infos(&self) -> Vec<(String, u32)> {
+    /// Every parameter's CLAP info, in the plugin's order.
+    fn parameters(&self) -> Vec<clap_param_info> {
         let params: &clap_plugin_params = self.extension(CLAP_EXT_PARAMS);
         let count = unsafe { (params.count.unwrap())(self.plugin) };
         (0..count)
             .map(|index| {
                 let mut info: clap_param_info = unsafe { std::mem::zeroed() };
                 assert!(unsafe { (params.get_info.unwrap())(self.plugin, index, &mut info) });
+                info
+            })
+            .collect()
+    }
+
+    /// Every parameter as (name, CLAP flags).
+    pub fn parameter_infos(&self) -> Vec<(String, u32)> {
+        self.parameters()
+            .into_iter()
+            .map(|info| {
                 let name = unsafe { CStr::from_ptr(info.name.as_ptr()) };
                 (name.to_string_lossy().into_owned(), info.flags)
             })
@@ -220,11 +230,9 @@ impl ClapInstance {
     /// Every parameter as (name, CLAP value, declared min, declared max).
     pub fn parameter_values(&self) -> Vec<(std::ffi::CString, f64, f64, f64)> {
         let params: &clap_plugin_params = self.extension(CLAP_EXT_PARAMS);
-        let count = unsafe { (params.count.unwrap())(self.plugin) };
-        (0..count)
-            .map(|index| {
-                let mut info: clap_param_info = unsafe { std::mem::zeroed() };
-                assert!(unsafe { (params.get_info.unwrap())(self.plugin, index, &mut info) });
+        self.parameters()
+            .into_iter()
+            .map(|info| {
                 let mut value = f64::NAN;
                 assert!(unsafe { (params.get_value.unwrap())(self.plugin, info.id, &mut value) });
                 let name = unsafe { CStr::from_ptr(info.name.as_ptr()) }.to_owned();
@@ -395,6 +403,17 @@ impl Drop for ClapInstance {
     }
 }
 
+/// The header of a core CLAP event of type `Event` at sample `time` of a call.
+fn core_event_header<Event>(time: u32, type_: u16) -> clap_event_header {
+    clap_event_header {
+        size: std::mem::size_of::<Event>() as u32,
+        time,
+        space_id: CLAP_CORE_EVENT_SPACE_ID,
+        type_,
+        flags: 0,
+    }
+}
+
 /// A parameter's new CLAP value from a sample of a render on.
 #[derive(Debug, Clone, Copy)]
 pub struct ParamChange {
@@ -407,13 +426,7 @@ pub struct ParamChange {
 impl ParamChange {
     fn event(&self, time: u32) -> clap_event_param_value {
         clap_event_param_value {
-            header: clap_event_header {
-                size: std::mem::size_of::<clap_event_param_value>() as u32,
-                time,
-                space_id: CLAP_CORE_EVENT_SPACE_ID,
-                type_: CLAP_EVENT_PARAM_VALUE,
-                flags: 0,
-            },
+            header: core_event_header::<clap_event_param_value>(time, CLAP_EVENT_PARAM_VALUE),
             param_id: self.param_id,
             cookie: ptr::null_mut(),
             note_id: -1,
@@ -440,13 +453,7 @@ pub struct MidiCc {
 impl MidiCc {
     fn event(&self, time: u32) -> clap_event_midi {
         clap_event_midi {
-            header: clap_event_header {
-                size: std::mem::size_of::<clap_event_midi>() as u32,
-                time,
-                space_id: CLAP_CORE_EVENT_SPACE_ID,
-                type_: CLAP_EVENT_MIDI,
-                flags: 0,
-            },
+            header: core_event_header::<clap_event_midi>(time, CLAP_EVENT_MIDI),
             port_index: 0,
             data: [0xB0 | (self.channel & 0x0F), self.cc, self.value],
         }

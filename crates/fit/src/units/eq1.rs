@@ -63,19 +63,10 @@ pub(super) fn fit(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<U
         decay_per_s[0],
         decay_per_s[1],
     ];
-    let problem = UnitProblem::new(
-        &window,
-        start_s,
-        Vector7::from_column_slice(&[
-            0.0,
-            amplitude[0],
-            amplitude[1],
-            frequency_hz[0],
-            frequency_hz[1],
-            decay_per_s[0],
-            decay_per_s[1],
-        ]),
-    );
+    // The problem's first parameter is the onset's shift from `start_s` (ms), so it starts at 0.
+    let mut shifted = Vector7::from_column_slice(&start);
+    shifted[0] = 0.0;
+    let problem = UnitProblem::new(&window, start_s, shifted);
     let (problem, _report) = LevenbergMarquardt::new()
         .with_patience(LM_PATIENCE)
         .minimize(problem);
