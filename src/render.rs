@@ -925,7 +925,7 @@ fn level_note(report: &RenderReport, haptic_peak: Option<HapticPeak>) -> String 
         }
     }
     if let Some(peak) = haptic_peak {
-        note += &format!("; haptic clips at {peak} peak drive");
+        note += &format!("; haptic clips and haptic channels at {peak} peak drive");
     }
     note
 }
