@@ -16,7 +16,9 @@ use sake_glug_io::text::{printable, quoted};
 use sake_glug_model_file::ModelFile;
 use sake_glug_render::clips::HapticBand;
 use sake_glug_render::fidelity::{self, fidelity_table, Fidelity};
-use sake_glug_render::loudness::{parse_loudness, parse_true_peak, HapticPeak, LevelTarget};
+use sake_glug_render::loudness::{
+    parse_loudness, parse_true_peak, HapticPeak, LevelTarget, Loudness,
+};
 use sake_glug_render::silence::why_silent;
 use sake_glug_render::sinks::{AudioChannels, DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
 use sake_glug_render::trim::{check_trim_db, trimmed, DEFAULT_TRIM_DB, TRIM_FADE_S};
@@ -138,8 +140,10 @@ pub struct RenderArgs {
     true_peak: Option<f64>,
     /// Scales every haptic clip (.haptic, .ahap, .haps, Android XML and waveform, rumble) so its
     /// strongest moment, as the format carries it, reaches this drive: 100%, a level in dB
-    /// (-3dB) or a fraction (0.8). The actuator's compensation (--actuator) comes first. Without
-    /// it a clip keeps the model's level, output gain included.
+    /// (-3dB) or a fraction (0.8); and the haptic channels of dualsense and android-ogg so their
+    /// largest sample does (their audio channels keep --loudness). The actuator's compensation
+    /// (--actuator) comes first. Without it a clip keeps the model's level, output gain
+    /// included.
     #[arg(long, value_name = "DRIVE", allow_hyphen_values = true)]
     haptic_peak: Option<HapticPeak>,
     /// Measures what every format keeps of the render (onsets, envelope, what carries c, size,
@@ -710,12 +714,19 @@ fn render_job(
         .iter()
         .map(|take| take.apply(scene.clone()))
         .collect::<Result<Vec<_>, _>>()?;
+    // Each take's level is measured on the samples its files are written from, for the
+    // manifest (MODEL.md §10.2).
+    let options = &OutputOptions {
+        measure_loudness: true,
+        ..*options
+    };
     let mut rendered = Vec::with_capacity(takes.len());
+    let mut measured = Vec::with_capacity(takes.len());
     for (index, (take, take_scene)) in takes.iter().zip(scenes).enumerate() {
         let name = take.name(&set_name, count);
         let outputs = take_outputs(&job.outputs, &name);
         let share = |fraction: f64| (index as f64 + fraction) / count as f64;
-        rendered.push(render_one(
+        let take_rendered = render_one(
             name,
             &job.name,
             take_scene,
@@ -724,7 +735,13 @@ fn render_job(
             options,
             stop,
             |fraction| progress(share(fraction)),
-        )?);
+        )?;
+        let level = take_rendered
+            .report
+            .levelled
+            .expect("a take's level is measured");
+        measured.push((take.clone(), level.after));
+        rendered.push(take_rendered);
     }
     let folder = match (&args.out_dir, job.outputs.first()) {
         (Some(directory), _) => directory.clone(),
@@ -741,7 +758,7 @@ fn render_job(
         job.scene.as_deref(),
         master_seed,
         &ranges,
-        &takes,
+        &measured,
     )?;
     Ok(JobDone {
         takes: rendered,
@@ -767,7 +784,7 @@ fn write_manifests(
     scene_file: Option<&Path>,
     master_seed: u64,
     ranges: &[(sake_glug_render::variations::Varied, [f64; 2])],
-    takes: &[Take],
+    takes: &[(Take, Loudness)],
 ) -> Result<Vec<(PathBuf, u64)>, JobError> {
     let [csv_path, json_path] = manifest_paths(folder, set_name);
     let texts = [
@@ -908,7 +925,7 @@ fn level_note(report: &RenderReport, haptic_peak: Option<HapticPeak>) -> String 
         }
     }
     if let Some(peak) = haptic_peak {
-        note += &format!("; haptic clips at {peak} peak drive");
+        note += &format!("; haptic clips and haptic channels at {peak} peak drive");
     }
     note
 }

@@ -47,6 +47,8 @@ def render(
     seed: Optional[int] = None,
     take: Optional[Mapping[str, Union[int, float, str]]] = None,
     trim: Union[bool, float, None] = None,
+    loudness: Optional[float] = None,
+    true_peak: Optional[float] = None,
 ) -> npt.NDArray[np.float32]:
     """Renders a scene and returns its samples (mono, float32), bit for bit those of
     `sake-glug render` of the same scene.
@@ -67,8 +69,11 @@ def render(
     set again, bit for bit, from its row of the set's manifest (a row of render_variations(),
     or of NAME.variations.json), as --take-from does; trim ends the samples once the last glug
     has decayed below a level re their peak, with a 10 ms fade (--trim): True for -60 dB, or a
-    level in dB below 0. A render in which nothing sounds warns (UserWarning) with the command
-    line's reason.
+    level in dB below 0. loudness brings the samples to an integrated loudness (LUFS, -70 to
+    0; BS.1770-4 gated as EBU R128) and true_peak keeps their true peak (dBTP, -60 to 0, 4x
+    oversampled) under a ceiling, as --loudness and --true-peak do (the ceiling wins; a render
+    under 0.4 s or silent is refused with the command line's message; MODEL.md §19). A render
+    in which nothing sounds warns (UserWarning) with the command line's reason.
 
     The samples are held in memory: a render that cannot fit (a day at 48 kHz is 16.6 GB) is
     refused before it starts, or, without duration_s, as soon as it outgrows the memory
@@ -84,13 +89,17 @@ def render_variations(
     trim: Union[bool, float, None] = None,
     actuator: _Actuator = None,
     felt: bool = False,
+    loudness: Optional[float] = None,
+    true_peak: Optional[float] = None,
 ) -> List[Tuple[Dict[str, Union[int, float]], npt.NDArray[np.float32]]]:
     """Renders a set of takes of a scene, as `sake-glug render --variations COUNT` does, and
     returns [(row, samples)] in take order: row is the take's row of the set's manifest
-    ({"take": k, "seed": ..., and each drawn value by its key}), samples those of the command
-    line's take k, bit for bit; render(scene, take=row) renders it again. count defaults to the
-    scene's [variations] count; seed is the master seed (default: the scene's seed); the
-    other arguments are render()'s, for every take."""
+    ({"take": k, "seed": ..., each drawn value by its key, then loudness_lufs and
+    true_peak_dbtp, measured on the samples returned}), samples those of the command line's
+    take k, bit for bit; render(scene, take=row) renders it again (the measured columns are
+    ignored). count defaults to the scene's [variations] count; seed is the master seed
+    (default: the scene's seed); the other arguments are render()'s, for every take (loudness
+    and true_peak level each take on its own)."""
 
 def presets() -> List[Preset]:
     """Every preset, in the order of the plugin's menu."""

@@ -25,10 +25,14 @@ use sake_glug_analysis::{
 };
 use sake_glug_engine::{Preset, UnitOnset, Voicing, PRESETS};
 use sake_glug_fit::{fit_json, fit_session, FitSession};
+use sake_glug_render::loudness::{
+    check_loudness, check_true_peak, LevelError, LevelStage, LevelTarget, Loudness,
+};
 use sake_glug_render::silence::why_silent;
 use sake_glug_render::trim::{check_trim_db, trimmed, DEFAULT_TRIM_DB};
 use sake_glug_render::variations::{
-    draw_takes, Take, VariationError, Varied, MAX_TAKES, NAME_COLUMN, SEED_COLUMN, TAKE_COLUMN,
+    draw_takes, is_measured_column, manifest_row, Cell, Take, VariationError, MAX_TAKES,
+    NAME_COLUMN, SEED_COLUMN, TAKE_COLUMN,
 };
 use sake_glug_render::{
     render_scene, render_tables_until, Column, RenderError, RenderObserver, Scene, SceneError,
@@ -244,6 +248,8 @@ fn take_of(take: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Take>> {
             .map_err(|_| PyTypeError::new_err("take: its keys are str"))?;
         let text = match key.as_str() {
             NAME_COLUMN => continue,
+            // What the take measured (its loudness), not what it drew.
+            column if is_measured_column(column) => continue,
             TAKE_COLUMN => {
                 number = value.extract::<u32>().map_err(|_| {
                     SakeGlugError::new_err("take: `take` is the take's number, an int from 1")
@@ -278,6 +284,24 @@ fn take_of(take: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Take>> {
     .map_err(|error| SakeGlugError::new_err(format!("take: {error}")))
 }
 
+/// `loudness=` and `true_peak=`: the level the samples are brought to, checked as
+/// --loudness and --true-peak check theirs (the same ranges, the same sentence).
+fn level_target(loudness: Option<f64>, true_peak: Option<f64>) -> PyResult<LevelTarget> {
+    fn refused(name: &'static str) -> impl Fn(String) -> PyErr {
+        move |message| SakeGlugError::new_err(format!("{name}: {message}"))
+    }
+    Ok(LevelTarget {
+        loudness_lufs: loudness
+            .map(check_loudness)
+            .transpose()
+            .map_err(refused("loudness"))?,
+        true_peak_dbtp: true_peak
+            .map(check_true_peak)
+            .transpose()
+            .map_err(refused("true_peak"))?,
+    })
+}
+
 /// Warns that a render is silent, with the command line's reason.
 fn warn_silent(py: Python<'_>, reason: &str) -> PyResult<()> {
     let message = std::ffi::CString::new(reason.replace('\0', " ")).expect("no NUL is left");
@@ -299,6 +323,8 @@ enum Refused {
     Tables(#[from] TablesError),
     #[error(transparent)]
     Variation(#[from] VariationError),
+    #[error(transparent)]
+    Level(#[from] LevelError),
     #[error("{0}")]
     Message(String),
     /// Python raised an exception while the render ran (KeyboardInterrupt, or the progress
@@ -352,6 +378,11 @@ impl Refused {
 ///     set's manifest as a dict (a row of render_variations(), or of NAME.variations.json).
 /// trim: ends the samples once the last glug has decayed below a level re their peak, with a
 ///     10 ms fade, as --trim does: True for -60 dB, or a level in dB below 0.
+/// loudness: brings the samples to this integrated loudness (LUFS, -70 to 0; ITU-R BS.1770-4
+///     gated as EBU R128), as --loudness does: one gain for the whole render, found on a first
+///     pass (after the trim). A render shorter than 0.4 s, or silent, is refused.
+/// true_peak: keeps the true peak (dBTP, -60 to 0, 4x oversampled) at or under this ceiling,
+///     as --true-peak does; with loudness, the ceiling wins (MODEL.md §19).
 ///
 /// A render in which nothing sounds warns (UserWarning) with the command line's reason (the
 /// bottle never tilts past where it pours, the bottle is empty, …).
@@ -365,7 +396,7 @@ impl Refused {
 #[pyfunction]
 #[pyo3(signature = (
     scene=None, *, sample_rate=None, preset=None, progress=None, actuator=None, felt=false,
-    seed=None, take=None, trim=None
+    seed=None, take=None, trim=None, loudness=None, true_peak=None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn render<'py>(
@@ -379,25 +410,22 @@ fn render<'py>(
     seed: Option<u64>,
     take: Option<&Bound<'py, PyAny>>,
     trim: Option<&Bound<'py, PyAny>>,
+    loudness: Option<f64>,
+    true_peak: Option<f64>,
 ) -> PyResult<Bound<'py, PyArray1<f32>>> {
     let source = SceneSource::of(scene)?;
     let progress = callback("progress", progress)?;
     let actuator = actuator_profile(actuator, felt)?;
     let shaping = Shaping::of(seed, take, trim)?;
+    let level = level_target(loudness, true_peak)?;
     let rendered = py.detach(|| {
         let scene = shaping.apply(source.load(preset, sample_rate, actuator.as_ref())?)?;
         let total = scene.duration_samples();
-        let mut samples = match total {
-            Some(total) => Samples::with_room(total, scene.sample_rate),
-            None => Ok(Samples::growing(scene.sample_rate)),
-        }
-        .map_err(Refused::Message)?;
         let mut ticks = Ticks::new(progress, total);
-        let sink = |block: &[f32]| samples.push(block).map_err(Refused::Message);
-        match render_scene(&scene, sink, &mut ticks) {
-            Ok(summary) => Ok((samples.into_vec(), why_silent(&scene, &summary))),
-            Err(refused) => Err(refused.stopped_by(ticks)),
-        }
+        let rendered = render_levelled(&scene, &level, false, &mut ticks);
+        rendered
+            .map(|in_memory| (in_memory.samples, in_memory.silent))
+            .map_err(|refused| refused.stopped_by(ticks))
     });
     let (samples, silent) = rendered.map_err(Refused::into_py)?;
     if let Some(reason) = silent {
@@ -414,11 +442,15 @@ fn render<'py>(
 /// count: takes in the set (1 to 9999); default: the count of the scene's [variations]
 ///     table, which gives the ranges drawn from (MODEL.md §10.2).
 /// seed: the master seed (default: the scene's seed), as --seed with --variations.
-/// trim, sample_rate, preset, actuator, felt: as render()'s, for every take.
+/// trim, sample_rate, preset, actuator, felt, loudness, true_peak: as render()'s, for every
+///     take (each take brought to the level on its own, as the command line's files are).
+///
+/// Each row ends with the take's loudness_lufs and true_peak_dbtp, measured on its samples as
+/// returned, as the manifest's last columns are; render(scene, take=row) ignores them.
 #[pyfunction]
 #[pyo3(signature = (
     scene=None, *, count=None, seed=None, sample_rate=None, preset=None, trim=None,
-    actuator=None, felt=false
+    actuator=None, felt=false, loudness=None, true_peak=None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn render_variations<'py>(
@@ -431,10 +463,13 @@ fn render_variations<'py>(
     trim: Option<&Bound<'py, PyAny>>,
     actuator: Option<&Bound<'py, PyAny>>,
     felt: bool,
+    loudness: Option<f64>,
+    true_peak: Option<f64>,
 ) -> PyResult<TakeRows<'py>> {
     let source = SceneSource::of(scene)?;
     let actuator = actuator_profile(actuator, felt)?;
     let trim_db = trim_of(trim)?;
+    let level = level_target(loudness, true_peak)?;
     if let Some(count) = count.filter(|count| !(1..=MAX_TAKES).contains(count)) {
         return Err(SakeGlugError::new_err(format!(
             "count = {count}: a set has 1 to {MAX_TAKES} takes"
@@ -460,38 +495,82 @@ fn render_variations<'py>(
         let mut rendered = Vec::with_capacity(takes.len());
         for (take, take_scene) in takes.into_iter().zip(scenes) {
             let take_scene = trim_scene(take_scene, trim_db)?;
-            let total = take_scene.duration_samples();
-            let mut samples = match total {
-                Some(total) => Samples::with_room(total, take_scene.sample_rate),
-                None => Ok(Samples::growing(take_scene.sample_rate)),
-            }
-            .map_err(Refused::Message)?;
-            let mut ticks = Ticks::new(None, total);
-            let sink = |block: &[f32]| samples.push(block).map_err(Refused::Message);
-            let summary = match render_scene(&take_scene, sink, &mut ticks) {
-                Ok(summary) => summary,
+            let mut ticks = Ticks::new(None, take_scene.duration_samples());
+            let in_memory = match render_levelled(&take_scene, &level, true, &mut ticks) {
+                Ok(in_memory) => in_memory,
                 Err(refused) => return Err(refused.stopped_by(ticks)),
             };
-            let silent = why_silent(&take_scene, &summary);
-            rendered.push((take, samples.into_vec(), silent));
+            rendered.push((take, in_memory));
         }
-        Ok(rendered)
+        Ok((rendered, count))
     });
-    let rendered = rendered.map_err(Refused::into_py)?;
+    let (rendered, count) = rendered.map_err(Refused::into_py)?;
     let mut set = Vec::with_capacity(rendered.len());
-    for (take, samples, silent) in rendered {
+    for (
+        take,
+        InMemory {
+            samples,
+            silent,
+            measured,
+        },
+    ) in rendered
+    {
         if let Some(reason) = silent {
             warn_silent(py, &format!("take {}: {reason}", take.number))?;
         }
+        // Every take is measured (render_levelled's `measure`).
+        let measured = measured.unwrap_or(Loudness {
+            integrated_lufs: f64::NAN,
+            range_lu: f64::NAN,
+            true_peak_dbtp: f64::NAN,
+            duration_s: f64::NAN,
+        });
+        // The manifest's row, but for the file name a set of samples has not.
         let row = PyDict::new(py);
-        row.set_item(TAKE_COLUMN, take.number)?;
-        row.set_item(SEED_COLUMN, take.seed)?;
-        for (varied, value) in &take.values {
-            row.set_item(Varied::key(*varied), value)?;
+        for (column, cell) in manifest_row(&take, "", count, &measured) {
+            match cell {
+                _ if column == NAME_COLUMN => {}
+                Cell::Whole(value) => row.set_item(column, value)?,
+                Cell::Number(value) => row.set_item(column, value)?,
+                Cell::Text(text) => row.set_item(column, text)?,
+            }
         }
         set.push((row, PyArray1::from_vec(py, samples)));
     }
     Ok(set)
+}
+
+/// Renders `scene` into memory through the level stage of `level` (the command line's
+/// [`LevelStage`]: a first pass finds the gain, the samples are written at it): its samples,
+/// why it is silent if it is, and with `measure` their loudness and true peak as returned.
+fn render_levelled(
+    scene: &Scene,
+    level: &LevelTarget,
+    measure: bool,
+    ticks: &mut Ticks,
+) -> Result<InMemory, Refused> {
+    let total = scene.duration_samples();
+    let mut samples = match total {
+        Some(total) => Samples::with_room(total, scene.sample_rate),
+        None => Ok(Samples::growing(scene.sample_rate)),
+    }
+    .map_err(Refused::Message)?;
+    let mut stage = LevelStage::new::<Refused>(scene, level, measure, &[], &*ticks)?;
+    let sink = |block: &[f32]| samples.push(stage.apply(block)).map_err(Refused::Message);
+    let summary = render_scene(scene, sink, ticks)?;
+    let measured = stage.finish().filter(|_| measure).map(|level| level.after);
+    Ok(InMemory {
+        samples: samples.into_vec(),
+        silent: why_silent(scene, &summary),
+        measured,
+    })
+}
+
+/// A render held in memory: its samples, why it is silent if it is, what they measure if asked.
+struct InMemory {
+    samples: Vec<f32>,
+    silent: Option<String>,
+    measured: Option<Loudness>,
 }
 
 /// `value` if it is None or callable, for `name`.

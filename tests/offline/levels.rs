@@ -254,6 +254,162 @@ fn haptic_peak_reaches_its_drive_in_every_haptic_format() {
     }
 }
 
+/// The largest |sample| of a 4-channel `dualsense` file's actuator channels (3 and 4) and of
+/// its audio channels (1 and 2), 0..1 of full scale.
+fn dualsense_peaks(path: &Path) -> (f64, f64) {
+    let mut reader = hound::WavReader::open(path).unwrap();
+    assert_eq!(reader.spec().channels, 4);
+    let (mut actuators, mut audio) = (0i32, 0i32);
+    for (index, sample) in reader.samples::<i16>().enumerate() {
+        let magnitude = i32::from(sample.unwrap()).abs();
+        if index % 4 >= 2 {
+            actuators = actuators.max(magnitude);
+        } else {
+            audio = audio.max(magnitude);
+        }
+    }
+    (f64::from(actuators) / 32_768.0, f64::from(audio) / 32_768.0)
+}
+
+/// The largest |sample| of an `android-ogg` file's haptic channel (its last) and of its audio
+/// channel, decoded as a player decodes them.
+fn ogg_peaks(path: &Path) -> (f64, f64) {
+    let file = std::fs::File::open(path).unwrap();
+    let mut decoder = vorbis_rs::VorbisDecoder::new(std::io::BufReader::new(file)).unwrap();
+    assert_eq!(decoder.channels().get(), 2);
+    let (mut haptic, mut audio) = (0.0f64, 0.0f64);
+    while let Some(block) = decoder.decode_audio_block().unwrap() {
+        let peak = |channel: &[f32]| channel.iter().fold(0.0f64, |m, y| m.max(y.abs() as f64));
+        audio = audio.max(peak(block.samples()[0]));
+        haptic = haptic.max(peak(block.samples()[1]));
+    }
+    (haptic, audio)
+}
+
+/// The haptic channels' peak drives (%) the fidelity table gives the `dualsense` and
+/// `android-ogg` rows.
+fn fidelity_channel_drives(table: &str) -> Vec<(String, f64)> {
+    table
+        .lines()
+        .filter(|line| line.starts_with("| `dualsense`") || line.starts_with("| `android-ogg`"))
+        .map(|line| {
+            let name = line.split('`').nth(1).unwrap().to_owned();
+            let drive = line
+                .split("haptic channel: peak drive ")
+                .nth(1)
+                .and_then(|rest| rest.split(' ').next())
+                .unwrap_or_else(|| panic!("no haptic channel's drive in {line}"));
+            (name, drive.parse().unwrap())
+        })
+        .collect()
+}
+
+/// `--haptic-peak` drives the haptic channel of the files that carry one beside their audio
+/// (the DualSense's actuators, Android's haptic channel) to the drive asked, read back from
+/// each file (16-bit PCM as written; Vorbis as decoded), at the scene's rate and resampled;
+/// their audio channels keep the loudness rules (the `.wav`'s samples), and `--fidelity` reads
+/// the same drive back. Without it the haptic channel keeps the render's level.
+#[test]
+fn haptic_peak_drives_the_haptic_channels_of_dualsense_and_android_ogg() {
+    let cases: [(&[&str], Option<f64>); 4] = [
+        (&[], None),
+        (&["--haptic-peak", "100%"], Some(1.0)),
+        (
+            &[
+                "--haptic-peak",
+                "-6dB",
+                "--loudness",
+                "-20",
+                "--audio-channels",
+                "glug",
+            ],
+            Some(10f64.powf(-6.0 / 20.0)),
+        ),
+        (
+            &[
+                "--haptic-peak",
+                "0.8",
+                "--sample-rate",
+                "44100",
+                "--audio-channels",
+                "glug",
+            ],
+            Some(0.8),
+        ),
+    ];
+    for (options, drive) in cases {
+        let directory = tempfile::tempdir().unwrap();
+        let mut args = vec![
+            "render",
+            "-o",
+            "pour.wav",
+            "-o",
+            "dualsense:pad.wav",
+            "-o",
+            "pour.ogg",
+        ];
+        args.extend(options);
+        let output = sake_glug(directory.path(), &args);
+        assert!(output.status.success(), "{output:?}");
+        let (samples, _) = wav(&directory.path().join("pour.wav"));
+        let render_peak = samples.iter().fold(0.0f64, |m, y| m.max(y.abs() as f64));
+        let (actuators, pad_audio) = dualsense_peaks(&directory.path().join("pad.wav"));
+        let (haptic, ogg_audio) = ogg_peaks(&directory.path().join("pour.ogg"));
+        match drive {
+            Some(drive) => {
+                // 16-bit: within a step (full scale is 32767/32768); resampled at 44.1 kHz.
+                assert!(
+                    (actuators - drive).abs() <= 1.5 / 32_768.0,
+                    "{options:?} dualsense: {actuators}"
+                );
+                // Vorbis codes the channel lossily: its decoded peak strays from the drive.
+                assert!((haptic - drive).abs() <= 0.02, "{options:?} ogg: {haptic}");
+            }
+            None => {
+                assert!(
+                    (actuators - render_peak).abs() <= 1.0 / 32_768.0,
+                    "{actuators}"
+                );
+                assert!((haptic - render_peak).abs() <= 0.02, "{haptic}");
+            }
+        }
+        // The audio channels (with --audio-channels glug) are the render's samples at the
+        // loudness asked, not driven: the .wav's peak, within the resampling's and the
+        // codec's error.
+        if options.contains(&"glug") {
+            let wav_peak = render_peak;
+            let resampled = options.contains(&"44100");
+            let tolerance = if resampled { 0.01 } else { 1.0 / 32_768.0 };
+            assert!(
+                (pad_audio - wav_peak).abs() <= tolerance,
+                "{options:?} {pad_audio} vs {wav_peak}"
+            );
+            assert!(
+                (ogg_audio - wav_peak).abs() <= 0.02,
+                "{options:?} {ogg_audio} vs {wav_peak}"
+            );
+            assert!(
+                (actuators - pad_audio).abs() > 0.05,
+                "the audio is not driven"
+            );
+        }
+    }
+    // The fidelity report reads the same drives back.
+    let directory = tempfile::tempdir().unwrap();
+    let output = sake_glug(
+        directory.path(),
+        &["render", "--fidelity", "--haptic-peak", "100%"],
+    );
+    assert!(output.status.success(), "{output:?}");
+    let table = String::from_utf8_lossy(&output.stdout);
+    let drives = fidelity_channel_drives(&table);
+    assert_eq!(drives.len(), 2, "{table}");
+    for (name, percent) in drives {
+        let tolerance = if name == "dualsense" { 0.05 } else { 2.0 };
+        assert!((percent - 100.0).abs() <= tolerance, "{name}: {percent} %");
+    }
+}
+
 /// The default pour's `.ahap` draws each glug's decay as intensity curves, every one within
 /// Core Haptics' 16 points, not as a staircase of short events; a decay too long for one curve
 /// goes on in the next, from the point the last ended on.

@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use crate::command::{files_in, sake_glug};
+use sake_glug_render::loudness::LoudnessMeter;
 use sake_glug_render::variations::{draw_takes, VariationSpec, Varied};
 
 /// A scene whose takes draw every kind of value: the tilt's end and ramp, controls, constants.
@@ -100,16 +101,39 @@ fn a_take_renders_again_bit_for_bit_from_its_row_alone() {
     let header = lines.next().unwrap();
     assert_eq!(
         header,
-        "take,name,seed,tilt_end_deg,ramp_s,viscosity_c,fill_percent,pour_time_s,glug.f1_hz"
+        "take,name,seed,tilt_end_deg,ramp_s,viscosity_c,fill_percent,pour_time_s,glug.f1_hz,\
+         loudness_lufs,true_peak_dbtp"
     );
     let row = lines.nth(2).unwrap();
     assert!(row.starts_with("3,set_03,"), "{row}");
     // A manifest of that one row, the others gone: the take comes back from it alone, with no
     // --seed (the row's seed is the take's).
     std::fs::write(set.path().join("one.csv"), format!("{header}\n{row}\n")).unwrap();
+    // The manifests as written before each take's level was in them: without its columns.
+    let without_level = |line: &str| line.rsplitn(3, ',').nth(2).unwrap().to_owned();
+    std::fs::write(
+        set.path().join("old.csv"),
+        format!("{}\n{}\n", without_level(header), without_level(row)),
+    )
+    .unwrap();
+    // Their lines taken out of the text (a value parsed and written again by serde_json may
+    // move by an ulp): neither is a row's last key, so what is left is JSON.
+    let json = std::fs::read_to_string(out.join("set.variations.json")).unwrap();
+    let old_json: String = json
+        .lines()
+        .filter(|line| !line.contains("\"loudness_lufs\"") && !line.contains("\"true_peak_dbtp\""))
+        .map(|line| format!("{line}\n"))
+        .collect();
+    let old: serde_json::Value = serde_json::from_str(&old_json).unwrap();
+    let old_row = old["takes"][2].as_object().unwrap();
+    assert!(!old_row.contains_key("loudness_lufs") && !old_row.contains_key("true_peak_dbtp"));
+    assert!(old_row.contains_key("seed"), "{old_json}");
+    std::fs::write(set.path().join("old.json"), old_json).unwrap();
     for (manifest, name) in [
         ("one.csv:3", "again"),
         ("out/set.variations.json:3", "json"),
+        ("old.csv:3", "old_csv"),
+        ("old.json:3", "old_json"),
     ] {
         succeeded(&sake_glug(
             set.path(),
@@ -145,6 +169,50 @@ fn a_take_renders_again_bit_for_bit_from_its_row_alone() {
     );
     assert_eq!(output.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&output.stderr).contains("no take 4"));
+}
+
+/// Each take's loudness and true peak are in its manifest's row (CSV and JSON), as measured
+/// on the samples its WAV holds, after the level stage brought it to `--loudness` under
+/// `--true-peak`.
+#[test]
+fn each_takes_level_is_in_the_manifests_as_its_file_measures() {
+    let set = render_set(&["--seed", "8", "--loudness", "-20", "--true-peak", "-1"]);
+    let out = set.path().join("out");
+    let csv_text = std::fs::read_to_string(out.join("set.variations.csv")).unwrap();
+    let mut rows = csv::Reader::from_reader(csv_text.as_bytes());
+    let header = rows.headers().unwrap().clone();
+    let column = |name: &str| header.iter().position(|c| c == name).unwrap();
+    let (lufs, peak) = (column("loudness_lufs"), column("true_peak_dbtp"));
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("set.variations.json")).unwrap()).unwrap();
+    let takes = json["takes"].as_array().unwrap();
+    let mut count = 0;
+    for (record, json_row) in rows.records().zip(takes) {
+        let record = record.unwrap();
+        let name = &record[1];
+        let mut reader = hound::WavReader::open(out.join(format!("{name}.wav"))).unwrap();
+        let rate = reader.spec().sample_rate;
+        let samples: Vec<f32> = reader.samples::<f32>().map(Result::unwrap).collect();
+        let mut meter = LoudnessMeter::mono(rate);
+        meter.add(&samples);
+        let measured = meter.loudness();
+        let in_csv: [f64; 2] = [record[lufs].parse().unwrap(), record[peak].parse().unwrap()];
+        let in_json = [
+            json_row["loudness_lufs"].as_f64().unwrap(),
+            json_row["true_peak_dbtp"].as_f64().unwrap(),
+        ];
+        let in_file = [measured.integrated_lufs, measured.true_peak_dbtp];
+        assert_eq!(in_csv, in_file, "{name}");
+        assert_eq!(in_json, in_file, "{name}");
+        // At the level asked: −20 LUFS, unless the ceiling held it quieter.
+        assert!(in_file[1] <= -1.0 + 1e-6, "{name}: {in_file:?}");
+        assert!(
+            (in_file[0] + 20.0).abs() < 0.01 || (in_file[0] < -20.0 && in_file[1] > -1.01),
+            "{name}: {in_file:?}"
+        );
+        count += 1;
+    }
+    assert_eq!(count, 5);
 }
 
 /// The ranges of [`SET_SCENE`] as the renderer reads them.

@@ -59,6 +59,9 @@ pub enum Level {
     Loudness(Loudness),
     /// A clip: the strongest drive it carries (0..1 of full scale), read back.
     PeakDrive(f64),
+    /// A waveform with a haptic channel beside its audio: the loudness of the render's
+    /// samples, and the haptic channel's strongest drive (0..1 of full scale), read back.
+    LoudnessAndDrive(Loudness, f64),
     /// Not measured.
     None,
 }
@@ -225,12 +228,23 @@ pub fn measure(
                 level: Level::None,
             };
             Ok(match read_back {
-                ReadBack::Waveform { limits } => Fidelity {
-                    level: report
-                        .levelled
-                        .map_or(Level::None, |levelled| Level::Loudness(levelled.after)),
-                    ..fidelity(None, None, limits(scene), delivered(true))
-                },
+                ReadBack::Waveform { limits, haptic } => {
+                    let drive = haptic
+                        .map(|channel| (channel.read_peak)(&output.path))
+                        .transpose()?;
+                    let level = match (report.levelled, drive) {
+                        (Some(levelled), Some(drive)) => {
+                            Level::LoudnessAndDrive(levelled.after, drive)
+                        }
+                        (Some(levelled), None) => Level::Loudness(levelled.after),
+                        (None, Some(drive)) => Level::PeakDrive(drive),
+                        (None, None) => Level::None,
+                    };
+                    Fidelity {
+                        level,
+                        ..fidelity(None, None, limits(scene), delivered(true))
+                    }
+                }
                 ReadBack::Clip(read, _) => {
                     let path = &output.path;
                     let text = std::fs::read_to_string(path).map_err(OutputError::io(path))?;
@@ -344,6 +358,12 @@ pub fn fidelity_table(rows: &[Fidelity]) -> String {
         let level = match row.level {
             Level::Loudness(loudness) => loudness.to_string(),
             Level::PeakDrive(drive) => format!("peak drive {:.1} %", drive * 100.0),
+            Level::LoudnessAndDrive(loudness, drive) => {
+                format!(
+                    "{loudness}; haptic channel: peak drive {:.1} %",
+                    drive * 100.0
+                )
+            }
             Level::None => "—".to_owned(),
         };
         let mut line = format!(
@@ -389,7 +409,9 @@ const COLUMN_NOTES: &[&str] = &[
      some motors with a click).",
     "**level**: a waveform's integrated loudness (LUFS, BS.1770-4 gated as EBU R128), its \
      loudness range (LU) and true peak (dBTP, 4× oversampled); a clip's strongest drive as \
-     the file carries it (100 % = the motor's full drive; `--haptic-peak` sets it).",
+     the file carries it (100 % = the motor's full drive; `--haptic-peak` sets it), and so \
+     a waveform's haptic channel (`dualsense`'s actuators, `android-ogg`'s haptic channel, \
+     decoded), its largest sample.",
 ];
 
 /// The columns an actuator profile adds.

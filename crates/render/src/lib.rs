@@ -22,7 +22,7 @@ pub mod variations;
 
 pub use automation::Automation;
 pub use memory::{available_bytes, human_bytes};
-pub use outputs::{measure_loudness, remove_temporary_files, render_to_files, RenderReport};
+pub use outputs::{remove_temporary_files, render_to_files, RenderReport};
 pub use render::{
     render_scene, render_scene_to_vec, BottleReport, RenderError, RenderObserver, RenderSummary,
 };

@@ -14,6 +14,10 @@ use std::str::FromStr;
 
 use ebur128::{EbuR128, Mode};
 
+use crate::render::{render_scene, RenderError, RenderObserver};
+use crate::resample::Resample;
+use crate::scene::Scene;
+
 /// EBU R128's gating block: a render shorter than this has no gated block, hence no integrated
 /// loudness (s).
 pub const GATING_BLOCK_S: f64 = 0.4;
@@ -216,32 +220,209 @@ pub enum LevelError {
 
 /// `--loudness`'s value: a number of LUFS within [`LOUDNESS_RANGE_LUFS`].
 pub fn parse_loudness(text: &str) -> Result<f64, String> {
-    parse_level(text, "LUFS", &LOUDNESS_RANGE_LUFS)
+    parse_level(text, LOUDNESS_UNIT)
 }
 
 /// `--true-peak`'s value: a number of dBTP within [`TRUE_PEAK_RANGE_DBTP`].
 pub fn parse_true_peak(text: &str) -> Result<f64, String> {
-    parse_level(text, "dBTP", &TRUE_PEAK_RANGE_DBTP)
+    parse_level(text, TRUE_PEAK_UNIT)
 }
 
-fn parse_level(
-    text: &str,
-    unit: &str,
-    range: &std::ops::RangeInclusive<f64>,
-) -> Result<f64, String> {
+/// A loudness given as a number (Python's `loudness=`), checked as `--loudness` checks its text.
+pub fn check_loudness(value: f64) -> Result<f64, String> {
+    check_level(value, &value.to_string(), LOUDNESS_UNIT)
+}
+
+/// A true-peak ceiling given as a number (Python's `true_peak=`), checked as `--true-peak`
+/// checks its text.
+pub fn check_true_peak(value: f64) -> Result<f64, String> {
+    check_level(value, &value.to_string(), TRUE_PEAK_UNIT)
+}
+
+/// A level's unit and the range a target may ask for in it.
+type LevelUnit = (&'static str, std::ops::RangeInclusive<f64>);
+const LOUDNESS_UNIT: LevelUnit = ("LUFS", LOUDNESS_RANGE_LUFS);
+const TRUE_PEAK_UNIT: LevelUnit = ("dBTP", TRUE_PEAK_RANGE_DBTP);
+
+fn parse_level(text: &str, (unit, range): LevelUnit) -> Result<f64, String> {
     let number = text.trim();
     let number = number
         .strip_suffix(unit)
         .or_else(|| number.strip_suffix(&unit.to_lowercase()))
         .unwrap_or(number)
         .trim();
-    match number.parse::<f64>() {
-        Ok(value) if range.contains(&value) => Ok(value),
-        _ => Err(format!(
+    // Text that is no number is refused as a number out of range is, with the same sentence.
+    check_level(
+        number.parse::<f64>().unwrap_or(f64::NAN),
+        text,
+        (unit, range),
+    )
+}
+
+fn check_level(value: f64, text: &str, (unit, range): LevelUnit) -> Result<f64, String> {
+    if range.contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!(
             "`{text}` is not a level from {} to {} {unit}",
             range.start(),
             range.end()
-        )),
+        ))
+    }
+}
+
+/// The level stage of one render (MODEL.md §19), as every product applies it (the command
+/// line's files through [`crate::render_to_files`], Python's samples): a first pass of the same
+/// render measures it, once, for what was asked (the gain of a [`LevelTarget`], the sample peaks
+/// `--haptic-peak` drives a haptic channel from); the second pass's samples go through
+/// [`LevelStage::apply`] before anything hears them, and, with `measure`, are measured as
+/// written.
+pub struct LevelStage {
+    levelled: Option<Levelled>,
+    gain: Option<f32>,
+    /// The samples as written, measured (with `measure`).
+    meter: Option<LoudnessMeter>,
+    /// Each rate asked for, with the peak |sample| of the render there, as synthesised.
+    peaks: Vec<(u32, f64)>,
+    scaled: Vec<f32>,
+}
+
+impl LevelStage {
+    /// The stage for `scene` at `target`, measuring what is written if `measure`, and the
+    /// render's sample peak at each of `peak_rates` (Hz; another rate than the scene's
+    /// resampled, [`Resample`]). A first pass runs only if a target is set or a peak asked for;
+    /// `observer` is asked on it whether to stop. A render that cannot be brought to the target
+    /// is refused ([`LevelError`]).
+    pub fn new<E: From<RenderError> + From<LevelError>>(
+        scene: &Scene,
+        target: &LevelTarget,
+        measure: bool,
+        peak_rates: &[u32],
+        observer: &impl RenderObserver,
+    ) -> Result<Self, E> {
+        let mut stage = Self {
+            levelled: None,
+            gain: None,
+            meter: measure.then(|| LoudnessMeter::mono(scene.sample_rate)),
+            peaks: Vec::new(),
+            scaled: Vec::new(),
+        };
+        if !target.is_set() && peak_rates.is_empty() {
+            return Ok(stage);
+        }
+        let mut meter = target
+            .is_set()
+            .then(|| LoudnessMeter::mono(scene.sample_rate));
+        let mut peaks: Vec<(u32, f64, Option<Resample>)> = Vec::new();
+        for &rate in peak_rates {
+            if !peaks.iter().any(|&(known, ..)| known == rate) {
+                let resample =
+                    (rate != scene.sample_rate).then(|| Resample::new(scene.sample_rate, rate));
+                peaks.push((rate, 0.0, resample));
+            }
+        }
+        let fold_peak = |peak: &mut f64, samples: &[f64]| {
+            *peak = samples.iter().fold(*peak, |peak, y| peak.max(y.abs()));
+            Ok::<(), RenderError>(())
+        };
+        let mut wide = Vec::new();
+        render_scene(
+            scene,
+            |block: &[f32]| {
+                if let Some(meter) = meter.as_mut() {
+                    meter.add(block);
+                }
+                wide.clear();
+                wide.extend(block.iter().map(|&y| f64::from(y)));
+                for (_, peak, resample) in &mut peaks {
+                    match resample {
+                        None => fold_peak(peak, &wide)?,
+                        Some(resample) => {
+                            resample.push(block, &mut |samples: &[f64]| fold_peak(peak, samples))?
+                        }
+                    }
+                }
+                Ok::<(), RenderError>(())
+            },
+            &mut Interruptible(observer),
+        )?;
+        for (rate, mut peak, resample) in peaks {
+            if let Some(resample) = resample {
+                resample.finish(&mut |samples: &[f64]| fold_peak(&mut peak, samples))?;
+            }
+            stage.peaks.push((rate, peak));
+        }
+        if let Some(meter) = meter {
+            let levelled = target.gain_for(&meter.loudness())?;
+            stage.gain = Some(levelled.gain());
+            stage.levelled = Some(levelled);
+        }
+        Ok(stage)
+    }
+
+    /// The samples as the files are written from them: `block` at the stage's gain.
+    pub fn apply<'a>(&'a mut self, block: &'a [f32]) -> &'a [f32] {
+        let block = match self.gain {
+            Some(gain) => {
+                self.scaled.clear();
+                self.scaled.extend(block.iter().map(|y| y * gain));
+                &self.scaled[..]
+            }
+            None => block,
+        };
+        if let Some(meter) = self.meter.as_mut() {
+            meter.add(block);
+        }
+        block
+    }
+
+    /// The gain (linear) [`LevelStage::apply`] gives every sample: 1 without a target.
+    pub fn gain(&self) -> f64 {
+        self.levelled
+            .as_ref()
+            .map_or(1.0, |levelled| 10f64.powf(levelled.gain_db / 20.0))
+    }
+
+    /// The render's sample peak at `rate` (Hz) as synthesised, before the gain, if it was asked
+    /// for.
+    pub fn peak_at(&self, rate: u32) -> Option<f64> {
+        self.peaks
+            .iter()
+            .find(|&&(known, _)| known == rate)
+            .map(|&(_, peak)| peak)
+    }
+
+    /// What the stage did, once the second pass has ended: the gain, and what the samples
+    /// written measure (measured on them with `measure`, else as the first pass's figures after
+    /// the gain); `None` if nothing was asked or measured.
+    pub fn finish(self) -> Option<Levelled> {
+        match (self.levelled, self.meter) {
+            (Some(levelled), Some(meter)) => Some(Levelled {
+                after: meter.loudness(),
+                ..levelled
+            }),
+            (Some(levelled), None) => Some(levelled),
+            (None, Some(meter)) => {
+                let loudness = meter.loudness();
+                Some(Levelled {
+                    gain_db: 0.0,
+                    held_by_peak: false,
+                    quieter_than_asked_lu: 0.0,
+                    before: loudness,
+                    after: loudness,
+                })
+            }
+            (None, None) => None,
+        }
+    }
+}
+
+/// An observer asked only whether to stop (the first pass reports no progress and no units).
+struct Interruptible<'a, O>(&'a O);
+
+impl<O: RenderObserver> RenderObserver for Interruptible<'_, O> {
+    fn interrupted(&self) -> bool {
+        self.0.interrupted()
     }
 }
 

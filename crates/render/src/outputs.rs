@@ -8,10 +8,11 @@
 use std::cell::RefCell;
 use std::path::PathBuf;
 
-use super::loudness::{Levelled, LoudnessMeter};
+use super::loudness::{LevelStage, Levelled};
 use super::memory::available_bytes;
 use super::render::{render_scene, BottleReport, RenderError, RenderObserver, RenderSummary};
 use super::scene::Scene;
+use super::sinks::read_back::ReadBack;
 use super::sinks::{
     remove_own_temps, remove_stale_temps, Output, OutputError, OutputOptions, PendingFile, Sink,
     SinkContext,
@@ -64,16 +65,39 @@ pub fn render_to_files(
         })
         .collect::<Result<Vec<_>, _>>()?;
     refuse_what_cannot_fit(outputs, &sinks)?;
+    // The haptic channels --haptic-peak drives, each with the rate its peak is measured at.
+    let driven: Vec<Option<u32>> = outputs
+        .iter()
+        .map(
+            |output| match (options.haptic_peak, output.format.read_back()) {
+                (Some(_), Some(ReadBack::Waveform { haptic, .. })) => {
+                    haptic.map(|channel| (channel.rate)(scene))
+                }
+                _ => None,
+            },
+        )
+        .collect();
+    let peak_rates: Vec<u32> = driven.iter().flatten().copied().collect();
     // The level stage (MODEL.md §19): a first pass measures, the second is written at its gain.
-    let level = if options.level.is_set() {
-        Some(options.level.gain_for(&measure_loudness(scene)?)?)
-    } else {
-        None
-    };
-    let gain = level.as_ref().map(Levelled::gain);
-    let mut meter = (options.measure_loudness && level.is_none())
-        .then(|| LoudnessMeter::mono(scene.sample_rate));
-    let mut scaled = Vec::new();
+    let mut level = LevelStage::new::<OutputError>(
+        scene,
+        &options.level,
+        options.measure_loudness,
+        &peak_rates,
+        &observer,
+    )?;
+    let mut sinks = sinks;
+    if let Some(drive) = options.haptic_peak {
+        for (sink, rate) in sinks.iter_mut().zip(&driven) {
+            let Some(peak) = rate.and_then(|rate| level.peak_at(rate)) else {
+                continue;
+            };
+            // A channel with nothing in it stays silent: no gain raises nothing.
+            if peak > 0.0 {
+                sink.haptic_gain(drive.level() / (peak * level.gain()));
+            }
+        }
+    }
     let sinks = RefCell::new(sinks);
     let mut fanout = Fanout {
         sinks: &sinks,
@@ -84,17 +108,7 @@ pub fn render_to_files(
     let summary = render_scene(
         scene,
         |block: &[f32]| {
-            let block = match gain {
-                Some(gain) => {
-                    scaled.clear();
-                    scaled.extend(block.iter().map(|y| y * gain));
-                    &scaled[..]
-                }
-                None => block,
-            };
-            if let Some(meter) = meter.as_mut() {
-                meter.add(block);
-            }
+            let block = level.apply(block);
             sinks
                 .borrow_mut()
                 .iter_mut()
@@ -113,18 +127,7 @@ pub fn render_to_files(
     }
     // Every file is complete: only now do they replace their targets, all together.
     let files = PendingFile::commit_all(finished)?;
-    let levelled = level.or_else(|| {
-        meter.map(|meter| {
-            let loudness = meter.loudness();
-            Levelled {
-                gain_db: 0.0,
-                held_by_peak: false,
-                quieter_than_asked_lu: 0.0,
-                before: loudness,
-                after: loudness,
-            }
-        })
-    });
+    let levelled = level.finish();
     Ok(RenderReport {
         summary,
         files,
@@ -132,21 +135,6 @@ pub fn render_to_files(
         audible_units,
         levelled,
     })
-}
-
-/// The loudness of `scene`'s render as synthesised: a pass of its own, writing nothing (the
-/// render is deterministic, so the pass that writes hears the same samples).
-pub fn measure_loudness(scene: &Scene) -> Result<crate::loudness::Loudness, RenderError> {
-    let mut meter = LoudnessMeter::mono(scene.sample_rate);
-    render_scene(
-        scene,
-        |block: &[f32]| {
-            meter.add(block);
-            Ok::<(), RenderError>(())
-        },
-        &mut |_| {},
-    )?;
-    Ok(meter.loudness())
 }
 
 /// Removes the temporary files this process's renders to `outputs` have open, for a process

@@ -15,6 +15,7 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 use serde_json::value::RawValue;
 
 use super::automation::Automation;
+use super::loudness::Loudness;
 use super::scene::variations_table::known_keys;
 pub use super::scene::variations_table::{
     VariationError, VariationSpec, Varied, COUNT_KEY, MAX_TAKES, VARIATIONS_KEY,
@@ -30,6 +31,80 @@ pub const TAKE_COLUMN: &str = "take";
 pub const NAME_COLUMN: &str = "name";
 /// The column of the take's seed.
 pub const SEED_COLUMN: &str = "seed";
+
+/// The manifest's last columns: each take's level, measured on the samples its files were
+/// written from, after any level stage (MODEL.md §19). What a take measured, not what it
+/// draws: a row read back ignores them, and a manifest written before them reads as well.
+pub const MEASURED_COLUMNS: [MeasuredColumn; 2] = [
+    ("loudness_lufs", |loudness| loudness.integrated_lufs),
+    ("true_peak_dbtp", |loudness| loudness.true_peak_dbtp),
+];
+
+/// A measured column: its name, and the figure it takes of a take's [`Loudness`].
+pub type MeasuredColumn = (&'static str, fn(&Loudness) -> f64);
+
+/// Whether `column` is one of [`MEASURED_COLUMNS`].
+pub fn is_measured_column(column: &str) -> bool {
+    MEASURED_COLUMNS.iter().any(|&(name, _)| name == column)
+}
+
+/// A cell of a manifest's row.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Cell {
+    /// A whole number (the take's number, its seed).
+    Whole(u64),
+    /// Text (the take's name).
+    Text(String),
+    /// A number, written as the shortest text that reads back as the same f64 (−∞ for a silent
+    /// take's loudness: `-inf` in the CSV, `null` in the JSON, which has no infinity).
+    Number(f64),
+}
+
+impl Cell {
+    fn csv(&self) -> String {
+        match self {
+            Cell::Whole(value) => value.to_string(),
+            Cell::Text(text) => text.clone(),
+            Cell::Number(value) => value.to_string(),
+        }
+    }
+
+    fn json(&self) -> serde_json::Value {
+        match self {
+            Cell::Whole(value) => (*value).into(),
+            Cell::Text(text) => text.as_str().into(),
+            // serde_json writes a non-finite number as null.
+            Cell::Number(value) => (*value).into(),
+        }
+    }
+}
+
+/// A take's row of its set's manifest, column by column: the one list both manifests (the
+/// CSV's header and cells, the JSON's keys and values) and Python's rows are written from.
+/// `take`, `name`, `seed`, each drawn value by its key, then [`MEASURED_COLUMNS`] of `measured`.
+pub fn manifest_row(
+    take: &Take,
+    set_name: &str,
+    count: u32,
+    measured: &Loudness,
+) -> Vec<(&'static str, Cell)> {
+    let mut row = vec![
+        (TAKE_COLUMN, Cell::Whole(take.number.into())),
+        (NAME_COLUMN, Cell::Text(take.name(set_name, count))),
+        (SEED_COLUMN, Cell::Whole(take.seed)),
+    ];
+    row.extend(
+        take.values
+            .iter()
+            .map(|&(varied, value)| (varied.key(), Cell::Number(value))),
+    );
+    row.extend(
+        MEASURED_COLUMNS
+            .iter()
+            .map(|&(column, of)| (column, Cell::Number(of(measured)))),
+    );
+    row
+}
 
 impl Varied {
     /// Sets `value` in `scene`; refused, naming the key, where the scene cannot take it.
@@ -98,8 +173,8 @@ impl Take {
         format!("{set_name}_{:0width$}", self.number)
     }
 
-    /// A take from a row's fields (column name, text): `seed` and the varied keys; `take` and
-    /// `name` are the row's own and change nothing. Unknown columns and unreadable numbers are
+    /// A take from a row's fields (column name, text): `seed` and the varied keys; `take`,
+    /// `name` and the [`MEASURED_COLUMNS`] are the row's own and change nothing. Unknown columns and unreadable numbers are
     /// refused by name.
     pub fn from_fields<'a>(
         number: u32,
@@ -111,6 +186,7 @@ impl Take {
             let text = text.trim();
             match column {
                 TAKE_COLUMN | NAME_COLUMN => {}
+                column if is_measured_column(column) => {}
                 SEED_COLUMN => {
                     seed = Some(text.parse::<u64>().map_err(|_| {
                         VariationError::Row(format!(
@@ -211,22 +287,21 @@ pub fn draw_takes(ranges: &[(Varied, [f64; 2])], count: u32, master_seed: u64) -
         .collect()
 }
 
-/// The manifest of a set as CSV: a header (`take,name,seed`, then the varied keys) and a row per
-/// take, each number written as the shortest text that reads back as the same f64.
-pub fn manifest_csv(set_name: &str, takes: &[Take]) -> String {
+/// The manifest of a set as CSV: a header ([`manifest_row`]'s columns) and a row per take,
+/// each take with what it measured.
+pub fn manifest_csv(set_name: &str, takes: &[(Take, Loudness)]) -> String {
     let count = takes.len() as u32;
-    let mut header = vec![TAKE_COLUMN, NAME_COLUMN, SEED_COLUMN];
-    if let Some(first) = takes.first() {
-        header.extend(first.values.iter().map(|(varied, _)| varied.key()));
-    }
+    let rows: Vec<_> = takes
+        .iter()
+        .map(|(take, measured)| manifest_row(take, set_name, count, measured))
+        .collect();
+    let Some(first) = rows.first() else {
+        return [TAKE_COLUMN, NAME_COLUMN, SEED_COLUMN].join(",") + "\n";
+    };
+    let header: Vec<&str> = first.iter().map(|&(column, _)| column).collect();
     let mut text = header.join(",") + "\n";
-    for take in takes {
-        let mut cells = vec![
-            take.number.to_string(),
-            take.name(set_name, count),
-            take.seed.to_string(),
-        ];
-        cells.extend(take.values.iter().map(|(_, value)| value.to_string()));
+    for row in &rows {
+        let cells: Vec<String> = row.iter().map(|(_, cell)| cell.csv()).collect();
         text += &(cells.join(",") + "\n");
     }
     text
@@ -239,19 +314,16 @@ pub fn manifest_json(
     scene_file: Option<&Path>,
     master_seed: u64,
     ranges: &[(Varied, [f64; 2])],
-    takes: &[Take],
+    takes: &[(Take, Loudness)],
 ) -> String {
     let count = takes.len() as u32;
     let rows: Vec<serde_json::Value> = takes
         .iter()
-        .map(|take| {
-            let mut row = serde_json::Map::new();
-            row.insert(TAKE_COLUMN.into(), take.number.into());
-            row.insert(NAME_COLUMN.into(), take.name(set_name, count).into());
-            row.insert(SEED_COLUMN.into(), take.seed.into());
-            for &(varied, value) in &take.values {
-                row.insert(varied.key().into(), value.into());
-            }
+        .map(|(take, measured)| {
+            let row = manifest_row(take, set_name, count, measured)
+                .into_iter()
+                .map(|(column, cell)| (column.to_owned(), cell.json()))
+                .collect();
             serde_json::Value::Object(row)
         })
         .collect();
@@ -377,8 +449,16 @@ mod tests {
             .unwrap()
             .ranges;
         let takes = draw_takes(&ranges, 12, 99);
-        let csv = manifest_csv("pour", &takes);
-        let json = manifest_json("pour", None, 99, &ranges, &takes);
+        let measured = Loudness {
+            integrated_lufs: -23.5,
+            range_lu: 4.0,
+            true_peak_dbtp: -1.25,
+            duration_s: 5.0,
+        };
+        let rows: Vec<(Take, Loudness)> =
+            takes.iter().map(|take| (take.clone(), measured)).collect();
+        let csv = manifest_csv("pour", &rows);
+        let json = manifest_json("pour", None, 99, &ranges, &rows);
         for take in &takes {
             assert_eq!(&take_from_csv(&csv, take.number).unwrap(), take);
             assert_eq!(&take_from_json(&json, take.number).unwrap(), take);

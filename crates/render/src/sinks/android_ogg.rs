@@ -15,7 +15,7 @@ use std::num::{NonZeroU32, NonZeroU8};
 #[cfg(feature = "ogg")]
 use vorbis_rs::{VorbisBitrateManagementStrategy, VorbisEncoder, VorbisEncoderBuilder};
 
-use super::read_back::{no_limits, ReadBack};
+use super::read_back::{no_limits, HapticChannel, ReadBack};
 #[cfg(feature = "ogg")]
 use super::{AudioChannels, PendingFile};
 use super::{OutputError, OutputFormat, Sink, SinkContext};
@@ -30,7 +30,13 @@ pub(super) const FORMAT: OutputFormat = OutputFormat {
     by_extension: true,
     built: cfg!(feature = "ogg"),
     open,
-    read_back: Some(ReadBack::Waveform { limits: no_limits }),
+    read_back: Some(ReadBack::Waveform {
+        limits: no_limits,
+        haptic: Some(HapticChannel {
+            rate: |scene| scene.sample_rate,
+            read_peak: haptic_peak,
+        }),
+    }),
     carries_c: "the waveform on the haptic channel, Vorbis-coded (lossy)",
 };
 
@@ -44,6 +50,41 @@ pub const ANDROID_OGG_CHANNELS: u8 = 2;
 /// file is still a tenth of a 16-bit WAV's size.
 #[cfg(feature = "ogg")]
 const QUALITY: f32 = 0.9;
+
+/// The largest |sample| of a written file's haptic channel (0..1 of full scale), decoded as a
+/// player decodes it (so the Vorbis coding's error is in it).
+#[cfg(feature = "ogg")]
+fn haptic_peak(path: &std::path::Path) -> Result<f64, OutputError> {
+    let error = |message: String| OutputError::Ogg {
+        path: path.to_owned(),
+        message,
+    };
+    let file = File::open(path).map_err(OutputError::io(path))?;
+    let mut decoder = vorbis_rs::VorbisDecoder::new(std::io::BufReader::new(file))
+        .map_err(|e| error(e.to_string()))?;
+    let haptic = usize::from(ANDROID_OGG_CHANNELS) - 1;
+    let mut peak = 0.0f64;
+    while let Some(block) = decoder
+        .decode_audio_block()
+        .map_err(|e| error(e.to_string()))?
+    {
+        if let Some(channel) = block.samples().get(haptic) {
+            peak = channel
+                .iter()
+                .fold(peak, |peak, &y| peak.max(f64::from(y).abs()));
+        }
+    }
+    Ok(peak)
+}
+
+/// A build without the `ogg` feature writes no `.ogg`, so it has none to read back.
+#[cfg(not(feature = "ogg"))]
+fn haptic_peak(path: &std::path::Path) -> Result<f64, OutputError> {
+    Err(OutputError::Ogg {
+        path: path.to_owned(),
+        message: "this build reads no Ogg Vorbis (feature `ogg`)".into(),
+    })
+}
 
 /// Without the `ogg` feature an `.ogg` is refused by name, not taken for an unknown format.
 #[cfg(not(feature = "ogg"))]
@@ -88,7 +129,9 @@ fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, OutputError>
         file,
         encoder,
         audio: context.options.platforms.audio_channels,
+        haptic_gain: 1.0,
         silence: Vec::new(),
+        haptic: Vec::new(),
     }))
 }
 
@@ -98,8 +141,12 @@ struct OggFile {
     file: PendingFile,
     encoder: VorbisEncoder<BufWriter<File>>,
     audio: AudioChannels,
+    /// The haptic channel's gain over the samples heard (`--haptic-peak`).
+    haptic_gain: f32,
     /// A block of silence for the audio channel, reused from block to block.
     silence: Vec<f32>,
+    /// The haptic channel's block at its gain, reused from block to block.
+    haptic: Vec<f32>,
 }
 
 #[cfg(feature = "ogg")]
@@ -120,8 +167,20 @@ impl Sink for OggFile {
             AudioChannels::Silent => &self.silence,
             AudioChannels::Glug => block,
         };
-        let result = self.encoder.encode_audio_block([audio, block]);
+        let haptic: &[f32] = if self.haptic_gain == 1.0 {
+            block
+        } else {
+            self.haptic.clear();
+            self.haptic
+                .extend(block.iter().map(|&y| y * self.haptic_gain));
+            &self.haptic
+        };
+        let result = self.encoder.encode_audio_block([audio, haptic]);
         result.map_err(self.error())
+    }
+
+    fn haptic_gain(&mut self, gain: f64) {
+        self.haptic_gain = gain as f32;
     }
 
     fn finish(self: Box<Self>, _: &RenderSummary) -> Result<PendingFile, OutputError> {

@@ -10,7 +10,7 @@ use std::path::Path;
 
 use hound::{SampleFormat, WavSpec, WavWriter};
 
-use super::read_back::ReadBack;
+use super::read_back::{HapticChannel, ReadBack};
 use super::{OutputError, OutputFormat, PendingFile, Sink, SinkContext};
 use crate::resample::Resample;
 use crate::{RenderSummary, Scene};
@@ -23,7 +23,13 @@ pub(super) const FORMAT: OutputFormat = OutputFormat {
     by_extension: false,
     built: true,
     open,
-    read_back: Some(ReadBack::Waveform { limits }),
+    read_back: Some(ReadBack::Waveform {
+        limits,
+        haptic: Some(HapticChannel {
+            rate: |_| DUALSENSE_RATE_HZ,
+            read_peak: actuators_peak,
+        }),
+    }),
     carries_c: "the waveform on both actuators (c·a at f1, (1 − c)·a at f2), 16-bit",
 };
 
@@ -45,6 +51,22 @@ fn limits(scene: &Scene) -> String {
 
 /// Its channels: audio left and right, then the left and right actuator.
 pub const DUALSENSE_CHANNELS: u16 = 4;
+
+/// The actuators' channels (from 0) of a frame.
+const ACTUATOR_CHANNELS: std::ops::Range<usize> = 2..4;
+
+/// The largest |sample| of a written file's actuator channels (0..1 of full scale).
+fn actuators_peak(path: &Path) -> Result<f64, OutputError> {
+    let mut reader = hound::WavReader::open(path).map_err(encode_error(path))?;
+    let mut peak = 0i32;
+    for (index, sample) in reader.samples::<i16>().enumerate() {
+        let sample = sample.map_err(encode_error(path))?;
+        if ACTUATOR_CHANNELS.contains(&(index % DUALSENSE_CHANNELS as usize)) {
+            peak = peak.max(i32::from(sample).abs());
+        }
+    }
+    Ok(f64::from(peak) / 32_768.0)
+}
 
 /// What the audio channels of a file that also drives actuators hold (the DualSense's two, the
 /// Android Ogg's one).
@@ -104,6 +126,7 @@ pub(super) fn open<'a>(context: SinkContext<'a>) -> Result<Box<dyn Sink + 'a>, O
         file,
         writer,
         audio: context.options.platforms.audio_channels,
+        actuator_gain: 1.0,
         frames: 0,
         resample: (scene.sample_rate != DUALSENSE_RATE_HZ)
             .then(|| Resample::new(scene.sample_rate, DUALSENSE_RATE_HZ)),
@@ -135,6 +158,8 @@ struct DualSenseFile {
     file: PendingFile,
     writer: WavWriter<BufWriter<File>>,
     audio: AudioChannels,
+    /// The actuators' gain over the samples heard (`--haptic-peak`).
+    actuator_gain: f64,
     /// Frames written.
     frames: u64,
     /// The render's samples on their way to 48 kHz, for a scene at another rate.
@@ -146,12 +171,19 @@ fn to_i16(sample: f64) -> i16 {
     (sample * 32_768.0).round().clamp(-32_768.0, 32_767.0) as i16
 }
 
-/// Writes a frame for each of `samples` (at 48 kHz): the glug on the actuators, the audio as
-/// `audio` says.
+/// How the frames are made of the samples: what the audio channels hold, the actuators' gain.
+#[derive(Clone, Copy)]
+struct Channels {
+    audio: AudioChannels,
+    actuator_gain: f64,
+}
+
+/// Writes a frame for each of `samples` (at 48 kHz): the glug on the actuators at their gain,
+/// the audio as `audio` says.
 fn write_frames(
     writer: &mut WavWriter<BufWriter<File>>,
     path: &Path,
-    audio: AudioChannels,
+    channels: Channels,
     frames: &mut u64,
     samples: impl ExactSizeIterator<Item = f64>,
 ) -> Result<(), OutputError> {
@@ -159,10 +191,10 @@ fn write_frames(
     check_length(path, *frames)?;
     let mut out = writer.get_i16_writer(samples.len() as u32 * 4);
     for sample in samples {
-        let glug = to_i16(sample);
-        let audio = match audio {
+        let glug = to_i16(sample * channels.actuator_gain);
+        let audio = match channels.audio {
             AudioChannels::Silent => 0,
-            AudioChannels::Glug => glug,
+            AudioChannels::Glug => to_i16(sample),
         };
         for channel in [audio, audio, glug, glug] {
             out.write_sample(channel);
@@ -177,22 +209,31 @@ impl Sink for DualSenseFile {
             file,
             writer,
             audio,
+            actuator_gain,
             frames,
             resample,
         } = self;
         let path = file.path();
+        let channels = Channels {
+            audio: *audio,
+            actuator_gain: *actuator_gain,
+        };
         let mut write =
-            |samples: &[f64]| write_frames(writer, path, *audio, frames, samples.iter().copied());
+            |samples: &[f64]| write_frames(writer, path, channels, frames, samples.iter().copied());
         match resample {
             None => write_frames(
                 writer,
                 path,
-                *audio,
+                channels,
                 frames,
                 block.iter().map(|&y| f64::from(y)),
             ),
             Some(resample) => resample.push(block, &mut write),
         }
+    }
+
+    fn haptic_gain(&mut self, gain: f64) {
+        self.actuator_gain = gain;
     }
 
     fn memory_bytes(&self) -> u64 {
@@ -204,16 +245,21 @@ impl Sink for DualSenseFile {
             file,
             mut writer,
             audio,
+            actuator_gain,
             mut frames,
             resample,
         } = *self;
         if let Some(resample) = resample {
             let path = file.path();
+            let channels = Channels {
+                audio,
+                actuator_gain,
+            };
             resample.finish(&mut |samples: &[f64]| {
                 write_frames(
                     &mut writer,
                     path,
-                    audio,
+                    channels,
                     &mut frames,
                     samples.iter().copied(),
                 )

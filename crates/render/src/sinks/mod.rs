@@ -73,6 +73,10 @@ pub(crate) trait Sink {
     }
     /// The bottle after a block.
     fn bottle(&mut self, _report: &BottleReport) {}
+    /// `--haptic-peak` (MODEL.md §19): the gain of the haptic channel of a file that carries
+    /// one ([`read_back::HapticChannel`]) over the samples [`Sink::samples`] hears, told before
+    /// the first of them; its audio channels keep the samples as they are.
+    fn haptic_gain(&mut self, _gain: f64) {}
     /// The most memory (bytes) the sink may keep, as far as it can tell before the render: a
     /// render whose sinks may need more than the machine has is refused before it starts.
     fn memory_bytes(&self) -> u64 {

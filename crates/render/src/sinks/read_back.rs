@@ -20,6 +20,8 @@ pub(crate) enum ReadBack {
     Waveform {
         /// The platform limits the file met.
         limits: fn(&Scene) -> String,
+        /// The haptic channel it carries beside its audio, if it does.
+        haptic: Option<HapticChannel>,
     },
     /// A clip: its onsets and its envelope, read from the file; and the document its sink
     /// writes of a clip (so its drive can be measured before it is written, `--haptic-peak`).
@@ -27,6 +29,18 @@ pub(crate) enum ReadBack {
         fn(&WrittenClip) -> Result<Reading, OutputError>,
         fn(&ClipSource, &OutputOptions) -> String,
     ),
+}
+
+/// The haptic channel of a waveform file that carries one beside its audio (the DualSense's
+/// actuators, Android's haptic channel): `--haptic-peak` drives it as the clips are driven
+/// (MODEL.md §19), and the fidelity report reads its peak back from the file.
+#[derive(Clone, Copy)]
+pub(crate) struct HapticChannel {
+    /// The rate (Hz) the file holds it at, for a scene: its peak is measured there.
+    pub rate: fn(&Scene) -> u32,
+    /// Its strongest drive as the file holds it: the largest |sample| of the haptic channels
+    /// (0..1 of full scale), read back from the file.
+    pub read_peak: fn(&Path) -> Result<f64, OutputError>,
 }
 
 /// The limits column of a waveform its platform takes as it is: "—".

@@ -21,7 +21,10 @@ pub(super) const FORMAT: OutputFormat = OutputFormat {
     by_extension: true,
     built: true,
     open,
-    read_back: Some(ReadBack::Waveform { limits: no_limits }),
+    read_back: Some(ReadBack::Waveform {
+        limits: no_limits,
+        haptic: None,
+    }),
     carries_c: WAVEFORM_CARRIES_C,
 };
 
