@@ -158,8 +158,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", value_parser = take_count, help = format!(
         "Renders a set of N takes of each scene (1 to {MAX_TAKES}; default: its [variations] \
          table's count), each with its own seed and values drawn from the ranges of the table \
-         (MODEL.md §10.2): every file is NAME_01 … NAME_NN, and NAME.variations.csv and .json \
-         list what each take drew"
+         (MODEL.md §10.2): each output FILE.ext is FILE_01.ext … FILE_NN.ext, and NAME.variations.csv \
+         and .json (NAME the first output's) list what each take drew"
     ))]
     variations: Option<u32>,
     /// Renders one take of a set again, bit for bit, from its row in the set's manifest:
@@ -724,7 +724,7 @@ fn render_job(
     let mut measured = Vec::with_capacity(takes.len());
     for (index, (take, take_scene)) in takes.iter().zip(scenes).enumerate() {
         let name = take.name(&set_name, count);
-        let outputs = take_outputs(&job.outputs, &name);
+        let outputs = take_outputs(&job.outputs, take, count);
         let share = |fraction: f64| (index as f64 + fraction) / count as f64;
         let take_rendered = render_one(
             name,
@@ -766,13 +766,15 @@ fn render_job(
     })
 }
 
-/// The files of take `name`: each of the job's, named for the take.
-fn take_outputs(outputs: &[Output], name: &str) -> Vec<Output> {
+/// The files of `take`: each of the job's, its own name followed by the take's number
+/// (`pour.wav` → `pour_07.wav`, `pad.wav` → `pad_07.wav`), so that two outputs of one extension
+/// stay two files.
+fn take_outputs(outputs: &[Output], take: &Take, count: u32) -> Vec<Output> {
     outputs
         .iter()
         .map(|output| Output {
             format: output.format,
-            path: take_path(&output.path, name),
+            path: take_path(&output.path, &take.name(&set_name_of(&output.path), count)),
         })
         .collect()
 }

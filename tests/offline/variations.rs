@@ -92,6 +92,46 @@ fn the_same_command_and_seed_give_the_same_set_byte_for_byte() {
     assert_ne!(first["set_01.wav"], first["set_02.wav"]);
 }
 
+/// Two outputs of one extension stay two files in every take: each keeps its own name, followed
+/// by the take's number; the manifests are named after the first.
+#[test]
+fn each_output_of_a_set_keeps_its_own_name() {
+    let directory = tempfile::tempdir().unwrap();
+    std::fs::write(directory.path().join("set.toml"), SET_SCENE).unwrap();
+    let args = [
+        "render",
+        "set.toml",
+        "--variations",
+        "2",
+        "-o",
+        "pour.wav",
+        "-o",
+        "dualsense:pad.wav",
+    ];
+    let stderr = succeeded(&sake_glug(directory.path(), &args));
+    let mut names = files_in(directory.path());
+    names.sort_unstable();
+    assert_eq!(
+        names,
+        [
+            "pad_01.wav",
+            "pad_02.wav",
+            "pour.variations.csv",
+            "pour.variations.json",
+            "pour_01.wav",
+            "pour_02.wav",
+            "set.toml"
+        ],
+        "{stderr}"
+    );
+    let pad = hound::WavReader::open(directory.path().join("pad_01.wav")).unwrap();
+    assert_eq!(
+        pad.spec().channels,
+        4,
+        "the DualSense file: two audio, two actuator channels"
+    );
+}
+
 #[test]
 fn a_take_renders_again_bit_for_bit_from_its_row_alone() {
     let set = render_set(&["--seed", "5", "--trim"]);

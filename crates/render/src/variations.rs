@@ -174,8 +174,8 @@ impl Take {
     }
 
     /// A take from a row's fields (column name, text): `seed` and the varied keys; `take`,
-    /// `name` and the [`MEASURED_COLUMNS`] are the row's own and change nothing. Unknown columns and unreadable numbers are
-    /// refused by name.
+    /// `name` and the [`MEASURED_COLUMNS`] are the row's own and change nothing. Unknown columns
+    /// and unreadable numbers are refused by name.
     pub fn from_fields<'a>(
         number: u32,
         fields: impl IntoIterator<Item = (&'a str, &'a str)>,
