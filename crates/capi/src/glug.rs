@@ -78,6 +78,9 @@ struct Audio {
     engine: Engine,
     /// Each control's value, or the target of its ramp.
     held: ControlValues,
+    /// `held` as the engine takes it while no ramp is under way: rebuilt when a control call
+    /// changes it, not at every process call.
+    held_lanes: Controls<'static>,
     ramps: PerControl<Option<Ramp>>,
     /// Storage for the ramps' lanes of one span.
     lanes: PerControl<Box<[f64]>>,
@@ -173,6 +176,7 @@ impl SakeGlug {
             audio: UnsafeCell::new(Audio {
                 engine: Engine::new(sample_rate, config),
                 held,
+                held_lanes: Controls::constant(held),
                 ramps: PerControl::splat(None),
                 lanes: PerControl::from_fn(|_| vec![0.0; SPAN].into_boxed_slice()),
                 mono: vec![0.0; SPAN].into_boxed_slice(),
@@ -297,7 +301,22 @@ impl Audio {
         actuator: &ArrayQueue<Option<ActuatorResponse>>,
     ) {
         // An empty queue (the usual call) is two loads, where a pop that finds nothing is more.
-        while let Some(command) = (!commands.is_empty()).then(|| commands.pop()).flatten() {
+        if !commands.is_empty() {
+            self.take_commands(commands, actuator);
+        }
+        self.kept = 0;
+        self.lost = 0;
+    }
+
+    /// The queued control calls, in order: out of line, so that the usual call, which finds the
+    /// queue empty, carries no more than the check.
+    #[cold]
+    fn take_commands(
+        &mut self,
+        commands: &ArrayQueue<Command>,
+        actuator: &ArrayQueue<Option<ActuatorResponse>>,
+    ) {
+        while let Some(command) = commands.pop() {
             if command == Command::Actuator {
                 // Every profile set by now is in the slot: a later marker finds it empty.
                 if let Some(response) = actuator.pop() {
@@ -307,8 +326,7 @@ impl Audio {
             }
             self.apply(command);
         }
-        self.kept = 0;
-        self.lost = 0;
+        self.held_lanes = Controls::constant(self.held);
     }
 
     fn apply(&mut self, command: Command) {
@@ -362,6 +380,7 @@ impl Audio {
         let Audio {
             engine,
             held,
+            held_lanes,
             ramps,
             lanes,
             units,
@@ -372,10 +391,11 @@ impl Audio {
         } = self;
         // No ramp under way (the usual call): every control is its held value.
         let ramping = ramps.iter().any(|(_, ramp)| ramp.is_some());
-        let controls: Controls = if !ramping {
-            Controls::constant(*held)
+        let ramp_lanes: Controls;
+        let controls = if !ramping {
+            &*held_lanes
         } else {
-            lanes.each_mut().into_map(|control, lane| {
+            ramp_lanes = lanes.each_mut().into_map(|control, lane| {
                 match &mut ramps[control] {
                     Some(ramp) if position < ramp.end_sample => {
                         let lane = &mut lane[..out.len()];
@@ -390,10 +410,11 @@ impl Audio {
                         Lane::Constant(held[control])
                     }
                 }
-            })
+            });
+            &ramp_lanes
         };
         engine.process_observed(
-            &controls,
+            controls,
             out,
             &mut |onset, voicing| match units.get_mut(*kept) {
                 Some(unit) => {

@@ -196,10 +196,7 @@ impl Control {
 
     /// The controls that drive the pour (all but the output gain).
     pub fn pour() -> impl Iterator<Item = Control> {
-        Control::ALL
-            .iter()
-            .copied()
-            .filter(|control| control.spec().drives_pour)
+        POUR_CONTROLS.iter().copied()
     }
 
     /// The controls a tilt device can set, with how it reaches them.
@@ -208,6 +205,34 @@ impl Control {
             .iter()
             .filter_map(|&control| Some((control, control.spec().device.as_ref()?)))
     }
+}
+
+/// The controls that drive the pour, picked from the table at compile time: a loop over them
+/// unrolls to one check per control, where filtering the table at run time cost a check of each
+/// control's spec in every span (the engine compares the pour's inputs once a span).
+const POUR_CONTROLS: [Control; pour_control_count()] = {
+    let mut pour = [Control::Tilt; pour_control_count()];
+    let (mut index, mut taken) = (0, 0);
+    while index < Control::ALL.len() {
+        if Control::ALL[index].spec().drives_pour {
+            pour[taken] = Control::ALL[index];
+            taken += 1;
+        }
+        index += 1;
+    }
+    pour
+};
+
+/// How many controls drive the pour.
+const fn pour_control_count() -> usize {
+    let (mut index, mut count) = (0, 0);
+    while index < Control::ALL.len() {
+        if Control::ALL[index].spec().drives_pour {
+            count += 1;
+        }
+        index += 1;
+    }
+    count
 }
 
 impl<T: Copy> PerControl<T> {
@@ -369,6 +394,7 @@ impl<'a> Controls<'a> {
 
     /// Whether every lane, the output gain's too, is a [`Lane::Constant`]: then the block is the
     /// same from any of its samples on.
+    #[inline]
     pub fn is_constant(&self) -> bool {
         Control::ALL
             .iter()

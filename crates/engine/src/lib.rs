@@ -402,6 +402,39 @@ impl<S: Synthesis> Engine<S> {
         if self.rests_under(controls) {
             return;
         }
+        let constant = self.held_pour.inputs(controls, len);
+        // Most spans of a pour lie inside a plain run, where no unit starts: those take no
+        // callback (and build none).
+        let plain = constant.and_then(|(_, sanitized)| {
+            self.pour.advance_plain(self.sample, len as u64, &sanitized)
+        });
+        let advanced = match plain {
+            Some(advanced) => advanced,
+            None => self.advance_pour(controls, constant, len, on_unit),
+        };
+        if let Some(until) = advanced.flowed_until {
+            self.active_until = until;
+        }
+        let last_step = (len > 0).then_some(advanced.last);
+        if let Some(step) = last_step {
+            self.last_outflow = step;
+        }
+        self.resting_under = match last_step {
+            Some(step) if step.amount_ml == 0.0 && !step.refilled => constant.map(|(raw, _)| raw),
+            _ => None,
+        };
+    }
+
+    /// The pour over a span in which units may start, under `constant` inputs (as given, and
+    /// brought into range) if they hold over the span: each unit is started in the synthesis and
+    /// told of.
+    fn advance_pour(
+        &mut self,
+        controls: &Controls,
+        constant: Option<(ControlValues, ControlValues)>,
+        len: usize,
+        on_unit: &mut impl FnMut(&UnitOnset, Voicing),
+    ) -> pour::Advanced {
         let Self {
             pour,
             synthesis,
@@ -411,7 +444,6 @@ impl<S: Synthesis> Engine<S> {
             block_end,
             deferred,
             actuator,
-            held_pour,
             ..
         } = self;
         let (span_start, block_end) = (*span_start, *block_end);
@@ -443,37 +475,26 @@ impl<S: Synthesis> Engine<S> {
                 *free = Some((*onset, voicing));
             }
         };
-        let constant = held_pour.inputs(controls, len);
-        let advanced = match constant {
+        match constant {
             // Under constant controls the pour takes the span at once (plain samples in closed
             // form, the same numbers as one step per sample).
             Some((_, sanitized)) => {
-                pour.advance(self.sample, len as u64, &sanitized, &mut start_unit)
+                pour.advance(span_start, len as u64, &sanitized, &mut start_unit)
             }
             // Otherwise the levels of the span are worked out at once, and the rest stepped
             // sample by sample (the same numbers as `Pour::step`).
-            None => pour.advance_varying(self.sample, controls, len, &mut start_unit),
-        };
-        if let Some(until) = advanced.flowed_until {
-            self.active_until = until;
+            None => pour.advance_varying(span_start, controls, len, &mut start_unit),
         }
-        let last_step = (len > 0).then_some(advanced.last);
-        if let Some(step) = last_step {
-            self.last_outflow = step;
-        }
-        self.resting_under = match last_step {
-            Some(step) if step.amount_ml == 0.0 && !step.refilled => constant.map(|(raw, _)| raw),
-            _ => None,
-        };
     }
 
     /// Whether the pour rests under `controls`, the same constant ones as its last step: then
     /// stepping it would change nothing.
     fn rests_under(&self, controls: &Controls) -> bool {
-        controls.pour_is_constant()
-            && self
-                .resting_under
-                .is_some_and(|resting| resting.same_pour_as(&controls.values_at(0)))
+        // While the bottle pours (the usual span) the pour rests under nothing: that is checked
+        // first.
+        self.resting_under.is_some_and(|resting| {
+            controls.pour_is_constant() && resting.same_pour_as(&controls.values_at(0))
+        })
     }
 
     fn advance_position(&mut self, len: usize) {

@@ -153,6 +153,7 @@ impl OutputStage {
     }
 
     /// The targets of a block's first sample: straight in after a reset, ramped to otherwise.
+    #[inline]
     fn begin(&mut self, gain_db: f64, ceiling: f64) {
         let gain = self.linear_gain(gain_db);
         if std::mem::take(&mut self.fresh) {

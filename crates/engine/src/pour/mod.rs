@@ -296,6 +296,40 @@ impl Pour {
         advanced
     }
 
+    /// [`Pour::advance`] of a span that lies wholly inside the plain run under way, under the
+    /// controls it was planned for (the usual span while a bottle pours): no unit starts in it,
+    /// so it takes no callback, and V and g move in closed form. `None` where [`Pour::advance`]
+    /// has more to do: the run ends within the span, or none is planned, or the controls or
+    /// constants changed since the last step.
+    #[inline]
+    pub fn advance_plain(
+        &mut self,
+        first_sample: u64,
+        count: u64,
+        controls: &ControlValues,
+    ) -> Option<Advanced> {
+        let run = self.plain.as_mut()?;
+        // As `advance` would find it: no step of its own first, and the run covering the span.
+        if count == 0
+            || run.samples_left < count
+            || self.config_changed
+            || !self
+                .bottle
+                .is_steady_under(controls, self.config.capacity_ml)
+        {
+            return None;
+        }
+        run.samples_left -= count;
+        let run = *run;
+        if run.samples_left == 0 {
+            self.plain = None;
+        }
+        Some(Advanced {
+            last: self.take_plain(&run, count),
+            flowed_until: (run.outflow.amount_ml > 0.0).then_some(first_sample + count),
+        })
+    }
+
     /// `count` samples from `first_sample` whose controls may change from sample to sample: the
     /// same onsets, outflows and volumes as `count` calls of [`Pour::step`] with
     /// `controls.values_at(i)`. The inputs are brought into range and the levels of every sample
