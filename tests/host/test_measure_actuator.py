@@ -7,8 +7,11 @@ response within 0.5 dB at every point, relative to its strongest point as the pr
 are; with `--repeat 2` it gives each point's spread; the renderer takes it as `--actuator`. A
 port the server does not have is refused by name, and no file is written.
 
-The server runs with long cycles (2048 frames), so the Python client keeps up on a busy machine;
-a cycle it still misses is an xrun, which the command answers by playing that step again.
+The command measures with `--freewheel`: once connected it turns the server's freewheel on, so
+that each cycle runs when every client has finished the last, with no clock to miss, and turns it
+off again before it leaves (the device client hears both). Nothing here then depends on the
+machine's speed or load: a device that sleeps twice its cycle's length in each callback (slower
+than real time, so a real-time server would drop every cycle it runs) is measured as exactly.
 
 Needs the release `sake-glug` built with audio (`cargo xtask test` builds it), `jackd` (Debian's
 jackd2) and the JACK-Client and SciPy packages (tests/host/requirements.txt).
@@ -16,12 +19,14 @@ jackd2) and the JACK-Client and SciPy packages (tests/host/requirements.txt).
 
 import os
 import subprocess
+import time
 import tomllib
+from dataclasses import dataclass, field
 
 import numpy as np
 import pytest
 
-from jack_server import RATE
+from jack_server import RATE, wait_for
 from test_standalone import CLI, own_jack_server
 
 FILTER = "device-under-test"
@@ -40,30 +45,44 @@ def device_response():
 
 @pytest.fixture(scope="module")
 def jack_server():
-    # Long cycles (2048 frames), so that the Python client keeps up on a busy machine.
+    # Long cycles (2048 frames): a freewheeling server runs as fast as the Python callback, whose
+    # cost is mostly per call.
     yield from own_jack_server("sakeglug-measure", (CLI, "--features audio"), period=2048)
 
 
+@dataclass
+class Device:
+    sos: np.ndarray
+    # What the server said of freewheel, in turn (True: started).
+    freewheel: list = field(default_factory=list)
+
+
 @pytest.fixture
-def device(jack_server):
-    """The filter between `device-under-test:drive_in` and `device-under-test:accel_out`."""
+def device(jack_server, request):
+    """The filter between `device-under-test:drive_in` and `device-under-test:accel_out`; with
+    `indirect` parameter `cycles_slept`, it sleeps that many of its cycles' length in each."""
     import jack
     from scipy.signal import sosfilt
 
-    sos = device_response()
+    cycles_slept = getattr(request, "param", 0)
+    device = Device(device_response())
     client = jack.Client(FILTER, servername=jack_server, no_start_server=True)
     drive = client.inports.register("drive_in")
     accelerometer = client.outports.register("accel_out")
-    state = [np.zeros((sos.shape[0], 2))]
+    state = [np.zeros((device.sos.shape[0], 2))]
+    sleep_s = cycles_slept * client.blocksize / RATE
 
     def process(frames):
-        filtered, state[0] = sosfilt(sos, drive.get_array(), zi=state[0])
+        filtered, state[0] = sosfilt(device.sos, drive.get_array(), zi=state[0])
         accelerometer.get_array()[:] = GAIN * filtered
+        if sleep_s:
+            time.sleep(sleep_s)
 
     client.set_process_callback(process)
+    client.set_freewheel_callback(device.freewheel.append)
     client.activate()
     try:
-        yield sos
+        yield device
     finally:
         client.deactivate()
         client.close()
@@ -78,36 +97,64 @@ def measure(jack_server, tmp_path, *options):
     )
 
 
-def test_the_measured_profile_is_the_device_response_within_half_a_db(
-    jack_server, device, tmp_path
-):
+def measured_freewheeling(jack_server, device, tmp_path, *options):
+    """The profile `measure-actuator --freewheel` writes; checks that the server freewheeled
+    while it measured and was back in real time before the command ended."""
+    done = measure(jack_server, tmp_path, "--freewheel", *options)
+    assert done.returncode == 0, done.stderr
+    assert "xrun" not in done.stdout, done.stdout
+    # The device hears of it through its own notification thread, a moment later.
+    wait_for(lambda: len(device.freewheel) >= 2, 30, "the device to hear freewheel end")
+    assert device.freewheel == [True, False]
+    return tomllib.loads((tmp_path / "device.toml").read_text())
+
+
+def levels_match_the_device(profile, device):
+    """The profile's points are the device's response within 0.5 dB, relative to its strongest
+    point as the profile's are; returns the frequencies."""
     from scipy.signal import sosfreqz
 
-    done = measure(jack_server, tmp_path, "--from", "40", "--to", "1000", "--per-octave", "2",
-                   "--settle", "0.2", "--measure", "0.3", "--repeat", "2")
-    assert done.returncode == 0, done.stderr
-    profile = tomllib.loads((tmp_path / "device.toml").read_text())
     hz = np.array([point[0] for point in profile["response"]])
     db = np.array([point[1] for point in profile["response"]])
-    assert hz[0] == pytest.approx(40.0) and hz[-1] == pytest.approx(1000.0)
-    assert len(hz) == 11, hz
-    _, response = sosfreqz(device, worN=hz, fs=RATE)
+    _, response = sosfreqz(device.sos, worN=hz, fs=RATE)
     expected = 20 * np.log10(GAIN * np.abs(response))
     expected -= expected.max()
     error = db - expected
     print(f"\nlargest error of the measured profile: {np.abs(error).max():.1e} dB over "
           f"{len(hz)} points")
     assert np.abs(error).max() < 0.5, dict(zip(hz.round(1), error.round(3)))
+    return hz
+
+
+def test_the_measured_profile_is_the_device_response_within_half_a_db(
+    jack_server, device, tmp_path
+):
+    profile = measured_freewheeling(
+        jack_server, device, tmp_path, "--from", "40", "--to", "1000", "--per-octave", "2",
+        "--settle", "0.2", "--measure", "0.3", "--repeat", "2")
+    hz = levels_match_the_device(profile, device)
+    assert hz[0] == pytest.approx(40.0) and hz[-1] == pytest.approx(1000.0)
+    assert len(hz) == 11, hz
     # The same filter twice: the repeats agree.
     spread = np.array(profile["spread_db"])
     assert len(spread) == len(hz) and spread.max() < 0.5, spread
     assert profile["band_hz"] == [hz[0], hz[-1]]
     assert profile["sample_rate_hz"] == RATE
     assert profile["name"] == "device"
+    assert "freewheeled" in (tmp_path / "device.toml").read_text()
     # The renderer takes it.
     render = subprocess.run([CLI, "render", "--actuator", "device.toml",
                              "-o", "pour.wav"], cwd=tmp_path, capture_output=True, text=True)
     assert render.returncode == 0, render.stderr
+
+
+@pytest.mark.parametrize("device", [2], indirect=True, ids=["sleeping two cycles a cycle"])
+def test_a_device_slower_than_real_time_is_measured_as_exactly(jack_server, device, tmp_path):
+    profile = measured_freewheeling(
+        jack_server, device, tmp_path, "--from", "50", "--to", "800", "--per-octave", "1",
+        "--settle", "0.15", "--measure", "0.2")
+    hz = levels_match_the_device(profile, device)
+    assert len(hz) == 5, hz
 
 
 def test_a_port_the_server_lacks_is_refused_by_name_and_nothing_is_written(
