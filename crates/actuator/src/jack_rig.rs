@@ -14,10 +14,11 @@
 //! cycle. Only then: jack2 saves the connections when freewheel starts and restores them when it
 //! stops, so a client that joins, connects or leaves meanwhile leaves the server confused (a
 //! cycle stalls for its 10 s timeout on a join; a client closed meanwhile is restored, jack2
-//! issue 1006). While it freewheels, xruns are not counted: those JACK reports then happened
-//! before, in real time, and reach the client late. The one way a freewheeling server drops a
-//! cycle is to give up on a client after [`FREEWHEEL_TIMEOUT`], so a block during which two of
-//! the rig's cycles came that far apart is reported spoiled instead.
+//! issue 1006). Xruns still spoil a block while it freewheels: jack2 reports some as it switches
+//! (a slow client still running its last real-time cycle), and a cycle can then be lost. A
+//! freewheeling server also drops a cycle when it gives up on a client after
+//! [`FREEWHEEL_TIMEOUT`], so a block during which two of the rig's cycles came that far apart is
+//! spoiled too.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -314,16 +315,15 @@ impl Rig for JackRig {
             }
             std::thread::sleep(Duration::from_millis(2));
         }
-        let spoiled = if self.freewheel {
-            Duration::from_nanos(self.shared.longest_gap_ns.load(Ordering::Acquire))
-                >= FREEWHEEL_TIMEOUT
-        } else {
-            // JACK reports an xrun after the cycle it spoiled: wait two periods for the news.
-            std::thread::sleep(Duration::from_secs_f64(
-                2.0 * self.period as f64 / self.sample_rate as f64,
-            ));
-            self.shared.xruns.load(Ordering::Acquire) != xruns_before
-        };
+        // JACK reports an xrun after the cycle it spoiled: wait two periods for the news.
+        std::thread::sleep(Duration::from_secs_f64(
+            2.0 * self.period as f64 / self.sample_rate as f64,
+        ));
+        let gave_up_on_a_client = self.freewheel
+            && Duration::from_nanos(self.shared.longest_gap_ns.load(Ordering::Acquire))
+                >= FREEWHEEL_TIMEOUT;
+        let spoiled =
+            gave_up_on_a_client || self.shared.xruns.load(Ordering::Acquire) != xruns_before;
         let recorded = std::mem::take(&mut self.block().recorded);
         Ok(Take { recorded, spoiled })
     }
