@@ -10,7 +10,8 @@ port the server does not have is refused by name, and no file is written.
 The command measures with `--freewheel`: once connected it turns the server's freewheel on, so
 that each cycle runs when every client has finished the last instead of on a clock that a busy
 machine makes the Python client miss, and turns it off again before it leaves (the device client
-hears both). The measurement thus runs faster than its steps last, and drops no cycle to load.
+hears both). Its pace is then the clients', not a clock's: a busy machine slows it down (from
+well under the steps' length on an idle one) rather than making it drop cycles.
 
 Needs the release `sake-glug` built with audio (`cargo xtask test` builds it), `jackd` (Debian's
 jackd2) and the JACK-Client and SciPy packages (tests/host/requirements.txt).
