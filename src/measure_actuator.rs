@@ -60,9 +60,9 @@ pub struct MeasureActuatorArgs {
     /// The JACK client's name.
     #[arg(long, default_value = CLIENT_NAME)]
     client_name: String,
-    /// Freewheels the JACK server while measuring: it runs as fast as its clients allow, never
-    /// dropping a cycle, for a device that is itself a JACK client (a model, a simulation). Not
-    /// for hardware: a freewheeling server leaves its sound card.
+    /// Freewheels the JACK server while measuring: it runs each cycle when every client has
+    /// finished the last, not on a clock, for a device that is itself a JACK client (a model, a
+    /// simulation). Not for hardware: a freewheeling server leaves its sound card.
     #[arg(long)]
     freewheel: bool,
 }
