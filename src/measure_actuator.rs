@@ -60,6 +60,11 @@ pub struct MeasureActuatorArgs {
     /// The JACK client's name.
     #[arg(long, default_value = CLIENT_NAME)]
     client_name: String,
+    /// Freewheels the JACK server while measuring: it runs each cycle when every client has
+    /// finished the last, not on a clock, for a device that is itself a JACK client (a model, a
+    /// simulation). Not for hardware: a freewheeling server leaves its sound card.
+    #[arg(long)]
+    freewheel: bool,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -159,6 +164,11 @@ fn comments(args: &MeasureActuatorArgs, measured: &Measured) -> Vec<String> {
          measured."
             .into(),
     ];
+    if args.freewheel {
+        lines.push(
+            "The JACK server freewheeled while measuring (as fast as its clients allowed).".into(),
+        );
+    }
     if let Some(weakest) = measured
         .above_noise_db
         .iter()
@@ -203,6 +213,7 @@ fn run_on_jack(args: &MeasureActuatorArgs, plan: &Plan) -> Result<Measured, Meas
         &args.client_name,
         args.play_to.as_deref(),
         args.record_from.as_deref(),
+        args.freewheel,
     )?;
     let mut progress = |repeat: usize, step: usize, steps: usize| {
         eprint!(

@@ -7,8 +7,11 @@ response within 0.5 dB at every point, relative to its strongest point as the pr
 are; with `--repeat 2` it gives each point's spread; the renderer takes it as `--actuator`. A
 port the server does not have is refused by name, and no file is written.
 
-The server runs with long cycles (2048 frames), so the Python client keeps up on a busy machine;
-a cycle it still misses is an xrun, which the command answers by playing that step again.
+The command measures with `--freewheel`: once connected it turns the server's freewheel on, so
+that each cycle runs when every client has finished the last instead of on a clock that a busy
+machine makes the Python client miss, and turns it off again before it leaves (the device client
+hears both). Its pace is then the clients', not a clock's: a busy machine slows it down (from
+well under the steps' length on an idle one) rather than making it drop cycles.
 
 Needs the release `sake-glug` built with audio (`cargo xtask test` builds it), `jackd` (Debian's
 jackd2) and the JACK-Client and SciPy packages (tests/host/requirements.txt).
@@ -16,12 +19,14 @@ jackd2) and the JACK-Client and SciPy packages (tests/host/requirements.txt).
 
 import os
 import subprocess
+import threading
 import tomllib
+from dataclasses import dataclass, field
 
 import numpy as np
 import pytest
 
-from jack_server import RATE
+from jack_server import RATE, wait_for
 from test_standalone import CLI, own_jack_server
 
 FILTER = "device-under-test"
@@ -40,8 +45,16 @@ def device_response():
 
 @pytest.fixture(scope="module")
 def jack_server():
-    # Long cycles (2048 frames), so that the Python client keeps up on a busy machine.
+    # Long cycles (2048 frames): a freewheeling server runs as fast as the Python callback, whose
+    # cost is mostly per call.
     yield from own_jack_server("sakeglug-measure", (CLI, "--features audio"), period=2048)
+
+
+@dataclass
+class Device:
+    sos: np.ndarray
+    # What the server said of freewheel, in turn (True: started).
+    freewheel: list = field(default_factory=list)
 
 
 @pytest.fixture
@@ -50,21 +63,32 @@ def device(jack_server):
     import jack
     from scipy.signal import sosfilt
 
-    sos = device_response()
+    device = Device(device_response())
     client = jack.Client(FILTER, servername=jack_server, no_start_server=True)
     drive = client.inports.register("drive_in")
     accelerometer = client.outports.register("accel_out")
-    state = [np.zeros((sos.shape[0], 2))]
+    state = [np.zeros((device.sos.shape[0], 2))]
+    leaving, left = threading.Event(), threading.Event()
 
     def process(frames):
-        filtered, state[0] = sosfilt(sos, drive.get_array(), zi=state[0])
+        if leaving.is_set():
+            left.set()
+            return
+        filtered, state[0] = sosfilt(device.sos, drive.get_array(), zi=state[0])
         accelerometer.get_array()[:] = GAIN * filtered
 
     client.set_process_callback(process)
+    client.set_freewheel_callback(device.freewheel.append)
     client.activate()
     try:
-        yield sos
+        yield device
     finally:
+        # jack_deactivate cancels the process thread (pthread_cancel) once the server has let it
+        # go: cancelled inside Python, it takes the GIL with it and this process hangs. So the
+        # callback first becomes instant (a cycle that saw `leaving` has ended), and the thread
+        # is then cancelled waiting for a cycle, not inside one.
+        leaving.set()
+        wait_for(left.is_set, 30, "the device's callback to see it is leaving")
         client.deactivate()
         client.close()
 
@@ -78,32 +102,50 @@ def measure(jack_server, tmp_path, *options):
     )
 
 
-def test_the_measured_profile_is_the_device_response_within_half_a_db(
-    jack_server, device, tmp_path
-):
+def measured_freewheeling(jack_server, device, tmp_path, *options):
+    """The profile `measure-actuator --freewheel` writes; checks that the server freewheeled
+    while it measured and was back in real time before the command ended."""
+    done = measure(jack_server, tmp_path, "--freewheel", *options)
+    assert done.returncode == 0, done.stderr
+    # The device hears of it through its own notification thread, a moment later.
+    wait_for(lambda: len(device.freewheel) >= 2, 30, "the device to hear freewheel end")
+    assert device.freewheel == [True, False]
+    return tomllib.loads((tmp_path / "device.toml").read_text())
+
+
+def levels_match_the_device(profile, device):
+    """The profile's points are the device's response within 0.5 dB, relative to its strongest
+    point as the profile's are; returns the frequencies."""
     from scipy.signal import sosfreqz
 
-    done = measure(jack_server, tmp_path, "--from", "40", "--to", "1000", "--per-octave", "2",
-                   "--settle", "0.2", "--measure", "0.3", "--repeat", "2")
-    assert done.returncode == 0, done.stderr
-    profile = tomllib.loads((tmp_path / "device.toml").read_text())
     hz = np.array([point[0] for point in profile["response"]])
     db = np.array([point[1] for point in profile["response"]])
-    assert hz[0] == pytest.approx(40.0) and hz[-1] == pytest.approx(1000.0)
-    assert len(hz) == 11, hz
-    _, response = sosfreqz(device, worN=hz, fs=RATE)
+    _, response = sosfreqz(device.sos, worN=hz, fs=RATE)
     expected = 20 * np.log10(GAIN * np.abs(response))
     expected -= expected.max()
     error = db - expected
     print(f"\nlargest error of the measured profile: {np.abs(error).max():.1e} dB over "
           f"{len(hz)} points")
     assert np.abs(error).max() < 0.5, dict(zip(hz.round(1), error.round(3)))
+    return hz
+
+
+def test_the_measured_profile_is_the_device_response_within_half_a_db(
+    jack_server, device, tmp_path
+):
+    profile = measured_freewheeling(
+        jack_server, device, tmp_path, "--from", "40", "--to", "1000", "--per-octave", "2",
+        "--settle", "0.2", "--measure", "0.3", "--repeat", "2")
+    hz = levels_match_the_device(profile, device)
+    assert hz[0] == pytest.approx(40.0) and hz[-1] == pytest.approx(1000.0)
+    assert len(hz) == 11, hz
     # The same filter twice: the repeats agree.
     spread = np.array(profile["spread_db"])
     assert len(spread) == len(hz) and spread.max() < 0.5, spread
     assert profile["band_hz"] == [hz[0], hz[-1]]
     assert profile["sample_rate_hz"] == RATE
     assert profile["name"] == "device"
+    assert "freewheeled" in (tmp_path / "device.toml").read_text()
     # The renderer takes it.
     render = subprocess.run([CLI, "render", "--actuator", "device.toml",
                              "-o", "pour.wav"], cwd=tmp_path, capture_output=True, text=True)
