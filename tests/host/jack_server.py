@@ -8,6 +8,7 @@ started, so that importing this module does not load libjack.
 import signal
 import subprocess
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -38,6 +39,41 @@ def connect_once_active(client, source, destination, timeout_s=60):
             return False
 
     wait_for(connected, timeout_s, f"{source} → {destination} to connect")
+
+
+class LeavableCallback:
+    """`client`'s process callback, set by this, which `close_client` makes instant before the
+    client leaves. jack_deactivate cancels the client's process thread (pthread_cancel) once the
+    server lets it go: cancelled inside a Python callback, that thread keeps the GIL and this
+    process hangs. So the callback first returns at once, and the client leaves once a cycle has
+    seen that: its thread is then cancelled waiting for a cycle, or in a callback of a few
+    instructions, not in the test's work."""
+
+    def __init__(self, client, callback):
+        self._callback = callback
+        self._leaving = threading.Event()
+        self._left = threading.Event()
+        client.set_process_callback(self)
+
+    def __call__(self, frames):
+        if self._leaving.is_set():
+            self._left.set()
+            return
+        self._callback(frames)
+
+    def leave(self, timeout_s=10):
+        """Makes the callback instant and waits for a cycle to have seen it (no longer than
+        `timeout_s`: a client the server no longer runs is in no callback)."""
+        self._leaving.set()
+        self._left.wait(timeout_s)
+
+
+def close_client(client, callback):
+    """Deactivates and closes `client`, whose process callback is the LeavableCallback
+    `callback`, made instant first."""
+    callback.leave()
+    client.deactivate()
+    client.close()
 
 
 def stop(process, sig=signal.SIGTERM, timeout_s=10):

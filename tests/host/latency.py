@@ -38,7 +38,15 @@ from pathlib import Path
 
 import numpy as np
 
-from jack_server import RATE, connect_once_active, start_jack, stop, wait_for
+from jack_server import (
+    RATE,
+    LeavableCallback,
+    close_client,
+    connect_once_active,
+    start_jack,
+    stop,
+    wait_for,
+)
 
 PERIOD = 64
 # The device's 14-bit tilt on CC 16 (MSB) and CC 48 (LSB), 0..16383 over 0..180°.
@@ -91,8 +99,10 @@ class Rig:
         # (first frame, monotonic time as the recorder received it) of the recent cycles.
         self.cycles = deque(maxlen=8192)
         self.xruns = 0
-        self.tilt.set_process_callback(self._send)
-        self.recorder.set_process_callback(self._record)
+        self.callbacks = [
+            LeavableCallback(self.tilt, self._send),
+            LeavableCallback(self.recorder, self._record),
+        ]
         self.recorder.set_xrun_callback(self._xrun)
         self.tilt.activate()
         self.recorder.activate()
@@ -155,9 +165,8 @@ class Rig:
 
     def close(self):
         self.tilt.transport_stop()
-        for client in (self.tilt, self.recorder):
-            client.deactivate()
-            client.close()
+        for client, callback in zip((self.tilt, self.recorder), self.callbacks):
+            close_client(client, callback)
 
 
 def tilt_ccs(value):

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from jack_server import connect_once_active, stop, wait_for
+from jack_server import LeavableCallback, close_client, connect_once_active, stop, wait_for
 from test_standalone import CLI, own_jack_server
 
 NOISE_DBFS = -30.0
@@ -112,7 +112,7 @@ def test_the_runner_plays_level_matched_stimuli_at_the_logged_frames(jack_server
         if recording[0]:
             chunks.append((recorder.last_frame_time, [p.get_array().copy() for p in inputs]))
 
-    recorder.set_process_callback(record)
+    callback = LeavableCallback(recorder, record)
     recorder.activate()
     env = dict(os.environ, JACK_DEFAULT_SERVER=jack_server)
     runner = subprocess.Popen(
@@ -136,8 +136,7 @@ def test_the_runner_plays_level_matched_stimuli_at_the_logged_frames(jack_server
     finally:
         stop(runner)
         recording[0] = False
-        recorder.deactivate()
-        recorder.close()
+        close_client(recorder, callback)
 
     rows = list(csv.DictReader(open(tmp_path / "log.csv")))
     # Each cycle's samples at its frame; a cycle the recorder missed (a busy machine) stays NaN.
@@ -359,7 +358,7 @@ def test_a_triangle_test_of_a_recording_plays_on_jack_in_the_seeded_order(jack_s
         if recording[0]:
             chunks.append((recorder.last_frame_time, inport.get_array().copy()))
 
-    recorder.set_process_callback(record)
+    callback = LeavableCallback(recorder, record)
     recorder.activate()
     env = dict(os.environ, JACK_DEFAULT_SERVER=jack_server)
     client = "triangle-under-test"
@@ -381,8 +380,7 @@ def test_a_triangle_test_of_a_recording_plays_on_jack_in_the_seeded_order(jack_s
     finally:
         stop(runner)
         recording[0] = False
-        recorder.deactivate()
-        recorder.close()
+        close_client(recorder, callback)
     rows = list(csv.DictReader(open(tmp_path / "log.csv")))
     check_triangle_log(rows, trials)
     start = chunks[0][0]

@@ -19,14 +19,13 @@ jackd2) and the JACK-Client and SciPy packages (tests/host/requirements.txt).
 
 import os
 import subprocess
-import threading
 import tomllib
 from dataclasses import dataclass, field
 
 import numpy as np
 import pytest
 
-from jack_server import RATE, wait_for
+from jack_server import RATE, LeavableCallback, close_client, wait_for
 from test_standalone import CLI, own_jack_server
 
 FILTER = "device-under-test"
@@ -68,29 +67,18 @@ def device(jack_server):
     drive = client.inports.register("drive_in")
     accelerometer = client.outports.register("accel_out")
     state = [np.zeros((device.sos.shape[0], 2))]
-    leaving, left = threading.Event(), threading.Event()
 
     def process(frames):
-        if leaving.is_set():
-            left.set()
-            return
         filtered, state[0] = sosfilt(device.sos, drive.get_array(), zi=state[0])
         accelerometer.get_array()[:] = GAIN * filtered
 
-    client.set_process_callback(process)
+    callback = LeavableCallback(client, process)
     client.set_freewheel_callback(device.freewheel.append)
     client.activate()
     try:
         yield device
     finally:
-        # jack_deactivate cancels the process thread (pthread_cancel) once the server has let it
-        # go: cancelled inside Python, it takes the GIL with it and this process hangs. So the
-        # callback first becomes instant (a cycle that saw `leaving` has ended), and the thread
-        # is then cancelled waiting for a cycle, not inside one.
-        leaving.set()
-        wait_for(left.is_set, 30, "the device's callback to see it is leaving")
-        client.deactivate()
-        client.close()
+        close_client(client, callback)
 
 
 def measure(jack_server, tmp_path, *options):

@@ -30,7 +30,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from jack_server import RATE, connect_once_active, forget_jack, start_jack, stop, wait_for
+from jack_server import (
+    RATE,
+    LeavableCallback,
+    close_client,
+    connect_once_active,
+    forget_jack,
+    start_jack,
+    stop,
+    wait_for,
+)
 
 REPO = Path(__file__).resolve().parents[2]
 TARGET = Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target"))
@@ -124,8 +133,10 @@ class Rig:
         self.sent_frames = []
         self.recording = False
         self.chunks = []
-        self.tilt.set_process_callback(self._send)
-        self.recorder.set_process_callback(self._record)
+        self.callbacks = [
+            LeavableCallback(self.tilt, self._send),
+            LeavableCallback(self.recorder, self._record),
+        ]
         self.tilt.activate()
         self.recorder.activate()
 
@@ -182,9 +193,8 @@ class Rig:
         return start, np.concatenate([block for _, block in chunks])
 
     def close(self):
-        for client in (self.tilt, self.recorder):
-            client.deactivate()
-            client.close()
+        for client, callback in zip((self.tilt, self.recorder), self.callbacks):
+            close_client(client, callback)
 
 
 NOTE_ON = [0x90, 60, 100]  # any note-on refills the bottle
