@@ -158,8 +158,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", value_parser = take_count, help = format!(
         "Renders a set of N takes of each scene (1 to {MAX_TAKES}; default: its [variations] \
          table's count), each with its own seed and values drawn from the ranges of the table \
-         (MODEL.md §10.2): each output FILE.ext is FILE_01.ext … FILE_NN.ext, and NAME.variations.csv \
-         and .json (NAME the first output's) list what each take drew"
+         (MODEL.md §10.2): each output FILE.ext is FILE_01.ext … FILE_NN.ext, and \
+         NAME.variations.csv and .json (NAME the first output's) list what each take drew"
     ))]
     variations: Option<u32>,
     /// Renders one take of a set again, bit for bit, from its row in the set's manifest:

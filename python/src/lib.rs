@@ -518,13 +518,7 @@ fn render_variations<'py>(
         if let Some(reason) = silent {
             warn_silent(py, &format!("take {}: {reason}", take.number))?;
         }
-        // Every take is measured (render_levelled's `measure`).
-        let measured = measured.unwrap_or(Loudness {
-            integrated_lufs: f64::NAN,
-            range_lu: f64::NAN,
-            true_peak_dbtp: f64::NAN,
-            duration_s: f64::NAN,
-        });
+        let measured = measured.expect("render_levelled measures every take");
         // The manifest's row, but for the file name a set of samples has not.
         let row = PyDict::new(py);
         for (column, cell) in manifest_row(&take, "", count, &measured) {

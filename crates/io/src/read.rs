@@ -56,9 +56,12 @@ impl InputKind {
     /// A set's manifest of takes (16 MiB): a row of a few hundred bytes per take, at most
     /// 9,999 takes.
     pub const VARIATIONS: Self = Self::new("variations manifest", 16 * MIB);
+    /// A file a render has just written, read back to measure what it holds (`--fidelity`) (4
+    /// GiB, the most a RIFF WAV file can hold).
+    pub const WRITTEN: Self = Self::new("file read back", 4096 * MIB);
 
     /// Every kind of input, for a test that tries each.
-    pub const ALL: [Self; 11] = [
+    pub const ALL: [Self; 12] = [
         Self::SCENE,
         Self::MODEL,
         Self::MIDI_TAKE,
@@ -70,6 +73,7 @@ impl InputKind {
         Self::STUDY_LOG,
         Self::ACTUATOR,
         Self::VARIATIONS,
+        Self::WRITTEN,
     ];
 
     const fn new(name: &'static str, max_bytes: u64) -> Self {

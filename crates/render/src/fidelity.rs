@@ -17,6 +17,7 @@ use super::sinks::read_back::{ReadBack, Reading, WrittenClip};
 use super::sinks::{Output, OutputError, OutputFormat, OutputOptions};
 use super::steps::ComponentEnvelopes;
 use sake_glug_engine::{ActuatorResponse, UnitOnset, Voicing};
+use sake_glug_io::read::{self, InputKind};
 
 /// The envelope is compared where the model's is within this of its loudest (−40 dB): the
 /// glugging part, where a difference can be felt; below it every format is near silence.
@@ -247,7 +248,7 @@ pub fn measure(
                 }
                 ReadBack::Clip(read, _) => {
                     let path = &output.path;
-                    let text = std::fs::read_to_string(path).map_err(OutputError::io(path))?;
+                    let text = read::read_text(path, InputKind::WRITTEN)?;
                     // The model's glugs at the drive the clip was written at (--haptic-peak),
                     // found as its sink found it, so the envelope is compared shape to shape.
                     let drive = format.clip_drive_gain(path, &source, options)?;

@@ -325,18 +325,19 @@ impl LevelStage {
             *peak = samples.iter().fold(*peak, |peak, y| peak.max(y.abs()));
             Ok::<(), RenderError>(())
         };
-        let mut wide = Vec::new();
         render_scene(
             scene,
             |block: &[f32]| {
                 if let Some(meter) = meter.as_mut() {
                     meter.add(block);
                 }
-                wide.clear();
-                wide.extend(block.iter().map(|&y| f64::from(y)));
                 for (_, peak, resample) in &mut peaks {
                     match resample {
-                        None => fold_peak(peak, &wide)?,
+                        None => {
+                            *peak = block
+                                .iter()
+                                .fold(*peak, |peak, &y| peak.max(y.abs().into()))
+                        }
                         Some(resample) => {
                             resample.push(block, &mut |samples: &[f64]| fold_peak(peak, samples))?
                         }

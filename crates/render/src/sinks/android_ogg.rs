@@ -59,7 +59,7 @@ fn haptic_peak(path: &std::path::Path) -> Result<f64, OutputError> {
         path: path.to_owned(),
         message,
     };
-    let file = File::open(path).map_err(OutputError::io(path))?;
+    let file = sake_glug_io::read::open(path, sake_glug_io::read::InputKind::WRITTEN)?;
     let mut decoder = vorbis_rs::VorbisDecoder::new(std::io::BufReader::new(file))
         .map_err(|e| error(e.to_string()))?;
     let haptic = usize::from(ANDROID_OGG_CHANNELS) - 1;

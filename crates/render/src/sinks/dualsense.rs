@@ -9,6 +9,7 @@ use std::io::BufWriter;
 use std::path::Path;
 
 use hound::{SampleFormat, WavSpec, WavWriter};
+use sake_glug_io::read::{self, InputKind};
 
 use super::read_back::{HapticChannel, ReadBack};
 use super::{OutputError, OutputFormat, PendingFile, Sink, SinkContext};
@@ -57,7 +58,9 @@ const ACTUATOR_CHANNELS: std::ops::Range<usize> = 2..4;
 
 /// The largest |sample| of a written file's actuator channels (0..1 of full scale).
 fn actuators_peak(path: &Path) -> Result<f64, OutputError> {
-    let mut reader = hound::WavReader::open(path).map_err(encode_error(path))?;
+    let file = read::open(path, InputKind::WRITTEN)?;
+    let mut reader =
+        hound::WavReader::new(std::io::BufReader::new(file)).map_err(encode_error(path))?;
     let mut peak = 0i32;
     for (index, sample) in reader.samples::<i16>().enumerate() {
         let sample = sample.map_err(encode_error(path))?;

@@ -471,6 +471,9 @@ pub enum OutputError {
         /// The longest render it can hold (s).
         max_s: f64,
     },
+    /// A file just written could not be read back (`--fidelity`).
+    #[error(transparent)]
+    ReadBack(#[from] sake_glug_io::read::ReadError),
     /// Another file could not be written.
     #[error("cannot write {}: {source}", path.display())]
     Io {
