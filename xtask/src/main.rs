@@ -134,6 +134,12 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             build_cli()?;
             paper::paper()
         }
+        // The fit's tables on recordings and simulated bottles it was not tuned on (docs/fit.md),
+        // written by the tests that hold them, the simulated family at its full size.
+        Some("docs") if args.get(1).is_some_and(|arg| arg == "fit") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            fit_docs()
+        }
         // The cost figures alone (callgrind, and the benchmark's report with --bench): seconds,
         // where the whole of `docs` renders for minutes.
         Some("docs") if args.get(1).is_some_and(|arg| arg == "scaling") => {
@@ -874,6 +880,20 @@ fn files_in(folder: &Path) -> nice_plug_xtask::Result<Vec<PathBuf>> {
 /// The guide's pages that hold blocks the code writes (`<!-- generated:NAME:begin -->`).
 const SOUND_DESIGNER_PAGE: &str = "docs/guide/sound-designer.md";
 const HAPTIC_DESIGNER_PAGE: &str = "docs/guide/haptic-designer.md";
+
+/// docs/fit.md's tables, written by the fit suite's tests that hold them (run in the release
+/// profile: the simulated family fits a hundred bottles).
+fn fit_docs() -> nice_plug_xtask::Result<()> {
+    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .args(["test", "--release", "--test", "fit", "--", "--include-ignored", "listening::", "family::"])
+        .env("SAKE_GLUG_WRITE_FIT_TABLES", "1")
+        .env("SAKE_GLUG_FULL_FAMILY", "1")
+        .status()?;
+    if !status.success() {
+        anyhow::bail!("writing docs/fit.md through the fit suite failed ({status})");
+    }
+    Ok(())
+}
 
 fn replace_block(file: &str, name: &str, content: &str) -> nice_plug_xtask::Result<()> {
     let text = std::fs::read_to_string(file)?;

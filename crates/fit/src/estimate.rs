@@ -8,6 +8,25 @@ pub const MIN_UNITS_FOR_INTERVAL: usize = 5;
 /// The fewest units an estimate written into the model comes from.
 pub const MIN_UNITS_FOR_MODEL: usize = 3;
 
+/// Which path of the fit gave an estimate (MODEL.md §13).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Source {
+    /// The units' fits (or the drain: a rate, the capacity).
+    Units,
+    /// The listening fit: candidates rendered and heard against the recordings.
+    Listening,
+}
+
+impl Source {
+    /// Its name in the report and the JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Units => "units",
+            Self::Listening => "listening",
+        }
+    }
+}
+
 /// One estimate of the report, written to the model under `key` if it is a model key.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Estimate {
@@ -23,6 +42,8 @@ pub struct Estimate {
     pub in_model: bool,
     /// Why it has no value, no interval, or is not in the model.
     pub note: Option<String>,
+    /// The path that gave it.
+    pub source: Source,
 }
 
 impl Estimate {
@@ -42,6 +63,7 @@ impl Estimate {
             units: Some(units),
             in_model,
             note: None,
+            source: Source::Units,
         };
         if !value.is_finite() {
             estimate.fail(if units == 0 {
@@ -79,6 +101,7 @@ impl Estimate {
             units: None,
             in_model,
             note: None,
+            source: Source::Units,
         };
         if !value.is_finite() {
             estimate.fail("could not be estimated".to_owned());
@@ -92,6 +115,16 @@ impl Estimate {
         self.interval = None;
         self.in_model = false;
         self.note = Some(why);
+    }
+
+    /// Set by the listening fit to `value`, for `why`: in the model, with no interval (a search
+    /// over renders gives none).
+    pub fn by_listening(&mut self, value: f64, why: String) {
+        self.value = value;
+        self.interval = None;
+        self.in_model = true;
+        self.note = Some(why);
+        self.source = Source::Listening;
     }
 
     /// Whether it has a value.

@@ -36,6 +36,7 @@ fn estimate_json(estimate: &Estimate) -> Value {
         "n": estimate.units,
         "in_model": estimate.in_model,
         "note": estimate.note,
+        "from": estimate.source.name(),
     })
 }
 

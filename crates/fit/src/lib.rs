@@ -10,6 +10,7 @@
 //! pictures; [`write_fit`] writes them all or none.
 
 mod audio;
+mod by_ear;
 #[cfg(feature = "plot")]
 mod compare_plot;
 mod curves;
@@ -37,12 +38,13 @@ mod write;
 
 pub mod compare;
 
+pub use by_ear::{misses, Listened, ListeningFit};
 pub use audio::{Audio, FIT_BYTES_PER_SAMPLE, MIN_SAMPLE_RATE_HZ};
 #[cfg(feature = "plot")]
 pub use compare_plot::draw_compare_plot;
 pub use curves::FittedCurves;
 pub use error::{FitError, SampleFault};
-pub use estimate::{Estimate, MIN_UNITS_FOR_INTERVAL, MIN_UNITS_FOR_MODEL};
+pub use estimate::{Estimate, Source, MIN_UNITS_FOR_INTERVAL, MIN_UNITS_FOR_MODEL};
 pub use headspace::{HeadspaceLaw, ModeLaw};
 pub use json::fit_json;
 pub use liquid::LiquidFit;

@@ -2,6 +2,7 @@
 //! recordings, its pocket and timing from their intervals, its pour time from the rate at 135°,
 //! each estimate checked by the honesty rules of [`Estimate`].
 
+use super::by_ear::{fit_by_listening, ListeningFit};
 use super::curves::FittedCurves;
 use super::estimate::Estimate;
 use super::estimate::MIN_UNITS_FOR_MODEL;
@@ -41,6 +42,8 @@ pub struct LiquidFit {
     pub amplitude_law: Option<Line>,
     /// The model: a scene file.
     pub model_toml: String,
+    /// What the listening fit did, where the units' model did not sound like the recordings.
+    pub listening: Option<ListeningFit>,
 }
 
 impl LiquidFit {
@@ -359,15 +362,37 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
             )
         }))
         .collect();
-    let model_toml = model_toml(liquid, &estimates, inputs.curves, &kept_default, &cautions);
+    let mut kept_default = kept_default;
+    let mut model = model_toml(liquid, &estimates, inputs.curves, &kept_default, &cautions);
+    let listening = if units.len() >= MIN_UNITS_FOR_MODEL {
+        fit_by_listening(
+            &model,
+            &mut estimates,
+            recordings,
+            capacity_ml,
+            matches!(inputs.modes, Modes::Split(_)),
+        )
+    } else {
+        None
+    };
+    if let Some(listening) = &listening {
+        warnings.push(format!(
+            "liquid `{liquid}`: the units' model did not sound like its recordings, so {} were \
+             fitted by listening (MODEL.md §13)",
+            listening.set.join(", ")
+        ));
+        kept_default = kept_at_default(&estimates, inputs.curves);
+        model = model_toml(liquid, &estimates, inputs.curves, &kept_default, &cautions);
+    }
     LiquidFit {
+        listening,
         liquid: liquid.to_owned(),
         units: units.len(),
         detected,
         modes: inputs.modes,
         estimates,
         kept_default,
-        model_toml,
+        model_toml: model,
         amplitude_law: law,
     }
 }

@@ -5,9 +5,9 @@
 //! the bottle's two modes. (The log-spectral distance between two pours is
 //! [`super::compare::log_spectral_distance`].)
 
-use rustfft::{num_complex::Complex, FftPlanner};
+use rustfft::num_complex::Complex;
 
-use super::spectrum::Spectrum;
+use super::spectrum::{forward, Spectrum};
 
 /// The envelope's frame (s).
 const FRAME_S: f64 = 0.005;
@@ -169,9 +169,7 @@ fn low_pitch(samples: &[f32], sample_rate: f64, split_hz: f64) -> f64 {
         .chain(std::iter::repeat(Complex::new(0.0, 0.0)))
         .take(padded)
         .collect();
-    FftPlanner::new()
-        .plan_fft_forward(padded)
-        .process(&mut buffer);
+    forward(padded).process(&mut buffer);
     let bin_hz = sample_rate / padded as f64;
     let (first, last) = (
         (LOWEST_PITCH_HZ / bin_hz).ceil() as usize,

@@ -88,9 +88,9 @@ pub fn report_markdown(fit: &SessionFit) -> String {
         );
         let _ = writeln!(
             out,
-            "| estimate | value | 95 % interval | units | in the model |"
+            "| estimate | value | 95 % interval | units | in the model | from |"
         );
-        let _ = writeln!(out, "|---|---|---|---|---|");
+        let _ = writeln!(out, "|---|---|---|---|---|---|");
         for estimate in &liquid.estimates {
             let interval = match estimate.interval {
                 Some((low, high)) => format!("{} … {}", sig(low), sig(high)),
@@ -98,7 +98,7 @@ pub fn report_markdown(fit: &SessionFit) -> String {
             };
             let _ = writeln!(
                 out,
-                "| `{}` | {} | {} | {} | {} |",
+                "| `{}` | {} | {} | {} | {} | {} |",
                 estimate.key,
                 if estimate.has_value() {
                     sig(estimate.value)
@@ -107,7 +107,19 @@ pub fn report_markdown(fit: &SessionFit) -> String {
                 },
                 interval,
                 estimate.units.map_or("—".into(), |n| n.to_string()),
-                if estimate.in_model { "yes" } else { "no" }
+                if estimate.in_model { "yes" } else { "no" },
+                estimate.source.name()
+            );
+        }
+        if let Some(listening) = &liquid.listening {
+            let _ = writeln!(
+                out,
+                "\nFitted by listening (the units' model did not sound like the recordings): {}; \
+                 the summed misses of what a listener hears (rate, pitch, fall, bright share, \
+                 spectral distance, each in its tolerance) went from {:.2} to {:.2}.",
+                listening.set.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", "),
+                listening.cost[0],
+                listening.cost[1]
             );
         }
         if let Some(law) = liquid.amplitude_law {

@@ -35,7 +35,7 @@ thread_local! {
 }
 
 /// The forward FFT of `len` points, planned once per length and thread.
-fn forward(len: usize) -> std::sync::Arc<dyn rustfft::Fft<f64>> {
+pub(crate) fn forward(len: usize) -> std::sync::Arc<dyn rustfft::Fft<f64>> {
     PLANNER.with(|planner| planner.borrow_mut().plan_fft_forward(len))
 }
 

@@ -1,0 +1,584 @@
+//! A model fitted by listening (MODEL.md §13, "Fitted by listening"). Where the units' model does
+//! not sound like its recordings (a measure a listener hears lies beyond its tolerance), its
+//! constants are fitted again by rendering candidates as each recording was made and minimising
+//! how far what a listener hears of them lies from what they hear of the recording: the glug rate,
+//! the median glug pitch, the pitch's fall, the share of the energy above 700 Hz and the
+//! log-spectral distance ([`super::listen`], [`super::compare`]). The unit fits, where they are
+//! good, start the search and bound it to their 95 % intervals.
+
+use argmin::core::{CostFunction, Error as ArgminError, Executor};
+use argmin::solver::neldermead::NelderMead;
+
+use sake_glug_engine::{Constant, Control};
+use sake_glug_io::keys;
+use sake_glug_render::{render_scene_to_vec, Scene};
+
+use super::compare::{log_spectral_distance, AsRecorded, ONE_MODE_SPLIT_HZ};
+use super::estimate::Estimate;
+use super::listen::{hear, Heard};
+use super::recording::{RecordingFit, LOW_EXPLAINED};
+use super::spectrum::Spectrum;
+use super::stats::median;
+
+/// The glug rate a listener takes for the same: within 25 %.
+pub const RATE_TOLERANCE: f64 = 0.25;
+/// The median glug pitch: within 15 %.
+pub const PITCH_TOLERANCE: f64 = 0.15;
+/// The pitch's fall over the recording's glugs: within 15 %.
+pub const FALL_TOLERANCE: f64 = 0.15;
+/// The share of the energy above [`ONE_MODE_SPLIT_HZ`]: within 10 points.
+pub const BRIGHT_TOLERANCE: f64 = 0.10;
+/// A log-spectral distance (dB) below which a model is as near as can be told: the distance
+/// misses in units of the default bottle's distance, but never of less than this (a recording
+/// of the default bottle itself is no reason to fit again).
+pub const NEAR_DISTANCE_DB: f64 = 4.0;
+/// The fewest glugs a recording's pitch fall is listened for over.
+const MIN_GLUGS_FOR_FALL: usize = 4;
+/// What a measure the recording has and a candidate lacks costs: as far as twice its tolerance.
+const MISSING: f64 = 4.0;
+/// The evaluations of one search.
+const MAX_ITERATIONS: u64 = 160;
+/// A units' interval is widened by this factor on each side before it bounds the search.
+const INTERVAL_SLACK: f64 = 1.1;
+
+/// What a listener hears of one pour, as the listening fit compares it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Listened {
+    /// Glugs a second (NaN with fewer than 2 glugs).
+    pub rate_per_s: f64,
+    /// The median of the glugs' low pitch (Hz; NaN where none is heard).
+    pub pitch_hz: f64,
+    /// The first glug's pitch over the last's, over the recording's glugs (NaN where not heard).
+    pub fall: f64,
+    /// The share of the energy above [`ONE_MODE_SPLIT_HZ`].
+    pub bright: f64,
+    /// The log-spectral distance from the recording (dB; 0 for the recording itself).
+    pub distance_db: f64,
+}
+
+impl Listened {
+    /// What a listener hears of `samples`, its pitch fall read over `glugs` glugs, its spectrum
+    /// against the recording's `reference`.
+    pub fn of(samples: &[f32], sample_rate: f64, glugs: usize, reference: &Spectrum) -> Self {
+        let heard = hear(samples, sample_rate, ONE_MODE_SPLIT_HZ);
+        let spectrum = Spectrum::of(samples, sample_rate);
+        Self::from_heard(
+            &heard,
+            glugs,
+            log_spectral_distance(reference, &spectrum, sample_rate),
+        )
+    }
+
+    fn from_heard(heard: &Heard, glugs: usize, distance_db: f64) -> Self {
+        let pitches: Vec<f64> = heard
+            .pitch_hz
+            .iter()
+            .copied()
+            .filter(|p| p.is_finite())
+            .collect();
+        Self {
+            rate_per_s: heard.rate_per_s,
+            pitch_hz: if pitches.is_empty() {
+                f64::NAN
+            } else {
+                median(&pitches)
+            },
+            fall: if glugs >= MIN_GLUGS_FOR_FALL {
+                heard.fall_over(glugs)
+            } else {
+                f64::NAN
+            },
+            bright: heard.high_share,
+            distance_db,
+        }
+    }
+}
+
+/// How far each measure of `candidate` lies from the recording's, in tolerances (squared): the
+/// rate, the pitch, the fall, the bright share, and the distance over the default bottle's.
+pub fn misses(recording: &Listened, candidate: &Listened, default_distance_db: f64) -> [f64; 5] {
+    let ratio = |ours: f64, theirs: f64, tolerance: f64| {
+        if !theirs.is_finite() {
+            0.0
+        } else if !ours.is_finite() || ours <= 0.0 {
+            MISSING
+        } else {
+            ((ours / theirs).ln() / (1.0 + tolerance).ln()).powi(2)
+        }
+    };
+    let difference = |ours: f64, theirs: f64, tolerance: f64| {
+        if !theirs.is_finite() {
+            0.0
+        } else if !ours.is_finite() {
+            MISSING
+        } else {
+            ((ours - theirs) / tolerance).powi(2)
+        }
+    };
+    [
+        ratio(candidate.rate_per_s, recording.rate_per_s, RATE_TOLERANCE),
+        ratio(candidate.pitch_hz, recording.pitch_hz, PITCH_TOLERANCE),
+        ratio(candidate.fall, recording.fall, FALL_TOLERANCE),
+        difference(candidate.bright, recording.bright, BRIGHT_TOLERANCE),
+        if candidate.distance_db.is_finite() {
+            (candidate.distance_db / default_distance_db.max(NEAR_DISTANCE_DB)).powi(2)
+        } else {
+            MISSING
+        },
+    ]
+}
+
+/// How a constant is searched: its scale and the widest span tried.
+#[derive(Debug, Clone, Copy)]
+enum Scale {
+    /// ln of the value.
+    Log,
+    /// The logit of a share.
+    Share,
+}
+
+/// One constant the listening fit sets.
+#[derive(Debug, Clone, Copy)]
+struct Knob {
+    /// Its model key.
+    key: &'static str,
+    scale: Scale,
+    /// The widest span searched (the recording's Nyquist limit bounds a frequency further).
+    span: (f64, f64),
+    /// A frequency (bounded by the recording's rate).
+    frequency: bool,
+    /// Which of the bottle's modes it belongs to (None: the pour, not a mode).
+    mode: Option<usize>,
+}
+
+impl Knob {
+    fn to_search(self, value: f64) -> f64 {
+        match self.scale {
+            Scale::Log => value.ln(),
+            Scale::Share => {
+                let share = value.clamp(1e-3, 1.0 - 1e-3);
+                (share / (1.0 - share)).ln()
+            }
+        }
+    }
+
+    fn from_search(self, x: f64) -> f64 {
+        match self.scale {
+            Scale::Log => x.exp(),
+            Scale::Share => 1.0 / (1.0 + (-x).exp()),
+        }
+    }
+}
+
+/// The constants the listening fit sets, and the widest span each is searched over.
+fn knobs() -> [Knob; 7] {
+    let constant = |c: Constant| c.quantity().scene_key;
+    [
+        Knob {
+            key: constant(Constant::F1),
+            scale: Scale::Log,
+            span: (30.0, 4000.0),
+            frequency: true,
+            mode: Some(0),
+        },
+        Knob {
+            key: constant(Constant::F2),
+            scale: Scale::Log,
+            span: (30.0, 4000.0),
+            frequency: true,
+            mode: Some(1),
+        },
+        Knob {
+            key: constant(Constant::B1),
+            scale: Scale::Log,
+            span: (3.0, 2000.0),
+            frequency: false,
+            mode: Some(0),
+        },
+        Knob {
+            key: constant(Constant::B2),
+            scale: Scale::Log,
+            span: (3.0, 2000.0),
+            frequency: false,
+            mode: Some(1),
+        },
+        Knob {
+            key: Control::Viscosity.quantity().scene_key,
+            scale: Scale::Share,
+            span: (0.01, 0.99),
+            frequency: false,
+            mode: None,
+        },
+        Knob {
+            key: constant(Constant::FreqJitter),
+            scale: Scale::Share,
+            span: (0.002, 0.5),
+            frequency: false,
+            mode: None,
+        },
+        Knob {
+            key: Control::PourTime.quantity().scene_key,
+            scale: Scale::Log,
+            span: (0.2, 600.0),
+            frequency: false,
+            mode: None,
+        },
+    ]
+}
+
+/// One recording as the listening fit hears it.
+struct Target {
+    made: AsRecorded,
+    /// Its glugs (the pitch fall is read over as many).
+    glugs: usize,
+    spectrum: Spectrum,
+    listened: Listened,
+    /// The default bottle's log-spectral distance from it (dB).
+    default_distance_db: f64,
+}
+
+/// The search: candidates rendered and listened to.
+#[derive(Clone, Copy)]
+struct Search<'a> {
+    base: &'a toml::Table,
+    knobs: &'a [Knob],
+    bounds: &'a [(f64, f64)],
+    targets: &'a [Target],
+}
+
+impl Search<'_> {
+    /// The model file of the point `x` of the search space (brought within its bounds).
+    fn model(&self, x: &[f64]) -> toml::Table {
+        let mut table = self.base.clone();
+        for ((knob, &(low, high)), &xi) in self.knobs.iter().zip(self.bounds).zip(x) {
+            let value = knob.from_search(xi.clamp(low, high));
+            keys::insert(&mut table, knob.key, toml::Value::Float(value));
+        }
+        table
+    }
+
+    /// The summed misses of the model `table` over every recording (None: it does not render).
+    fn cost_of(&self, table: &toml::Table) -> Option<f64> {
+        let mut total = 0.0;
+        for target in self.targets {
+            let samples = render_as_recorded(table, &target.made)?;
+            let listened = Listened::of(
+                &samples,
+                f64::from(target.made.sample_rate),
+                target.glugs,
+                &target.spectrum,
+            );
+            total += misses(&target.listened, &listened, target.default_distance_db)
+                .iter()
+                .sum::<f64>();
+        }
+        Some(total)
+    }
+
+    /// How far `x` lies outside its bounds (in the search space's units).
+    fn outside(&self, x: &[f64]) -> f64 {
+        x.iter()
+            .zip(self.bounds)
+            .map(|(&xi, &(low, high))| (low - xi).max(0.0) + (xi - high).max(0.0))
+            .sum()
+    }
+}
+
+impl CostFunction for Search<'_> {
+    type Param = Vec<f64>;
+    type Output = f64;
+
+    fn cost(&self, x: &Self::Param) -> Result<Self::Output, ArgminError> {
+        // A point beyond the bounds costs what its nearest point within costs, and more the
+        // further out it lies, so the simplex comes back.
+        let outside = self.outside(x);
+        let cost = self.cost_of(&self.model(x)).unwrap_or(1e6);
+        Ok(cost + 100.0 * outside * outside)
+    }
+}
+
+/// `table` (a model file) rendered as a recording was made; None if the renderer refuses it.
+fn render_as_recorded(table: &toml::Table, made: &AsRecorded) -> Option<Vec<f32>> {
+    let mut table = table.clone();
+    let mut set = |key: &str, value: toml::Value| keys::insert(&mut table, key, value);
+    set("sample_rate", toml::Value::Integer(made.sample_rate.into()));
+    set("duration_s", toml::Value::Float(made.duration_s));
+    set(
+        Control::Tilt.quantity().scene_key,
+        toml::Value::Float(made.tilt_deg),
+    );
+    set(
+        Control::Fill.quantity().scene_key,
+        toml::Value::Float(100.0 * made.fill),
+    );
+    let scene = Scene::parse(&toml::to_string(&table).ok()?).ok()?;
+    render_scene_to_vec(&scene).ok().map(|(samples, _)| samples)
+}
+
+/// What the listening fit did for one liquid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ListeningFit {
+    /// The summed misses of the units' model, and of the model kept.
+    pub cost: [f64; 2],
+    /// The keys it set.
+    pub set: Vec<String>,
+}
+
+/// Fits the constants of [`knobs`] by listening, where the units' model (`model_toml`, with its
+/// `estimates`) does not sound like `recordings`: the estimates it sets are marked as its own.
+/// None where the units' model already sounds like every recording (or nothing can be heard).
+pub(crate) fn fit_by_listening(
+    model_toml: &str,
+    estimates: &mut Vec<Estimate>,
+    recordings: &[&RecordingFit],
+    capacity_ml: f64,
+    two_modes: bool,
+) -> Option<ListeningFit> {
+    let base: toml::Table = toml::from_str(model_toml).ok()?;
+    let default: toml::Table = toml::from_str("tilt_deg = 135.0\n").ok()?;
+    let mut targets = Vec::new();
+    for recording in recordings {
+        let made = AsRecorded::of(recording, capacity_ml);
+        let fs = f64::from(made.sample_rate);
+        let length = ((made.duration_s * fs) as usize).min(recording.excerpt.len());
+        let samples = &recording.excerpt[..length];
+        let spectrum = Spectrum::of(samples, fs);
+        let heard = hear(samples, fs, ONE_MODE_SPLIT_HZ);
+        let glugs = heard.onsets_s.len();
+        let listened = Listened::from_heard(&heard, glugs, 0.0);
+        let default_render = render_as_recorded(&default, &made)?;
+        let default_distance_db = log_spectral_distance(
+            &spectrum,
+            &Spectrum::of(&default_render, fs),
+            fs,
+        );
+        targets.push(Target {
+            made,
+            glugs,
+            spectrum,
+            listened,
+            default_distance_db,
+        });
+    }
+    if targets.iter().all(|t| t.glugs < 2) {
+        return None;
+    }
+    let knobs = knobs();
+    let nyquist = targets
+        .iter()
+        .map(|t| 0.45 * f64::from(t.made.sample_rate))
+        .fold(f64::INFINITY, f64::min);
+    let explained = recordings.iter().all(|r| r.explained >= LOW_EXPLAINED);
+    let value_of = |key: &str, table: &toml::Table| {
+        let (section, name) = keys::split(key);
+        let holder = match section {
+            Some(section) => table.get(section)?.as_table()?,
+            None => table,
+        };
+        let value = holder.get(name)?;
+        value.as_float().or(value.as_integer().map(|i| i as f64))
+    };
+    let default_of = |key: &str| {
+        Constant::ALL
+            .iter()
+            .map(|c| c.quantity())
+            .chain(Control::ALL.iter().map(|c| c.quantity()))
+            .find(|q| q.scene_key == key)
+            .map_or(f64::NAN, |q| q.range.default)
+    };
+    let units_value = |key: &str| value_of(key, &base).unwrap_or_else(|| default_of(key));
+    // Each constant's bounds: its units' interval where they are good, else its widest span.
+    let bounds: Vec<(f64, f64)> = knobs
+        .iter()
+        .map(|knob| {
+            let (mut low, mut high) = knob.span;
+            if knob.frequency {
+                high = high.min(nyquist);
+            }
+            let estimate = estimates.iter().find(|e| e.key == knob.key);
+            let mode_heard = knob.mode != Some(1) || two_modes;
+            // c is the balance of the two modes: the units tell it only where they show both.
+            let shared = knob.key == Control::Viscosity.quantity().scene_key;
+            if let Some((from, to)) = estimate
+                .filter(|e| e.in_model && explained && mode_heard && (!shared || two_modes))
+                .and_then(|e| e.interval)
+            {
+                low = low.max(from / INTERVAL_SLACK);
+                high = high.min(to * INTERVAL_SLACK);
+            }
+            let (low, high) = if low < high { (low, high) } else { (high, low) };
+            (knob.to_search(low), knob.to_search(high))
+        })
+        .collect();
+    let search = Search {
+        base: &base,
+        knobs: &knobs,
+        bounds: &bounds,
+        targets: &targets,
+    };
+    let units_cost = search.cost_of(&base)?;
+    let units_pass = targets
+        .iter()
+        .map(|target| {
+            let samples = render_as_recorded(&base, &target.made)?;
+            let listened = Listened::of(
+                &samples,
+                f64::from(target.made.sample_rate),
+                target.glugs,
+                &target.spectrum,
+            );
+            Some(
+                misses(&target.listened, &listened, target.default_distance_db)
+                    .iter()
+                    .all(|&m| m < 1.0),
+            )
+        })
+        .all(|pass| pass == Some(true));
+    if units_pass {
+        return None;
+    }
+    let starts = starting_points(&knobs, &bounds, &targets, capacity_ml, &units_value);
+    let mut best: Option<(Vec<f64>, f64)> = None;
+    for start in starts {
+        let Some((x, cost)) = minimise(&search, start) else {
+            continue;
+        };
+        if best.as_ref().is_none_or(|(_, c)| cost < *c) {
+            best = Some((x, cost));
+        }
+    }
+    let (x, cost) = best?;
+    if cost >= units_cost {
+        return None;
+    }
+    let mut set = Vec::new();
+    for ((knob, &(low, high)), &xi) in knobs.iter().zip(&bounds).zip(&x) {
+        let value = knob.from_search(xi.clamp(low, high));
+        let bounded = (knob.from_search(low), knob.from_search(high));
+        let within_units = estimates
+            .iter()
+            .find(|e| e.key == knob.key)
+            .and_then(|e| e.interval)
+            .is_some_and(|(from, to)| bounded.0 >= from / INTERVAL_SLACK - 1e-9 && bounded.1 <= to * INTERVAL_SLACK + 1e-9);
+        let note = if within_units {
+            "fitted by listening, within the units' 95 % interval".to_owned()
+        } else {
+            "fitted by listening: the units' model did not sound like the recordings".to_owned()
+        };
+        match estimates.iter_mut().find(|e| e.key == knob.key) {
+            Some(estimate) => estimate.by_listening(value, note),
+            None => {
+                let mut estimate = Estimate::measured(knob.key, value, None, true);
+                estimate.by_listening(value, note);
+                estimates.push(estimate);
+            }
+        }
+        set.push(knob.key.to_owned());
+    }
+    Some(ListeningFit {
+        cost: [units_cost, cost],
+        set,
+    })
+}
+
+/// Where the searches start (in the search space): the units' model, the default bottle, and the
+/// recordings' own spectral peaks and rate.
+fn starting_points(
+    knobs: &[Knob],
+    bounds: &[(f64, f64)],
+    targets: &[Target],
+    capacity_ml: f64,
+    units_value: &dyn Fn(&str) -> f64,
+) -> Vec<Vec<f64>> {
+    let at = |values: &dyn Fn(&Knob) -> f64| -> Vec<f64> {
+        knobs
+            .iter()
+            .zip(bounds)
+            .map(|(knob, &(low, high))| {
+                let value = values(knob);
+                let x = knob.to_search(if value.is_finite() {
+                    value
+                } else {
+                    units_value(knob.key)
+                });
+                if x.is_finite() {
+                    x.clamp(low, high)
+                } else {
+                    0.5 * (low + high)
+                }
+            })
+            .collect()
+    };
+    let units = at(&|knob| units_value(knob.key));
+    let defaults = at(&|knob| {
+        Constant::ALL
+            .iter()
+            .map(|c| c.quantity())
+            .chain(Control::ALL.iter().map(|c| c.quantity()))
+            .find(|q| q.scene_key == knob.key)
+            .map_or(f64::NAN, |q| q.range.default)
+    });
+    // The recordings' own: the strongest peak below the split and above it, the share of the
+    // energy below it as c, and the pour time that glugs at the heard rate.
+    let first = &targets[0];
+    let (low_peak, high_peak) = strongest_peaks(&first.spectrum, first.made.sample_rate);
+    let rates: Vec<f64> = targets
+        .iter()
+        .map(|t| t.listened.rate_per_s)
+        .filter(|r| r.is_finite())
+        .collect();
+    let pocket_ml = units_value(Constant::Pocket.quantity().scene_key);
+    let heard = at(&|knob| match knob.key {
+        k if k == Constant::F1.quantity().scene_key => low_peak,
+        k if k == Constant::F2.quantity().scene_key => high_peak,
+        k if k == Control::Viscosity.quantity().scene_key => 1.0 - first.listened.bright,
+        k if k == Control::PourTime.quantity().scene_key && !rates.is_empty() => {
+            capacity_ml / (median(&rates) * pocket_ml)
+        }
+        _ => f64::NAN,
+    });
+    vec![units, heard, defaults]
+}
+
+/// The frequencies (Hz) of the strongest bins of `spectrum` below [`ONE_MODE_SPLIT_HZ`] (from
+/// 50 Hz) and above it (up to 4 kHz and 45 % of the rate).
+fn strongest_peaks(spectrum: &Spectrum, sample_rate: u32) -> (f64, f64) {
+    let strongest = |low: f64, high: f64| {
+        (0..spectrum.power.len())
+            .filter(|&bin| (low..high).contains(&spectrum.hz(bin)))
+            .max_by(|&a, &b| spectrum.power[a].total_cmp(&spectrum.power[b]))
+            .map_or(f64::NAN, |bin| spectrum.hz(bin))
+    };
+    (
+        strongest(50.0, ONE_MODE_SPLIT_HZ),
+        strongest(
+            ONE_MODE_SPLIT_HZ,
+            4000.0f64.min(0.45 * f64::from(sample_rate)),
+        ),
+    )
+}
+
+/// Nelder–Mead from `start`: the best point and its cost.
+fn minimise(search: &Search, start: Vec<f64>) -> Option<(Vec<f64>, f64)> {
+    // The first simplex: a step of a fifth of each bound's width (at least 0.1 in the search
+    // space: 10 % of a frequency).
+    let mut simplex = vec![start.clone()];
+    for (i, &(low, high)) in search.bounds.iter().enumerate() {
+        let step = (0.2 * (high - low)).max(0.1);
+        let mut vertex = start.clone();
+        vertex[i] = if start[i] + step <= high {
+            start[i] + step
+        } else {
+            start[i] - step
+        };
+        simplex.push(vertex);
+    }
+    let solver = NelderMead::new(simplex).with_sd_tolerance(1e-3).ok()?;
+    let result = Executor::new(*search, solver)
+        .configure(|state| state.max_iters(MAX_ITERATIONS))
+        .run()
+        .ok()?;
+    let state = result.state;
+    let x = state.best_param?;
+    Some((x, state.best_cost))
+}
