@@ -9,6 +9,12 @@
 //! - the **bubble**: the bubble pinched off as the pocket enters rings at Minnaert's resonance
 //!   f = (1/2πa)·√(3γp0/ρ) for its radius a, decaying fast; its pitch may rise from glug to glug.
 //!
+//! Either mode may **glide** within each glug, approaching its own frequency f from a start ρ·f
+//! as f(τ) = f·(1 + (ρ − 1)·e^(−τ/τ_g)) (the cavity down into its resonance as the bubble forms,
+//! ρ > 1; the bubble up as it rises and shrinks, ρ < 1), and the low mode may be **fixed**
+//! instead of the Helmholtz cavity: a resonance that does not grow with the air above the liquid
+//! (the paper's bottle, whose f1 it found almost constant), so that the pitch does not fall.
+//!
 //! The bubble takes the share `bubble_share` of each glug's amplitude and the cavity the rest;
 //! the cavity is the lower mode in both presets, so its share is MODEL.md §13's c = A1/(A1 + A2)
 //! (f1 the lower mode). A glug's amplitude may fall as the bottle empties. Around it: a room (the
@@ -20,9 +26,9 @@ use std::f64::consts::{PI, TAU};
 
 use super::bubbles::{minnaert_hz, minnaert_radius, SOUND_M_PER_S};
 /// The neck's end correction, in neck radii: 0.85·r at each of its two ends.
-const END_CORRECTION: f64 = 1.7;
+pub const END_CORRECTION: f64 = 1.7;
 /// Quiet before the first glug (s).
-const LEAD_IN_S: f64 = 0.05;
+pub const LEAD_IN_S: f64 = 0.05;
 /// A mode is rendered until its envelope falls below this share of its amplitude (−100 dB).
 const SILENT: f64 = 1e-5;
 /// The room's taps: one in each cell of this length (s), at a random place in it.
@@ -72,6 +78,30 @@ pub fn bubble_share_for_energy(
     ratio / (1.0 + ratio)
 }
 
+/// A mode's glide within a glug: f(τ) = f·(1 + (ρ − 1)·e^(−τ/τ_g)), from ρ·f at the onset to the
+/// mode's own f.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Glide {
+    /// ρ, the start frequency over the mode's own (1: no glide).
+    pub ratio: f64,
+    /// τ_g (s).
+    pub time_s: f64,
+}
+
+impl Glide {
+    /// The mode rings at its own frequency from its onset.
+    pub const NONE: Glide = Glide {
+        ratio: 1.0,
+        time_s: 0.0,
+    };
+
+    /// The phase (rad) the glide adds by τ to a mode of `hz` ringing at its own frequency:
+    /// 2π·f·(ρ − 1)·τ_g·(1 − e^(−τ/τ_g)), the integral of f(τ) − f.
+    fn extra_phase(&self, hz: f64, tau: f64) -> f64 {
+        TAU * hz * (self.ratio - 1.0) * self.time_s * (1.0 - (-tau / self.time_s).exp())
+    }
+}
+
 /// A bottle emptying as this simulator sees it.
 #[derive(Debug, Clone, Copy)]
 pub struct Params {
@@ -99,6 +129,13 @@ pub struct Params {
     pub timing_jitter: f64,
     /// The cavity mode's decay (1/s).
     pub cavity_decay: f64,
+    /// `None`: the low mode is the Helmholtz cavity of the air above the liquid; `Some(f)`: a
+    /// low mode fixed at f (Hz), whatever the air.
+    pub fixed_cavity_hz: Option<f64>,
+    /// The low mode's glide within each glug.
+    pub cavity_glide: Glide,
+    /// The bubble mode's glide within each glug.
+    pub bubble_glide: Glide,
     /// The ringing bubble's radius a (m) at the first glug.
     pub bubble_radius_m: f64,
     /// The bubble's pitch rises linearly from glug to glug, by this share of f at the last glug.
@@ -153,6 +190,9 @@ impl Params {
             rate_per_s: 10.0,
             timing_jitter: 0.15,
             cavity_decay: 30.0,
+            fixed_cavity_hz: None,
+            cavity_glide: Glide::NONE,
+            bubble_glide: Glide::NONE,
             bubble_radius_m: minnaert_radius(1150.0),
             bubble_rise: 0.0,
             bubble_decay: 150.0,
@@ -196,6 +236,9 @@ impl Params {
             rate_per_s: 8.0,
             timing_jitter: 0.15,
             cavity_decay,
+            fixed_cavity_hz: None,
+            cavity_glide: Glide::NONE,
+            bubble_glide: Glide::NONE,
             bubble_radius_m: minnaert_radius(bubble_first_hz),
             bubble_rise: bubble_last_hz / bubble_first_hz - 1.0,
             bubble_decay,
@@ -244,7 +287,7 @@ pub struct Simulated {
     pub bubble_energy: Vec<f64>,
     /// The cavity's decay (1/s).
     pub cavity_decay: f64,
-    /// The exponent γ of f ∝ V_air^(−γ) for the cavity: 1/2.
+    /// The exponent γ of f ∝ V_air^(−γ) for the cavity: 1/2 (0 for a fixed low mode).
     pub cavity_exponent: f64,
     /// The full bottle's headspace H (ml).
     pub headspace_ml: f64,
@@ -269,10 +312,16 @@ pub struct Simulated {
 }
 
 /// A small generator of its own (xorshift64*), so that the simulation shares nothing.
-struct Draws(u64);
+pub struct Draws(u64);
 
 impl Draws {
-    fn uniform(&mut self) -> f64 {
+    /// The generator of `seed`, mixed by `salt` (an odd constant of the caller's, so that two
+    /// users of one seed draw apart).
+    pub fn new(seed: u64, salt: u64) -> Self {
+        Draws(seed.wrapping_mul(salt) | 1)
+    }
+
+    pub fn uniform(&mut self) -> f64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;
@@ -280,7 +329,7 @@ impl Draws {
     }
 
     /// Uniform on −1…1.
-    fn signed(&mut self) -> f64 {
+    pub fn signed(&mut self) -> f64 {
         2.0 * self.uniform() - 1.0
     }
 
@@ -290,9 +339,19 @@ impl Draws {
     }
 }
 
-/// Adds A·e^(−Bτ)·sin(2πfτ), τ = t − onset ≥ 0, to `dry` until it is silent: the phasor
-/// e^((−B + iω)τ) advanced by one sample's step at a time.
-fn ring(dry: &mut [f64], fs: f64, onset: f64, amplitude: f64, hz: f64, decay: f64) {
+/// A glide's extra phase is taken as settled once τ passes this many τ_g (e^(−40) < 10⁻¹⁷).
+const GLIDE_SETTLED: f64 = 40.0;
+
+/// Adds A·e^(−Bτ)·sin(2πfτ + φ_g(τ)), τ = t − onset ≥ 0, to `dry` until it is silent: the phasor
+/// e^((−B + iω)τ) advanced by one sample's step at a time, turned by the glide's extra phase φ_g
+/// (none without a glide).
+fn ring(
+    dry: &mut [f64],
+    fs: f64,
+    onset: f64,
+    (amplitude, hz, decay): (f64, f64, f64),
+    glide: Glide,
+) {
     if amplitude == 0.0 {
         return;
     }
@@ -308,8 +367,17 @@ fn ring(dry: &mut [f64], fs: f64, onset: f64, amplitude: f64, hz: f64, decay: f6
         shrink * (TAU * hz / fs).cos(),
         shrink * (TAU * hz / fs).sin(),
     );
-    for sample in &mut dry[first..last] {
-        *sample += amplitude * im;
+    if glide.ratio == 1.0 {
+        for sample in &mut dry[first..last] {
+            *sample += amplitude * im;
+            (re, im) = (re * step_re - im * step_im, re * step_im + im * step_re);
+        }
+        return;
+    }
+    let settled = (GLIDE_SETTLED * glide.time_s * fs) as usize;
+    for (n, sample) in dry[first..last].iter_mut().enumerate() {
+        let phase = glide.extra_phase(hz, tau + n.min(settled) as f64 / fs);
+        *sample += amplitude * (im * phase.cos() + re * phase.sin());
         (re, im) = (re * step_re - im * step_im, re * step_im + im * step_re);
     }
 }
@@ -338,7 +406,7 @@ pub fn simulate(params: &Params) -> Simulated {
     );
     let fs = params.sample_rate;
     let nyquist = fs / 2.0;
-    let mut draws = Draws(params.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let mut draws = Draws::new(params.seed, 0x9E37_79B9_7F4A_7C15);
     // The glugs: each draws its pocket, interval, bubble decay and amplitude, in that order.
     let (mut onsets, mut volume_ml, mut pocket_ml, mut air_ml) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -366,11 +434,11 @@ pub fn simulate(params: &Params) -> Simulated {
         volume_ml.push(volume);
         pocket_ml.push(pocket);
         air_ml.push(air);
-        cavity_hz.push(helmholtz_hz(
-            air,
-            params.neck_radius_m,
-            params.neck_length_m,
-        ));
+        cavity_hz.push(
+            params
+                .fixed_cavity_hz
+                .unwrap_or_else(|| helmholtz_hz(air, params.neck_radius_m, params.neck_length_m)),
+        );
         bubble_hz.push(minnaert_hz(params.bubble_radius_m) * (1.0 + params.bubble_rise * along));
         bubble_decay.push(decay);
         level.push((1.0 - params.amplitude_fall * (1.0 - volume / params.capacity_ml)) * jitter);
@@ -391,10 +459,10 @@ pub fn simulate(params: &Params) -> Simulated {
         .collect();
     for glug in 0..onsets.len() {
         let onset = onsets[glug];
-        let (hz, decay) = (cavity_hz[glug], params.cavity_decay);
-        ring(&mut dry, fs, onset, cavity_amplitude[glug], hz, decay);
-        let (hz, decay) = (bubble_hz[glug], bubble_decay[glug]);
-        ring(&mut dry, fs, onset, bubble_amplitude[glug], hz, decay);
+        let cavity = (cavity_amplitude[glug], cavity_hz[glug], params.cavity_decay);
+        ring(&mut dry, fs, onset, cavity, params.cavity_glide);
+        let bubble = (bubble_amplitude[glug], bubble_hz[glug], bubble_decay[glug]);
+        ring(&mut dry, fs, onset, bubble, params.bubble_glide);
     }
     // The room: the dry sound convolved with sparse noise (one tap of random sign at a random
     // place in each millisecond) under an envelope falling 60 dB over its decay time.
@@ -486,7 +554,11 @@ pub fn simulate(params: &Params) -> Simulated {
         cavity_energy,
         bubble_energy,
         cavity_decay: params.cavity_decay,
-        cavity_exponent: 0.5,
+        cavity_exponent: if params.fixed_cavity_hz.is_some() {
+            0.0
+        } else {
+            0.5
+        },
         headspace_ml: params.headspace_ml,
         rate_per_s: params.rate_per_s,
         drain_ml_per_s,

@@ -7,6 +7,7 @@ mod bubbles;
 mod command;
 mod emptying;
 mod emptying_fit;
+mod family;
 mod listening;
 mod real;
 mod round_trip;

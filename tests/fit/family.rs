@@ -1,0 +1,701 @@
+//! The independent emptying simulator (`emptying.rs`) drawn at random over a wide family of
+//! bottles (issue 45, item 2), each draw fitted as a bare clip of its bottle (its capacity given,
+//! full at the first sample) and judged per constant against its truth: the simulators as a
+//! family, not a point.
+//!
+//! Two disjoint sets of seeds: the **development** set, run while the fit is tuned, and the
+//! **held-out** set, run only at the end. Each prints its table (per draw the truth, the model's
+//! value and a pass or a miss per constant; per constant the share within tolerance and the
+//! draws that miss) and writes it as markdown to the file that `SAKE_GLUG_FAMILY_TABLE` (the
+//! development set) or `SAKE_GLUG_FAMILY_HELD_OUT_TABLE` (the held-out set) names. The goal, each
+//! constant within its tolerance in at least 90 % of the draws, is not met by today's fit, so
+//! both are `#[ignore]`d:
+//!
+//! ```sh
+//! SAKE_GLUG_FAMILY_TABLE=family.md cargo test --test fit family -- --ignored --nocapture
+//! ```
+
+use std::f64::consts::{PI, TAU};
+use std::fmt::Write as _;
+use std::ops::Range;
+
+use sake_glug_engine::Constant;
+use sake_glug_fit::compare::compare;
+use sake_glug_fit::{fit_session, FitSession, SessionFit};
+use sake_glug_render::Scene;
+
+use super::bubbles::{minnaert_hz, minnaert_radius, SOUND_M_PER_S};
+use super::emptying::{
+    helmholtz_hz, neck_length_m, simulate, Draws, Glide, Params, Simulated, END_CORRECTION,
+    LEAD_IN_S,
+};
+use super::{add_noise, glug_rms, write_wav};
+
+/// The development set: tune the fit on these draws only.
+pub const DEVELOPMENT_SEEDS: Range<u64> = 1..61;
+/// The held-out set: run once, at the end, and reported whatever it shows.
+pub const HELD_OUT_SEEDS: Range<u64> = 1001..1061;
+/// The issue's goal: each constant within its tolerance in this share of the draws.
+const GOAL_SHARE: f64 = 0.9;
+
+/// The family's ranges (issue 45).
+const CAVITY_HZ: (f64, f64) = (80.0, 600.0);
+const CAVITY_DECAY: (f64, f64) = (8.0, 60.0);
+const BUBBLE_HZ: (f64, f64) = (600.0, 2500.0);
+const BUBBLE_DECAY: (f64, f64) = (60.0, 400.0);
+/// c, the cavity's (the lower mode's) share of each glug's amplitude.
+const LOW_SHARE: (f64, f64) = (0.2, 0.9);
+/// The bubble mode lies at least this far above the cavity's own frequency: two modes a fit can
+/// tell apart (MODEL.md §13 splits modes at least 1.4× apart).
+const MODES_APART: f64 = 1.5;
+/// ρ of a cavity gliding down into its resonance, and of a bubble gliding up to its own.
+const CAVITY_GLIDE_RATIO: (f64, f64) = (1.1, 2.0);
+const BUBBLE_GLIDE_RATIO: (f64, f64) = (0.5, 0.9);
+/// τ_g (s).
+const GLIDE_TIME_S: (f64, f64) = (0.005, 0.06);
+/// The noise below the glugs' RMS (`glug_rms`, as the round trips measure it).
+const SNR_DB: (f64, f64) = (10.0, 40.0);
+/// Each mode below 0.45·fs at every rate: the bubble's 2.5 kHz is below 0.45 · 8 kHz.
+const SAMPLE_RATES_HZ: [f64; 8] = [
+    8_000.0, 11_025.0, 16_000.0, 22_050.0, 24_000.0, 32_000.0, 44_100.0, 48_000.0,
+];
+const HIGHEST_MODE_OF_FS: f64 = 0.45;
+/// A real bottle's glugs a second.
+const GLUG_RATE: (f64, f64) = (4.0, 14.0);
+/// The clip's nominal length (s): the lead-in, the glugs at their mean interval, the tail; the
+/// clip ends with the last whole glug that fits in the length drawn.
+const DURATION_S: (f64, f64) = (1.5, 6.0);
+const TAIL_S: f64 = 0.3;
+/// The bottle: its capacity (ml), the share of it the clip pours, its full headspace H as a
+/// share of the capacity (how far the cavity falls), the neck's radius (m).
+const CAPACITY_ML: (f64, f64) = (180.0, 1000.0);
+const POURED_SHARE: (f64, f64) = (0.3, 0.8);
+const HEADSPACE_SHARE: (f64, f64) = (0.03, 0.3);
+/// A falling cavity's last glug rings no lower than this (Hz): a bottle's glug, not a rumble.
+const LOWEST_CAVITY_HZ: f64 = 50.0;
+const NECK_RADIUS_M: (f64, f64) = (0.005, 0.012);
+/// The simulator's other draws, as its presets have them (see `emptying::Params`).
+const POCKET_JITTER: (f64, f64) = (0.0, 0.15);
+const TIMING_JITTER: (f64, f64) = (0.05, 0.2);
+const BUBBLE_DECAY_SPREAD: (f64, f64) = (1.0, 1.5);
+const AMPLITUDE_FALL: (f64, f64) = (0.0, 0.4);
+const LEVEL_JITTER: (f64, f64) = (0.0, 0.15);
+const REVERB_LEVEL: (f64, f64) = (0.0, 0.15);
+const REVERB_S: (f64, f64) = (0.1, 0.5);
+const HUM: (f64, f64) = (0.0, 0.02);
+/// The family's own salt for a seed (the simulator has its own).
+const FAMILY_SALT: u64 = 0xD1B5_4A32_D192_ED03;
+
+/// One bottle of the family.
+#[derive(Debug, Clone, Copy)]
+pub struct Draw {
+    pub seed: u64,
+    pub params: Params,
+    /// The noise below the glugs' RMS (dB).
+    pub snr_db: f64,
+    /// Whether the cavity falls with the air above the liquid (else a fixed low mode).
+    pub falls: bool,
+    /// Whether the modes glide within each glug.
+    pub glides: bool,
+    /// The nominal length (s).
+    pub duration_s: f64,
+}
+
+fn between(draws: &mut Draws, (low, high): (f64, f64)) -> f64 {
+    low + (high - low) * draws.uniform()
+}
+
+fn log_between(draws: &mut Draws, (low, high): (f64, f64)) -> f64 {
+    (low.ln() + (high.ln() - low.ln()) * draws.uniform()).exp()
+}
+
+/// The bottle of `seed`.
+pub fn draw(seed: u64) -> Draw {
+    let mut draws = Draws::new(seed, FAMILY_SALT);
+    let sample_rate = SAMPLE_RATES_HZ[(draws.uniform() * SAMPLE_RATES_HZ.len() as f64) as usize];
+    let cavity_hz = log_between(&mut draws, CAVITY_HZ);
+    let cavity_decay = log_between(&mut draws, CAVITY_DECAY);
+    let bubble_low = BUBBLE_HZ.0.max(MODES_APART * cavity_hz);
+    let bubble_hz = log_between(&mut draws, (bubble_low, BUBBLE_HZ.1));
+    let bubble_decay = log_between(&mut draws, BUBBLE_DECAY);
+    let low_share = between(&mut draws, LOW_SHARE);
+    let falls = draws.uniform() < 0.5;
+    let glides = draws.uniform() < 0.5;
+    let (cavity_glide, bubble_glide) = if glides {
+        (
+            Glide {
+                ratio: between(&mut draws, CAVITY_GLIDE_RATIO),
+                time_s: log_between(&mut draws, GLIDE_TIME_S),
+            },
+            Glide {
+                ratio: between(&mut draws, BUBBLE_GLIDE_RATIO),
+                time_s: log_between(&mut draws, GLIDE_TIME_S),
+            },
+        )
+    } else {
+        (Glide::NONE, Glide::NONE)
+    };
+    let snr_db = between(&mut draws, SNR_DB);
+    let rate_per_s = between(&mut draws, GLUG_RATE);
+    let duration_s = between(&mut draws, DURATION_S);
+    let glugs = 1 + ((duration_s - LEAD_IN_S - TAIL_S) * rate_per_s) as usize;
+    let capacity_ml = log_between(&mut draws, CAPACITY_ML);
+    let poured_ml = between(&mut draws, POURED_SHARE) * capacity_ml;
+    let pocket_ml = poured_ml / glugs as f64;
+    // A falling cavity's last glug rings no lower than LOWEST_CAVITY_HZ: its air, H + poured,
+    // at most (f/f_lowest)² times the first glug's, H + b; H is raised where the draw is lower.
+    let widest_fall = (cavity_hz / LOWEST_CAVITY_HZ).powi(2);
+    let headspace_ml = (log_between(&mut draws, HEADSPACE_SHARE) * capacity_ml)
+        .max((poured_ml - widest_fall * pocket_ml) / (widest_fall - 1.0));
+    // The neck that makes the first glug's air (H and its pocket) ring at the cavity's f; wide
+    // enough that its length less the end correction stays positive (L > 0 needs
+    // r > END_CORRECTION·V·k²/π; twice that).
+    let first_air_ml = headspace_ml + pocket_ml;
+    let wavenumber = TAU * cavity_hz / SOUND_M_PER_S;
+    let narrowest_m = 2.0 * END_CORRECTION * first_air_ml * 1e-6 * wavenumber * wavenumber / PI;
+    let neck_radius_m = log_between(&mut draws, NECK_RADIUS_M).max(narrowest_m);
+    let params = Params {
+        sample_rate,
+        capacity_ml,
+        start_ml: capacity_ml,
+        headspace_ml,
+        neck_radius_m,
+        neck_length_m: neck_length_m(cavity_hz, first_air_ml, neck_radius_m),
+        glugs,
+        pocket_ml,
+        pocket_jitter: between(&mut draws, POCKET_JITTER),
+        rate_per_s,
+        timing_jitter: between(&mut draws, TIMING_JITTER),
+        cavity_decay,
+        fixed_cavity_hz: (!falls).then_some(cavity_hz),
+        cavity_glide,
+        bubble_glide,
+        bubble_radius_m: minnaert_radius(bubble_hz),
+        bubble_rise: 0.0,
+        bubble_decay,
+        bubble_decay_spread: between(&mut draws, BUBBLE_DECAY_SPREAD),
+        bubble_share: 1.0 - low_share,
+        amplitude_fall: between(&mut draws, AMPLITUDE_FALL),
+        level_jitter: between(&mut draws, LEVEL_JITTER),
+        reverb: (
+            between(&mut draws, REVERB_LEVEL),
+            between(&mut draws, REVERB_S),
+        ),
+        // Added after the simulation, at the draw's SNR against the glugs' RMS.
+        noise: 0.0,
+        hum: between(&mut draws, HUM),
+        tail_s: TAIL_S,
+        log_hz: 0.0,
+        seed,
+    };
+    Draw {
+        seed,
+        params,
+        snr_db,
+        falls,
+        glides,
+        duration_s,
+    }
+}
+
+/// How near an estimate must come to its truth.
+#[derive(Debug, Clone, Copy)]
+enum Within {
+    /// Within this share of the truth.
+    Share(f64),
+    /// Within this much of the truth.
+    Plus(f64),
+}
+
+impl Within {
+    fn holds(self, truth: f64, got: f64) -> bool {
+        got.is_finite()
+            && match self {
+                Within::Share(share) => (got / truth - 1.0).abs() <= share,
+                Within::Plus(plus) => (got - truth).abs() <= plus,
+            }
+    }
+
+    fn describe(self) -> String {
+        match self {
+            Within::Share(share) => format!("{:.0} %", share * 100.0),
+            Within::Plus(plus) => format!("± {plus}"),
+        }
+    }
+}
+
+/// What the fit gave, as its model plays it.
+struct Fitted {
+    /// The model file, parsed as the renderer reads it.
+    scene: Scene,
+    /// The model's glugs a second, rendered as the clip was made and heard
+    /// (`sake_glug_fit::listen`).
+    rate_per_s: f64,
+}
+
+impl Fitted {
+    fn constant(&self, constant: Constant) -> f64 {
+        (constant.spec().get)(&self.scene.config)
+    }
+}
+
+/// One constant judged: its truth in the simulator, its value in the fitted model, its tolerance
+/// and why.
+struct Measure {
+    name: &'static str,
+    decimals: usize,
+    within: Within,
+    why: &'static str,
+    truth: fn(&Simulated) -> f64,
+    model: fn(&Fitted) -> f64,
+}
+
+fn median(values: &[f64]) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let middle = sorted.len() / 2;
+    if sorted.len() % 2 == 1 {
+        sorted[middle]
+    } else {
+        (sorted[middle - 1] + sorted[middle]) / 2.0
+    }
+}
+
+/// The tolerances, declared once: the test, its table and docs/testing.md read them.
+const MEASURES: [Measure; 8] = [
+    Measure {
+        name: "f1 (Hz)",
+        decimals: 0,
+        within: Within::Share(0.05),
+        why: "a pitch heard as the bottle's: the truth is the cavity at a full bottle's first \
+              glug, where MODEL.md §5.1 quotes f1 (a fixed low mode's own f)",
+        truth: |s| s.cavity_hz[0],
+        model: |m| m.constant(Constant::F1),
+    },
+    Measure {
+        name: "f2 (Hz)",
+        decimals: 0,
+        within: Within::Share(0.05),
+        why: "the bubble mode's own f (the end of its glide), held as f1",
+        truth: |s| s.bubble_hz[0],
+        model: |m| m.constant(Constant::F2),
+    },
+    Measure {
+        name: "B1 (/s)",
+        decimals: 1,
+        within: Within::Share(0.3),
+        why: "a ring's length: units' decays scatter by tens of per cent in noise, a room and \
+              overlap (the bubbles test holds 30 %)",
+        truth: |s| s.cavity_decay,
+        model: |m| m.constant(Constant::B1),
+    },
+    Measure {
+        name: "B2 (/s)",
+        decimals: 0,
+        within: Within::Share(0.3),
+        why: "as B1; the truth is the median of the glugs' drawn decays, as the fit takes the \
+              median of its units'",
+        truth: |s| median(&s.bubble_decay),
+        model: |m| m.constant(Constant::B2),
+    },
+    Measure {
+        name: "c",
+        decimals: 2,
+        within: Within::Plus(0.12),
+        why: "the cavity's share of the amplitude, c = A1/(A1 + A2) (MODEL.md §5), as the \
+              bubbles test holds it",
+        truth: |s| s.low_mode_share,
+        model: |m| m.scene.lanes.viscosity.value_at(0.0),
+    },
+    Measure {
+        name: "γ1",
+        decimals: 2,
+        within: Within::Plus(0.1),
+        why: "½ for a Helmholtz cavity, 0 for a fixed low mode: 0.1 tells a falling pitch from \
+              a constant one",
+        truth: |s| s.cavity_exponent,
+        model: |m| m.constant(Constant::F1Exponent),
+    },
+    Measure {
+        name: "γ2",
+        decimals: 2,
+        within: Within::Plus(0.1),
+        why: "0: in this family the bubble's own pitch does not follow the air",
+        truth: |_| 0.0,
+        model: |m| m.constant(Constant::F2Exponent),
+    },
+    Measure {
+        name: "rate (/s)",
+        decimals: 2,
+        within: Within::Share(0.1),
+        why: "the model, rendered as the clip was made, glugs at the clip's pace: (glugs − 1) \
+              over the first to the last onset",
+        truth: |s| {
+            let glugs = s.onsets.len();
+            (glugs - 1) as f64 / (s.onsets[glugs - 1] - s.onsets[0])
+        },
+        model: |m| m.rate_per_s,
+    },
+];
+
+/// One draw fitted.
+struct Outcome {
+    draw: Draw,
+    /// The clip's length (s) and its glugs.
+    clip_s: f64,
+    glugs: usize,
+    truth: [f64; MEASURES.len()],
+    /// The model's values, or why the fit gave none.
+    got: Result<[f64; MEASURES.len()], String>,
+    /// Units used and detected.
+    units: (usize, usize),
+}
+
+impl Outcome {
+    fn passes(&self, measure: usize) -> bool {
+        self.got.as_ref().is_ok_and(|got| {
+            MEASURES[measure]
+                .within
+                .holds(self.truth[measure], got[measure])
+        })
+    }
+}
+
+fn fitted(fit: &SessionFit) -> Result<Fitted, String> {
+    let liquid = &fit.liquids[0];
+    let scene = Scene::parse(&liquid.model_toml).map_err(|e| format!("its model: {e}"))?;
+    let comparison = compare(fit)?;
+    let rate_per_s = comparison
+        .first()
+        .map_or(f64::NAN, |compared| compared.heard[1].rate_per_s);
+    Ok(Fitted { scene, rate_per_s })
+}
+
+/// Simulates `draw`, adds its noise, writes it as a clip and fits it as a user would.
+fn fit_draw(draw: &Draw) -> Outcome {
+    let mut simulated = simulate(&draw.params);
+    let sigma = glug_rms(&simulated.samples) * 10f64.powf(-draw.snr_db / 20.0);
+    add_noise(&mut simulated.samples, sigma, draw.seed);
+    let folder = tempfile::tempdir().unwrap();
+    let wav = folder.path().join("clip.wav");
+    write_wav(&wav, &simulated.samples, draw.params.sample_rate as u32);
+    let truth = MEASURES.map(|measure| (measure.truth)(&simulated));
+    let fit = FitSession::of_clips(&[wav], Some(draw.params.capacity_ml), None)
+        .and_then(|session| fit_session(&session))
+        .map_err(|e| e.to_string());
+    let units = fit.as_ref().map_or((0, 0), |fit| {
+        (fit.liquids[0].units, fit.liquids[0].detected)
+    });
+    let got = fit
+        .and_then(|fit| fitted(&fit))
+        .map(|model| MEASURES.map(|measure| (measure.model)(&model)));
+    Outcome {
+        draw: *draw,
+        clip_s: simulated.samples.len() as f64 / draw.params.sample_rate,
+        glugs: simulated.onsets.len(),
+        truth,
+        got,
+        units,
+    }
+}
+
+/// The share of `outcomes` within tolerance for each measure, and the seeds that miss.
+fn summary(outcomes: &[Outcome]) -> Vec<(f64, Vec<u64>)> {
+    (0..MEASURES.len())
+        .map(|measure| {
+            let misses: Vec<u64> = outcomes
+                .iter()
+                .filter(|outcome| !outcome.passes(measure))
+                .map(|outcome| outcome.draw.seed)
+                .collect();
+            let share = 1.0 - misses.len() as f64 / outcomes.len().max(1) as f64;
+            (share, misses)
+        })
+        .collect()
+}
+
+/// The set's table in markdown: per constant the share within tolerance and the draws that miss,
+/// then per draw the truth → the model's value, ✓ or ✗.
+fn markdown(set: &str, outcomes: &[Outcome]) -> String {
+    let mut text = format!(
+        "#### The emptying family: the {set} set ({} draws)\n\n\
+         | constant | tolerance | within | draws missing it | why |\n|---|---|---|---|---|\n",
+        outcomes.len()
+    );
+    for (measure, (share, misses)) in MEASURES.iter().zip(summary(outcomes)) {
+        let misses: Vec<String> = misses.iter().map(u64::to_string).collect();
+        writeln!(
+            text,
+            "| {} | {} | {:.0} % | {} | {} |",
+            measure.name,
+            measure.within.describe(),
+            share * 100.0,
+            misses.join(", "),
+            measure.why
+        )
+        .unwrap();
+    }
+    text.push_str(
+        "\n| draw | fs (Hz) | s | glugs | falls | glides | SNR (dB) | units used/detected |",
+    );
+    for measure in &MEASURES {
+        write!(text, " {} |", measure.name).unwrap();
+    }
+    text.push_str("\n|---|---|---|---|---|---|---|---|");
+    text.push_str(&"---|".repeat(MEASURES.len()));
+    text.push('\n');
+    for outcome in outcomes {
+        let draw = &outcome.draw;
+        let yes = |flag: bool| if flag { "yes" } else { "no" };
+        write!(
+            text,
+            "| {} | {} | {:.2} | {} | {} | {} | {:.1} | {}/{} |",
+            draw.seed,
+            draw.params.sample_rate,
+            outcome.clip_s,
+            outcome.glugs,
+            yes(draw.falls),
+            yes(draw.glides),
+            draw.snr_db,
+            outcome.units.0,
+            outcome.units.1
+        )
+        .unwrap();
+        for (index, measure) in MEASURES.iter().enumerate() {
+            let digits = measure.decimals;
+            let truth = outcome.truth[index];
+            let cell = match &outcome.got {
+                Ok(got) => format!(
+                    "{truth:.digits$} → {:.digits$} {}",
+                    got[index],
+                    if outcome.passes(index) { "✓" } else { "✗" }
+                ),
+                Err(_) => format!("{truth:.digits$} → — ✗"),
+            };
+            write!(text, " {cell} |").unwrap();
+        }
+        text.push('\n');
+    }
+    let refused: Vec<String> = outcomes
+        .iter()
+        .filter_map(|o| {
+            o.got
+                .as_ref()
+                .err()
+                .map(|e| format!("- draw {}: {e}", o.draw.seed))
+        })
+        .collect();
+    if !refused.is_empty() {
+        text.push_str("\nNo model:\n\n");
+        text.push_str(&refused.join("\n"));
+        text.push('\n');
+    }
+    text
+}
+
+/// Fits every draw of `seeds`, prints the table, writes it where `table_variable` names, and
+/// holds each constant to the goal.
+fn run_family(set: &str, seeds: Range<u64>, table_variable: &str) {
+    let outcomes: Vec<Outcome> = seeds.map(|seed| fit_draw(&draw(seed))).collect();
+    let table = markdown(set, &outcomes);
+    println!("{table}");
+    if let Some(path) = std::env::var_os(table_variable) {
+        std::fs::write(&path, &table).unwrap();
+    }
+    let short: Vec<String> = MEASURES
+        .iter()
+        .zip(summary(&outcomes))
+        .filter(|(_, (share, _))| *share < GOAL_SHARE)
+        .map(|(measure, (share, _))| format!("{} {:.0} %", measure.name, share * 100.0))
+        .collect();
+    assert!(
+        short.is_empty(),
+        "the {set} set: within tolerance in fewer than {:.0} % of the draws: {}",
+        GOAL_SHARE * 100.0,
+        short.join(", ")
+    );
+}
+
+#[test]
+#[ignore = "the fit does not yet meet it — issue 45"]
+fn the_development_family_is_fitted_within_tolerance() {
+    run_family("development", DEVELOPMENT_SEEDS, "SAKE_GLUG_FAMILY_TABLE");
+}
+
+#[test]
+#[ignore = "the held-out set: run only at the end (issue 45); the fit does not yet meet it"]
+fn the_held_out_family_is_fitted_within_tolerance() {
+    run_family(
+        "held-out",
+        HELD_OUT_SEEDS,
+        "SAKE_GLUG_FAMILY_HELD_OUT_TABLE",
+    );
+}
+
+/// Every draw of both sets lies in the family the issue names, the sets are disjoint and each
+/// holds both kinds of cavity and both kinds of glug (gliding or not).
+#[test]
+fn the_family_is_drawn_as_stated() {
+    let inside = |value: f64, (low, high): (f64, f64)| (low..=high).contains(&value);
+    for set in [DEVELOPMENT_SEEDS, HELD_OUT_SEEDS] {
+        assert!(set.end - set.start >= 50);
+        let draws: Vec<Draw> = set.map(draw).collect();
+        for (what, count) in [
+            ("falling", draws.iter().filter(|d| d.falls).count()),
+            ("gliding", draws.iter().filter(|d| d.glides).count()),
+        ] {
+            let share = count as f64 / draws.len() as f64;
+            assert!(
+                (0.25..=0.75).contains(&share),
+                "{share} of the draws {what}"
+            );
+        }
+        for d in &draws {
+            let p = &d.params;
+            let cavity_hz = p.fixed_cavity_hz.unwrap_or_else(|| {
+                helmholtz_hz(
+                    p.headspace_ml + p.pocket_ml,
+                    p.neck_radius_m,
+                    p.neck_length_m,
+                )
+            });
+            let bubble_hz = minnaert_hz(p.bubble_radius_m);
+            let last_air_ml = p.headspace_ml + p.pocket_ml * p.glugs as f64;
+            let last_hz = p
+                .fixed_cavity_hz
+                .unwrap_or_else(|| helmholtz_hz(last_air_ml, p.neck_radius_m, p.neck_length_m));
+            let nominal_s = LEAD_IN_S + (p.glugs - 1) as f64 / p.rate_per_s + p.tail_s;
+            let ok = inside(cavity_hz, CAVITY_HZ)
+                && last_hz >= LOWEST_CAVITY_HZ * (1.0 - 1e-9)
+                && inside(p.cavity_decay, CAVITY_DECAY)
+                && inside(bubble_hz, BUBBLE_HZ)
+                && bubble_hz >= MODES_APART * cavity_hz * (1.0 - 1e-9)
+                && bubble_hz < HIGHEST_MODE_OF_FS * p.sample_rate
+                && inside(p.bubble_decay, BUBBLE_DECAY)
+                && inside(1.0 - p.bubble_share, LOW_SHARE)
+                && inside(d.snr_db, SNR_DB)
+                && inside(p.rate_per_s, GLUG_RATE)
+                && inside(d.duration_s, DURATION_S)
+                && nominal_s <= d.duration_s
+                && nominal_s > d.duration_s - 1.0 / p.rate_per_s
+                && p.glugs >= 5
+                && p.neck_length_m > 0.0
+                && p.pocket_ml * p.glugs as f64 * (1.0 + p.pocket_jitter) < p.capacity_ml
+                && (d.falls == p.fixed_cavity_hz.is_none())
+                && (d.glides || (p.cavity_glide == Glide::NONE && p.bubble_glide == Glide::NONE))
+                && (!d.glides
+                    || (inside(p.cavity_glide.ratio, CAVITY_GLIDE_RATIO)
+                        && inside(p.bubble_glide.ratio, BUBBLE_GLIDE_RATIO)
+                        && inside(p.cavity_glide.time_s, GLIDE_TIME_S)
+                        && inside(p.bubble_glide.time_s, GLIDE_TIME_S)));
+            assert!(
+                ok,
+                "draw {}: cavity {cavity_hz} Hz, bubble {bubble_hz} Hz, {nominal_s} s: {d:?}",
+                d.seed
+            );
+        }
+    }
+    assert!(
+        DEVELOPMENT_SEEDS.end <= HELD_OUT_SEEDS.start
+            || HELD_OUT_SEEDS.end <= DEVELOPMENT_SEEDS.start
+    );
+}
+
+/// A glide follows its law, f(τ) = f·(1 + (ρ − 1)·e^(−τ/τ_g)), and a fixed low mode stays put
+/// while the air grows: one mode of a quiet, dry bottle against the closed form.
+#[test]
+fn a_glide_and_a_fixed_low_mode_are_as_their_laws_say() {
+    let fs = 16_000.0;
+    let (hz, decay) = (200.0, 20.0);
+    let glide = Glide {
+        ratio: 1.8,
+        time_s: 0.02,
+    };
+    let mut params = Params::short_clip(fs);
+    params.glugs = 3;
+    params.fixed_cavity_hz = Some(hz);
+    params.cavity_decay = decay;
+    params.cavity_glide = glide;
+    params.bubble_share = 0.0;
+    (params.reverb, params.noise, params.hum, params.level_jitter) = ((0.0, 0.3), 0.0, 0.0, 0.0);
+    let simulated = simulate(&params);
+    assert!(simulated.cavity_hz.iter().all(|&f| f == hz));
+    assert_eq!(simulated.cavity_exponent, 0.0);
+    // The first glug alone, until the second starts: e^(−Bτ)·sin(2π·f·(τ + (ρ − 1)·τ_g·(1 −
+    // e^(−τ/τ_g)))), at the simulator's own scale (its peak at 0.5).
+    let onset = simulated.onsets[0];
+    let first = (onset * fs).ceil() as usize;
+    let last = (simulated.onsets[1] * fs) as usize;
+    let scale = simulated.amplitude[0];
+    let worst = (first..last)
+        .map(|n| {
+            let tau = n as f64 / fs - onset;
+            let phase = TAU
+                * hz
+                * (tau + (glide.ratio - 1.0) * glide.time_s * (1.0 - (-tau / glide.time_s).exp()));
+            (simulated.samples[n] as f64 - scale * (-decay * tau).exp() * phase.sin()).abs()
+        })
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-5, "the glide's samples are {worst} off its law");
+}
+
+/// The judge passes the truth, misses a value just beyond a tolerance and a fit that gave no
+/// model, and counts the misses per constant.
+#[test]
+fn a_miss_is_counted_as_a_miss() {
+    let truth = [300.0, 1500.0, 20.0, 150.0, 0.5, 0.5, 0.0, 8.0];
+    let outcome = |seed, got| Outcome {
+        draw: draw(seed),
+        clip_s: 2.0,
+        glugs: 16,
+        truth,
+        got,
+        units: (16, 16),
+    };
+    let mut off = truth;
+    off[0] *= 1.051; // f1 5.1 % off
+    off[4] += 0.121; // c 0.121 off
+    let mut near = truth;
+    near[0] *= 1.049;
+    near[4] -= 0.119;
+    let outcomes = [
+        outcome(1, Ok(truth)),
+        outcome(2, Ok(off)),
+        outcome(3, Ok(near)),
+        outcome(4, Err("refused".to_owned())),
+    ];
+    let summary = summary(&outcomes);
+    for (index, (share, misses)) in summary.iter().enumerate() {
+        let expected: &[u64] = if index == 0 || index == 4 {
+            &[2, 4]
+        } else {
+            &[4]
+        };
+        assert_eq!(misses, expected, "{}", MEASURES[index].name);
+        assert_eq!(*share, 1.0 - expected.len() as f64 / 4.0);
+    }
+    let table = markdown("test", &outcomes);
+    assert!(table.contains("| f1 (Hz) | 5 % | 50 % | 2, 4 |"), "{table}");
+    assert!(table.contains("- draw 4: refused"), "{table}");
+}
+
+/// The harness end to end on one draw of the development set: every truth finite, the model's
+/// values finite where the fit gave one, a row in the table.
+#[test]
+fn one_draw_runs_through_the_harness() {
+    let outcome = fit_draw(&draw(DEVELOPMENT_SEEDS.start));
+    assert!(
+        outcome.truth.iter().all(|v| v.is_finite()),
+        "{:?}",
+        outcome.truth
+    );
+    if let Ok(got) = &outcome.got {
+        assert!(got.iter().all(|v| v.is_finite()), "{got:?}");
+    }
+    assert!(outcome.truth[0] > 0.0 && outcome.glugs >= 5);
+    let table = markdown("development", std::slice::from_ref(&outcome));
+    assert!(
+        table.contains(&format!("\n| {} |", DEVELOPMENT_SEEDS.start)),
+        "{table}"
+    );
+}
