@@ -39,8 +39,9 @@ pub struct RecursiveComponent<T> {
     silent_from: u64,
     component: Component,
     /// A glide's second rotation (MODEL.md §5.2): the phase it adds from `next_sample` to the
-    /// sample after, and r = e^(−1/T), by which that angle shrinks each sample.
-    glide: Option<(T, T)>,
+    /// sample after, and r = e^(−1/T), by which that angle shrinks each sample. Kept in f64 on
+    /// both paths: in f32, r^n's rounding would pile up over a long glide into radians of phase.
+    glide: Option<(f64, f64)>,
 }
 
 impl<T: Float> BankComponent for RecursiveComponent<T> {
@@ -101,11 +102,7 @@ impl<T: Float> RecursiveComponent<T> {
             // K·e^(−τ/T)·(1 − e^(−1/T)): what the glide adds over this sample.
             let elapsed = self.component.samples_since_onset(sample);
             let angle = -glide.phase_left_at(elapsed) * (-1.0 / glide.time_samples).exp_m1();
-            let shrink = (-1.0 / glide.time_samples).exp();
-            (
-                T::from(angle).unwrap_or(T::zero()),
-                T::from(shrink).unwrap_or(T::zero()),
-            )
+            (angle, (-1.0 / glide.time_samples).exp())
         });
     }
 
@@ -134,8 +131,13 @@ impl<T: Float> RecursiveComponent<T> {
             Some((angle, shrink)) => {
                 for y in &mut out[offset..offset + count] {
                     *y = *y + state.im;
-                    state = state * self.step * Complex::from_polar(T::one(), *angle);
-                    *angle = *angle * *shrink;
+                    let (sin, cos) = angle.sin_cos();
+                    let turn = Complex::new(
+                        T::from(cos).unwrap_or(T::one()),
+                        T::from(sin).unwrap_or(T::zero()),
+                    );
+                    state = state * self.step * turn;
+                    *angle *= *shrink;
                 }
             }
         }
