@@ -203,7 +203,7 @@ fn a_ramp_to_its_own_value_and_a_ramp_of_no_samples_are_steps() {
 
 #[test]
 fn a_model_files_text_plays_as_the_renderers_model() {
-    for name in ["fitted", "falling-pitch"] {
+    for name in ["fitted", "falling-pitch", "gliding"] {
         a_model_plays_as_the_renderers(name);
     }
 }

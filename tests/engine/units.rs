@@ -36,6 +36,7 @@ fn unit(viscosity: f64, decay_per_s: [f64; 2]) -> UnitOnset {
             frequency_spread: [1.0, 1.0],
             decay_per_s,
             amplitude_factor: 1.0,
+            glide: ModelConfig::default().glide,
         },
         actuator_gain: [1.0, 1.0],
     }

@@ -41,11 +41,15 @@ SCENE_KEYS = {
     "f2": ("glug", "f2_hz"),
     "B1": ("glug", "b1_per_s"),
     "B2": ("glug", "b2_per_s"),
-    # The headspace law (MODEL.md §5.1): only a preset that follows it names them; the others
-    # leave them at their defaults.
+    # The headspace law and the glide (MODEL.md §5.1, §5.2): only a preset that follows them
+    # names them; the others leave them at their defaults.
     "Headspace": ("bottle", "headspace_ml"),
     "f1 headspace exponent": ("glug", "f1_headspace_exponent"),
     "f2 headspace exponent": ("glug", "f2_headspace_exponent"),
+    "f1 glide ratio": ("glug", "f1_glide_ratio"),
+    "f2 glide ratio": ("glug", "f2_glide_ratio"),
+    "f1 glide time": ("glug", "f1_glide_ms"),
+    "f2 glide time": ("glug", "f2_glide_ms"),
 }
 
 # The IDs the plugin saves its parameters under (crates/plugin/src/params.rs).
@@ -61,6 +65,10 @@ PARAMETER_IDS = {
     "Headspace": "headsp",
     "f1 headspace exponent": "f1exp",
     "f2 headspace exponent": "f2exp",
+    "f1 glide ratio": "f1glide",
+    "f2 glide ratio": "f2glide",
+    "f1 glide time": "f1glms",
+    "f2 glide time": "f2glms",
 }
 
 # A user's changes before picking a preset: the preset must undo them.

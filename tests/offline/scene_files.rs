@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use sake_glug_engine::curves::BottleCurves;
-use sake_glug_engine::{Curve, DrainMode, Headspace, ModelConfig, SilentBelow};
+use sake_glug_engine::{Curve, DrainMode, Glide, Headspace, ModelConfig, SilentBelow};
 use sake_glug_render::{Automation, Scene, SceneError};
 
 fn fixtures(kind: &str) -> Vec<(String, String)> {
@@ -93,6 +93,10 @@ fn the_full_fixture_reads_every_key_with_its_own_value() {
             headspace: Headspace {
                 headspace_ml: 42.5,
                 exponent: [0.5, -0.125],
+            },
+            glide: Glide {
+                ratio: [1.6, 0.8],
+                time_ms: [12.5, 35.0],
             },
             curves: BottleCurves {
                 rest: Curve::Rest

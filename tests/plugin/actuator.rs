@@ -135,16 +135,16 @@ fn state_fixture(name: &str) -> Vec<u8> {
     .unwrap()
 }
 
-/// The state a fresh instance saves today: written by the plugin once the headspace law's
-/// parameters came (issue 36; `SAKE_GLUG_WRITE_STATE=1` writes it anew, as a change of the
-/// state's format must be deliberate).
+/// The state a fresh instance saves today: written by the plugin once the glide's parameters
+/// came (issue 45; `SAKE_GLUG_WRITE_STATE=1` writes it anew, as a change of the state's format
+/// must be deliberate).
 fn todays_state() -> Vec<u8> {
     if std::env::var_os("SAKE_GLUG_WRITE_STATE").is_some() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/fixtures/state/v2-headspace-law.state");
+        let path =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/state/v3-glide.state");
         std::fs::write(path, ClapInstance::new().save()).unwrap();
     }
-    state_fixture("v2-headspace-law.state")
+    state_fixture("v3-glide.state")
 }
 
 /// The state a fresh instance saved before actuators (written by the plugin at main e888c234).
@@ -169,6 +169,10 @@ fn a_state_without_an_actuator_is_todays_and_clears_one() {
         todays_state(),
         "an older state loads as today's"
     );
+    // So does one saved before the glide (MODEL.md §5.2): its parameters at their defaults.
+    let before_the_glide = with_actuator("lra", true);
+    assert!(before_the_glide.load(&state_fixture("v2-headspace-law.state")));
+    assert_eq!(before_the_glide.save(), todays_state());
     let mut fresh = fresh;
     assert_eq!(bounce(&mut with_one, 512), bounce(&mut fresh, 512));
 }

@@ -7,7 +7,7 @@ use std::path::Path;
 use serde_json::Value;
 
 use crate::clap_host::ClapInstance;
-use sake_glug_engine::HEADSPACE_LAW;
+use sake_glug_engine::ADDED_RULES;
 
 /// The JSON inside saved bytes (the CLAP wrapper prefixes its length).
 fn json(bytes: &[u8]) -> Value {
@@ -58,17 +58,18 @@ fn a_state_saved_before_state_versions_loads_with_the_same_values() {
     for (id, value) in old_params {
         assert_eq!(&now_params[id], value, "parameter {id}");
     }
-    // The parameters added since (the headspace law, MODEL.md §5.1) load at their defaults.
+    // The parameters added since (the headspace law and the glide, MODEL.md §5.1, §5.2) load
+    // at their defaults.
     let added: Vec<&String> = now_params
         .keys()
         .filter(|id| !old_params.contains_key(*id))
         .collect();
-    let law: Vec<&str> = HEADSPACE_LAW
+    let law: Vec<&str> = ADDED_RULES
         .iter()
         .map(|constant| constant.quantity().param_id)
         .collect();
     assert_eq!(added.len(), law.len(), "{added:?}");
-    for constant in HEADSPACE_LAW {
+    for constant in ADDED_RULES {
         let id = constant.quantity().param_id;
         assert_eq!(
             now_params[id]["f32"].as_f64(),

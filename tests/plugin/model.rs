@@ -68,9 +68,9 @@ fn bounce(instance: &mut ClapInstance, block: usize) -> Vec<f32> {
 
 #[test]
 fn a_bounce_with_a_model_in_the_state_is_the_render_with_that_model() {
-    // The fitted model, and one whose pitch follows its headspace (MODEL.md §5.1), which the
-    // editor loads through the headspace law's parameters.
-    for name in ["fitted", "falling-pitch"] {
+    // The fitted model, one whose pitch follows its headspace (MODEL.md §5.1) and one whose
+    // glugs glide (§5.2), which the editor loads through those rules' parameters.
+    for name in ["fitted", "falling-pitch", "gliding"] {
         a_bounce_plays(&model_fixture(name));
     }
 }

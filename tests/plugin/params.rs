@@ -11,9 +11,9 @@ use sake_glug_engine::{Constant, Control};
 use sake_glug_plugin::GlugParams;
 
 const MAIN_IDS: [&str; 5] = ["tilt", "visc", "fill", "pour", "gain"];
-const MODEL_IDS: [&str; 15] = [
+const MODEL_IDS: [&str; 19] = [
     "f1", "f2", "b1", "b2", "pocket", "cap", "tjit", "fjit", "dsig", "headsp", "f1exp", "f2exp",
-    "seed", "drain", "ceil",
+    "f1glide", "f2glide", "f1glms", "f2glms", "seed", "drain", "ceil",
 ];
 
 fn param_map() -> Vec<(String, ParamPtr, String)> {

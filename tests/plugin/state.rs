@@ -9,7 +9,7 @@ use crate::fuzz::checks::{assert_saved_state_valid, bytes_of, float_quantity, js
 use sake_glug_engine::config;
 
 /// Every parameter, by the name a host lists, with a value other than its default.
-const CHANGED: [(&str, &str); 20] = [
+const CHANGED: [(&str, &str); 24] = [
     ("Tilt", "131.25"),
     ("Viscosity", "0.123"),
     ("Fill level", "93.5"),
@@ -27,6 +27,10 @@ const CHANGED: [(&str, &str); 20] = [
     ("Headspace", "45.5"),
     ("f1 headspace exponent", "0.5"),
     ("f2 headspace exponent", "-0.25"),
+    ("f1 glide ratio", "1.75"),
+    ("f2 glide ratio", "0.6"),
+    ("f1 glide time", "12.5"),
+    ("f2 glide time", "40"),
     ("Seed", "123"),
     ("Drain mode", "Follow"),
     ("Output ceiling", "-0.5"),
@@ -156,7 +160,7 @@ fn a_float_out_of_range_loads_clamped_and_one_not_finite_as_the_default() {
         .filter(|(_, value)| value.get("f32").is_some())
         .map(|(id, _)| id.clone())
         .collect();
-    assert_eq!(floats.len(), 18, "every float parameter");
+    assert_eq!(floats.len(), 22, "every float parameter");
     // The saved f32, read back as one (JSON holds its shortest decimal).
     let f32_of = |value: serde_json::Value| value["f32"].as_f64().map(|v| v as f32);
     for id in &floats {

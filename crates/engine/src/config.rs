@@ -7,6 +7,7 @@
 use super::amplitude::{SilentBelow, PAPERS_SILENT_BELOW_ML};
 use super::controls::Control;
 use super::curves::{BottleCurves, CurveError, TiltCurve, REFERENCE_TILT_DEG};
+use super::glide::Glide;
 use super::headspace::Headspace;
 use super::quantity::{Knob, Quantity, Range, ValueError};
 
@@ -89,6 +90,11 @@ const CAPACITY_ML: Range = Range::new(1.0, 100_000.0, 300.0);
 /// γ of the headspace law (MODEL.md §5.1): wide enough for a mode that rises (negative) and for
 /// more than a Helmholtz cavity's ½, narrow enough that every frequency it gives stays finite.
 const HEADSPACE_EXPONENT: Range = Range::new(-3.0, 3.0, 0.0);
+/// ρ of the glide (MODEL.md §5.2): two octaves either way; 1 is no glide.
+const GLIDE_RATIO: Range = Range::new(0.25, 4.0, 1.0);
+/// τ of the glide (MODEL.md §5.2, ms): from a sweep within a few cycles to one through a whole
+/// glug.
+const GLIDE_MS: Range = Range::new(0.5, 500.0, 20.0);
 
 declare_constants! {
     /// Frequency f1 of the first component, the air pocket bouncing in the neck (Hz).
@@ -262,6 +268,64 @@ declare_constants! {
         },
         get: |config| config.headspace.exponent[1],
         set: |config, value| config.headspace.exponent[1] = value,
+    };
+    /// ρ1: the ratio f1 glides from into its own (MODEL.md §5.2); 1 is no glide.
+    F1GlideRatio => ConstantSpec {
+        quantity: Quantity {
+            name: "f1 glide ratio",
+            unit: "",
+            scene_key: "glug.f1_glide_ratio",
+            param_id: "f1glide",
+            note: "ρ1 of MODEL.md §5.2: f1 starts at ρ1·f1 and approaches f1; 1 no glide, \
+                   above 1 down, below 1 up",
+            range: GLIDE_RATIO,
+            knob: Knob::full(3).skewed(-1.0),
+        },
+        get: |config| config.glide.ratio[0],
+        set: |config, value| config.glide.ratio[0] = value,
+    };
+    /// ρ2: the ratio f2 glides from into its own (MODEL.md §5.2); 1 is no glide.
+    F2GlideRatio => ConstantSpec {
+        quantity: Quantity {
+            name: "f2 glide ratio",
+            unit: "",
+            scene_key: "glug.f2_glide_ratio",
+            param_id: "f2glide",
+            note: "ρ2 of MODEL.md §5.2: f2 starts at ρ2·f2 and approaches f2; 1 no glide, \
+                   above 1 down, below 1 up",
+            range: GLIDE_RATIO,
+            knob: Knob::full(3).skewed(-1.0),
+        },
+        get: |config| config.glide.ratio[1],
+        set: |config, value| config.glide.ratio[1] = value,
+    };
+    /// τ1: the time constant of f1's glide (ms, MODEL.md §5.2).
+    F1GlideTime => ConstantSpec {
+        quantity: Quantity {
+            name: "f1 glide time",
+            unit: " ms",
+            scene_key: "glug.f1_glide_ms",
+            param_id: "f1glms",
+            note: "τ1 of MODEL.md §5.2: f1's glide is e^(−τ/τ1) from its end",
+            range: GLIDE_MS,
+            knob: Knob::full(2).skewed(-1.5),
+        },
+        get: |config| config.glide.time_ms[0],
+        set: |config, value| config.glide.time_ms[0] = value,
+    };
+    /// τ2: the time constant of f2's glide (ms, MODEL.md §5.2).
+    F2GlideTime => ConstantSpec {
+        quantity: Quantity {
+            name: "f2 glide time",
+            unit: " ms",
+            scene_key: "glug.f2_glide_ms",
+            param_id: "f2glms",
+            note: "τ2 of MODEL.md §5.2: f2's glide is e^(−τ/τ2) from its end",
+            range: GLIDE_MS,
+            knob: Knob::full(2).skewed(-1.5),
+        },
+        get: |config| config.glide.time_ms[1],
+        set: |config, value| config.glide.time_ms[1] = value,
     };
     /// V0 (ml): the residual volume from which down a unit is silent (MODEL.md §12). Its
     /// default is the paper's, scaled with the capacity ([`SilentBelow::PapersFit`]; the range's
@@ -441,6 +505,8 @@ pub struct ModelConfig {
     pub amplitude_spread: f64,
     /// H and γ1, γ2 of the headspace law (§5.1).
     pub headspace: Headspace,
+    /// ρ1, ρ2 and τ1, τ2 of the glide (§5.2).
+    pub glide: Glide,
     /// r(θ), s(θ) and h(θ) (§2, §3, §12): inline, so that the constants stay `Copy`.
     pub curves: BottleCurves,
     /// Seed of the random generator of §7, applied again at every reset.
@@ -466,6 +532,10 @@ impl Default for ModelConfig {
             headspace: Headspace {
                 headspace_ml: 0.0,
                 exponent: [0.0; 2],
+            },
+            glide: Glide {
+                ratio: [0.0; 2],
+                time_ms: [0.0; 2],
             },
             curves: BottleCurves::default(),
             seed: SEED.range.default as u64,

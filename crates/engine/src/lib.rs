@@ -10,6 +10,7 @@ mod amplitude;
 pub mod config;
 mod controls;
 pub mod curves;
+mod glide;
 mod headspace;
 mod output;
 pub mod pour;
@@ -24,11 +25,12 @@ pub use controls::{
     sample_time_s, Control, ControlSource, ControlSpec, ControlValues, Controls, DeviceInput, Lane,
     LinearSegment, PerControl,
 };
+pub use glide::Glide;
 pub use headspace::Headspace;
 use output::OutputStage;
 use pour::MAX_ONSETS_PER_SAMPLE;
 pub use pour::{Outflow, Pour, PourStats, UnitOnset};
-pub use presets::{Preset, PresetValue, HEADSPACE_LAW, PRESETS};
+pub use presets::{Preset, PresetValue, ADDED_RULES, PRESETS};
 pub use quantity::{Knob, Quantity, Range, ValueError};
 pub use synthesis::{AnchoredF32, RecursiveF32, RecursiveF64, Synthesis, GRID};
 

@@ -74,13 +74,18 @@ const fn same_target(a: PresetValue, b: PresetValue) -> bool {
     }
 }
 
-/// The constants of the headspace law (MODEL.md §5.1). The paper's bottle keeps its frequencies
-/// constant, so its presets leave them out of their files; picked in a menu, a preset that names
-/// none of them sets them to their defaults ([`Preset::menu_values`]).
-pub const HEADSPACE_LAW: [Constant; 3] = [
+/// The constants of the rules the implementation added to the paper's model: the headspace law
+/// (MODEL.md §5.1) and the glide (§5.2). The paper's bottle keeps its frequencies constant, so
+/// its presets leave them out of their files; picked in a menu, a preset that names none of them
+/// sets them to their defaults ([`Preset::menu_values`]).
+pub const ADDED_RULES: [Constant; 7] = [
     Constant::Headspace,
     Constant::F1Exponent,
     Constant::F2Exponent,
+    Constant::F1GlideRatio,
+    Constant::F2GlideRatio,
+    Constant::F1GlideTime,
+    Constant::F2GlideTime,
 ];
 
 /// A 720 ml glass bottle of water emptying: its neck and shoulder hold 60 ml of air when full, and
@@ -189,10 +194,10 @@ impl Preset {
     }
 
     /// What picking the preset in a menu sets: its own values, then each constant of the
-    /// headspace law it leaves out at its default, so that picking one preset after another
+    /// rules added to the paper's model ([`ADDED_RULES`]) it leaves out at its default, so that picking one preset after another
     /// leaves nothing of the first.
     pub fn menu_values(&self) -> impl Iterator<Item = PresetValue> + '_ {
-        let left_out = HEADSPACE_LAW.into_iter().filter(|law| {
+        let left_out = ADDED_RULES.into_iter().filter(|law| {
             !self
                 .values
                 .iter()

@@ -7,8 +7,8 @@ use nice_plug::prelude::*;
 use crate::params::GlugParams;
 use sake_glug_engine::{Preset, PresetValue};
 
-/// The parameters a preset sets, each with the preset's value for it (the headspace law's at its
-/// default where the preset leaves it out: [`Preset::menu_values`]). Every other parameter (tilt,
+/// The parameters a preset sets, each with the preset's value for it (the headspace law's and the
+/// glide's at their defaults where the preset leaves them out: [`Preset::menu_values`]). Every other parameter (tilt,
 /// fill level, gain, spreads, seed, drain, ceiling) is left as it is.
 pub fn preset_values<'a>(
     preset: &'a Preset,

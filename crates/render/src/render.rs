@@ -279,7 +279,9 @@ fn refuse_endless_decays(scene: &Scene) -> Result<(), RenderError> {
     ];
     for (index, key) in ["glug.b1_per_s", "glug.b2_per_s"].into_iter().enumerate() {
         let frequency_hz = config.frequency_hz[index];
-        let lowest_draw_hz = frequency_hz * (1.0 - config.freq_jitter);
+        // The highest it reaches: a glide down starts above it (MODEL.md §5.2).
+        let lowest_draw_hz =
+            config.glide.highest_hz(index, frequency_hz) * (1.0 - config.freq_jitter);
         let can_sound = share_can_sound[index] && frequency_hz > 0.0 && lowest_draw_hz < nyquist_hz;
         let decay_per_s = config.decay_per_s[index];
         let decay_s = SILENT_DECAY_EXPONENT / decay_per_s;

@@ -10,7 +10,7 @@
 use super::render::{render_scene, RenderError, RenderObserver};
 use super::scene::{FadeOut, Scene};
 use super::tables::UnitRow;
-use sake_glug_engine::{UnitOnset, Voicing};
+use sake_glug_engine::{Glide, UnitOnset, Voicing};
 
 /// The level of `--trim` without a value (dB re the render's peak).
 pub const DEFAULT_TRIM_DB: f64 = -60.0;
@@ -35,19 +35,28 @@ pub fn check_trim_db(level_db: f64) -> Result<f64, TrimLevelError> {
 
 /// When a unit of the units table has decayed below `threshold` (in output units) for good:
 /// its onset plus the time its two components' sum A1·e^(−B1·τ) + A2·e^(−B2·τ) takes to fall to
-/// the threshold; a component the engine omits (at or above Nyquist, or at 0 Hz) counts for
-/// nothing. `None` for a unit that starts at or below the threshold (it keeps nothing audible);
-/// infinity for one that never falls below it (a decay rate of 0).
-pub fn unit_decayed_s(unit: &UnitRow, threshold: f64, sample_rate: f64) -> Option<f64> {
-    let sounds =
-        |frequency_hz: f64| unit.audible && frequency_hz > 0.0 && frequency_hz < sample_rate / 2.0;
+/// the threshold; a component the engine omits (reaching Nyquist, its `glide`'s start included,
+/// or at 0 Hz) counts for nothing. `None` for a unit that starts at or below the threshold (it
+/// keeps nothing audible); infinity for one that never falls below it (a decay rate of 0).
+pub fn unit_decayed_s(
+    unit: &UnitRow,
+    threshold: f64,
+    sample_rate: f64,
+    glide: &Glide,
+) -> Option<f64> {
+    let sounds = |index: usize, frequency_hz: f64| {
+        unit.audible
+            && frequency_hz > 0.0
+            && glide.highest_hz(index, frequency_hz) < sample_rate / 2.0
+    };
     let components: Vec<(f64, f64)> = [
         (unit.f1_hz, unit.a1.abs(), unit.b1_per_s),
         (unit.f2_hz, unit.a2.abs(), unit.b2_per_s),
     ]
     .into_iter()
-    .filter(|&(frequency_hz, amplitude, _)| sounds(frequency_hz) && amplitude > 0.0)
-    .map(|(_, amplitude, decay)| (amplitude, decay))
+    .enumerate()
+    .filter(|&(index, (frequency_hz, amplitude, _))| sounds(index, frequency_hz) && amplitude > 0.0)
+    .map(|(_, (_, amplitude, decay))| (amplitude, decay))
     .collect();
     let level = |tau: f64| -> f64 {
         components
@@ -93,12 +102,19 @@ impl RenderObserver for UnitsAndPeak {
 }
 
 /// The sample at which every unit of a render with these `units` and this `peak` has decayed
-/// below `level_db` re the peak (rounded up), or `None` if one never does.
-pub fn trim_point(units: &[UnitRow], peak: f64, sample_rate: f64, level_db: f64) -> Option<u64> {
+/// below `level_db` re the peak (rounded up), or `None` if one never does; `glide` is the
+/// model's (MODEL.md §5.2).
+pub fn trim_point(
+    units: &[UnitRow],
+    peak: f64,
+    sample_rate: f64,
+    level_db: f64,
+    glide: &Glide,
+) -> Option<u64> {
     let threshold = peak * 10f64.powf(level_db / 20.0);
     let last_s = units
         .iter()
-        .filter_map(|unit| unit_decayed_s(unit, threshold, sample_rate))
+        .filter_map(|unit| unit_decayed_s(unit, threshold, sample_rate, glide))
         .fold(0.0, f64::max);
     last_s
         .is_finite()
@@ -115,8 +131,13 @@ pub fn trimmed(scene: Scene, level_db: f64) -> Result<Scene, RenderError> {
     };
     let summary = render_scene(&scene, |_: &[f32]| Ok::<(), RenderError>(()), &mut observer)?;
     let sample_rate = scene.sample_rate as f64;
-    let Some(point) = trim_point(&observer.units, summary.peak as f64, sample_rate, level_db)
-    else {
+    let Some(point) = trim_point(
+        &observer.units,
+        summary.peak as f64,
+        sample_rate,
+        level_db,
+        &scene.config.glide,
+    ) else {
         return Ok(scene);
     };
     let fade_samples = (TRIM_FADE_S * sample_rate).round().max(1.0) as u64;

@@ -11,6 +11,7 @@ use rand_distr::StandardNormal;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 use crate::config::ModelConfig;
+use crate::glide::Glide;
 
 /// The randomised constants of one wave unit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -23,6 +24,8 @@ pub struct UnitShape {
     pub decay_per_s: [f64; 2],
     /// exp(σ_A·z_i): the factor on the unit's a(V_i) (§12); exactly 1 when σ_A = 0.
     pub amplitude_factor: f64,
+    /// Each component's glide (§5.2): the model's, not drawn, taken at the onset like c.
+    pub glide: Glide,
 }
 
 pub struct UnitDraws {
@@ -69,6 +72,7 @@ impl UnitDraws {
             frequency_spread: [1.0; 2],
             decay_per_s: config.decay_per_s,
             amplitude_factor: 1.0,
+            glide: config.glide,
         };
         // Skipped without the law, so that its frequencies are exactly the paper's.
         if config.headspace.is_active() {

@@ -20,6 +20,9 @@ const NEGLIGIBLE_POWER: f64 = 1e-7;
 /// The f64 anchor recursion is re-evaluated from the closed form this often, so nothing can
 /// drift however long a component rings (B = 0 rings for ever).
 const PERIODS_PER_DIRECT_ANCHOR: u32 = 1024;
+/// A glide with less phase than this left to add (rad) is over: from then on a period's powers
+/// are the plain z^j, which leaves the samples within A·10⁻⁷ (−140 dB) of the closed form.
+const GLIDE_SETTLED_RADIANS: f64 = 1e-7;
 
 /// The default synthesis path: anchored components in f32, allocation-free after `new()`.
 pub type AnchoredF32 = Bank<AnchoredComponent>;
@@ -42,6 +45,9 @@ pub struct AnchoredComponent {
     /// The sample from which the component is silent (see [`Component::silent_from`]).
     silent_from: u64,
     periods_since_direct: u32,
+    /// The powers of each period carry the glide's phase (MODEL.md §5.2), refilled every period
+    /// until the glide is over.
+    gliding: bool,
 }
 
 impl BankComponent for AnchoredComponent {
@@ -62,6 +68,7 @@ impl BankComponent for AnchoredComponent {
             component,
             silent_from: component.silent_from(),
             periods_since_direct: 0,
+            gliding: component.glide.is_some(),
         };
         anchored.set_anchor(component.state_at(first_sample));
         let next_period = (first_sample / GRID as u64 + 1) * GRID as u64;
@@ -88,6 +95,14 @@ impl BankComponent for AnchoredComponent {
         self.set_anchor(self.next_anchor);
         self.anchor_sample = period_start;
         let following = period_start + GRID as u64;
+        if self.component.glide.is_some() {
+            // A glide's phase is no fixed rotation a period: each anchor is the closed form's.
+            self.next_anchor = self.component.state_at(following);
+            if self.gliding {
+                self.fill_powers();
+            }
+            return true;
+        }
         self.periods_since_direct += 1;
         self.next_anchor = if self.periods_since_direct == PERIODS_PER_DIRECT_ANCHOR {
             self.periods_since_direct = 0;
@@ -199,6 +214,9 @@ impl AnchoredComponent {
         self.anchor_f64 = state;
     }
 
+    /// z^j for the period that starts at `anchor_sample`, times the glide's phase over it while
+    /// the component glides: from the anchor, the glide adds K_a·(1 − r^j), K_a the phase left
+    /// to add at the anchor and r = e^(−1/T).
     fn fill_powers(&mut self) {
         let step = self.component.step();
         // |z^j| = e^(−dj) falls below NEGLIGIBLE_POWER from j = ln(1/NEGLIGIBLE_POWER)/d on;
@@ -209,11 +227,37 @@ impl AnchoredComponent {
         } else {
             GRID
         };
+        let glide = match self.component.glide {
+            Some(glide) if self.gliding => {
+                let elapsed = self.component.samples_since_onset(self.anchor_sample);
+                let left = glide.phase_left_at(elapsed);
+                self.gliding = left.abs() >= GLIDE_SETTLED_RADIANS;
+                self.gliding
+                    .then(|| (left, (-1.0 / glide.time_samples).exp()))
+            }
+            _ => None,
+        };
         let mut power: [f64; 2] = [1.0, 0.0];
-        for j in 0..count {
-            self.powers_re[j] = power[0] as f32;
-            self.powers_im[j] = power[1] as f32;
-            power = complex_mul(power, step);
+        match glide {
+            None => {
+                for j in 0..count {
+                    self.powers_re[j] = power[0] as f32;
+                    self.powers_im[j] = power[1] as f32;
+                    power = complex_mul(power, step);
+                }
+            }
+            Some((left, per_sample)) => {
+                // r^j by products: j roundings of a number below 1, far inside the budget even
+                // times the largest K (a few thousand radians).
+                let mut remaining = 1.0;
+                for j in 0..count {
+                    let glided = complex_mul(power, complex_exp(0.0, left * (1.0 - remaining)));
+                    self.powers_re[j] = glided[0] as f32;
+                    self.powers_im[j] = glided[1] as f32;
+                    power = complex_mul(power, step);
+                    remaining *= per_sample;
+                }
+            }
         }
     }
 }

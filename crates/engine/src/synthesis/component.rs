@@ -8,7 +8,8 @@ pub const SILENT_DECAY_EXPONENT: f64 = 13.815_510_557_964_274;
 /// A component this weak (−240 dB) is never audible; skipping it keeps denormals out of f32.
 const NEGLIGIBLE_AMPLITUDE: f64 = 1e-12;
 
-/// A·e^((−d + iω)·(n − n_i − x)) at sample n: the closed form, in per-sample units.
+/// A·e^(−d·τ + i·(ω·τ + glide(τ))) at sample n, τ = n − n_i − x: the closed form, in per-sample
+/// units.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Component {
     pub onset_sample: u64,
@@ -16,25 +17,62 @@ pub struct Component {
     pub amplitude: f64,
     pub decay_per_sample: f64,
     pub radians_per_sample: f64,
+    /// `None` for a component that does not glide (MODEL.md §5.2: ρ = 1).
+    pub glide: Option<ComponentGlide>,
+}
+
+/// A component's glide (MODEL.md §5.2) in per-sample units: its phase runs ahead of the plain
+/// ω·τ by K·(1 − e^(−τ/T)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ComponentGlide {
+    /// K = ω·(ρ − 1)·T: all the phase the glide adds over its course (rad).
+    pub excess_radians: f64,
+    /// T: the time constant τ_k in samples.
+    pub time_samples: f64,
+}
+
+impl ComponentGlide {
+    /// The phase the glide has added by `elapsed` samples since the onset.
+    #[inline]
+    pub fn phase_at(&self, elapsed: f64) -> f64 {
+        -self.excess_radians * (-elapsed / self.time_samples).exp_m1()
+    }
+
+    /// The phase it has yet to add after `elapsed` samples: K·e^(−τ/T).
+    #[inline]
+    pub fn phase_left_at(&self, elapsed: f64) -> f64 {
+        self.excess_radians * (-elapsed / self.time_samples).exp()
+    }
 }
 
 impl Component {
     /// Component `index` (0: f1/B1, 1: f2/B2) of `onset`, or `None` if it is never computed:
-    /// zero amplitude, a frequency of 0 or at/above Nyquist, or already below −120 dB.
+    /// zero amplitude, a frequency of 0 or one that reaches Nyquist (its glide's start
+    /// included, MODEL.md §5.2), or already below −120 dB.
     pub fn of(onset: &UnitOnset, index: usize, sample_rate: f64) -> Option<Self> {
         let amplitude = onset.component_amplitudes()[index];
         let frequency_hz = onset.shape.frequency_hz[index];
+        let glide = &onset.shape.glide;
         let audible_amplitude = amplitude >= NEGLIGIBLE_AMPLITUDE;
-        let below_nyquist = frequency_hz > 0.0 && frequency_hz < 0.5 * sample_rate;
+        let below_nyquist =
+            frequency_hz > 0.0 && glide.highest_hz(index, frequency_hz) < 0.5 * sample_rate;
         if !audible_amplitude || !below_nyquist {
             return None;
         }
+        let radians_per_sample = std::f64::consts::TAU * frequency_hz / sample_rate;
         let component = Self {
             onset_sample: onset.sample,
             onset_fraction: onset.fraction,
             amplitude,
             decay_per_sample: onset.shape.decay_per_s[index] / sample_rate,
-            radians_per_sample: std::f64::consts::TAU * frequency_hz / sample_rate,
+            radians_per_sample,
+            glide: glide.glides(index).then(|| {
+                let time_samples = glide.time_ms[index] / 1000.0 * sample_rate;
+                ComponentGlide {
+                    excess_radians: radians_per_sample * (glide.ratio[index] - 1.0) * time_samples,
+                    time_samples,
+                }
+            }),
         };
         (!component.is_silent_at(component.first_sample())).then_some(component)
     }
@@ -77,19 +115,21 @@ impl Component {
     /// The exact complex state at `sample`; its imaginary part is the output.
     pub fn state_at(&self, sample: u64) -> [f64; 2] {
         let elapsed = self.samples_since_onset(sample);
-        let [re, im] = complex_exp(
-            -self.decay_per_sample * elapsed,
-            self.radians_per_sample * elapsed,
-        );
+        let phase = match self.glide {
+            None => self.radians_per_sample * elapsed,
+            Some(glide) => self.radians_per_sample * elapsed + glide.phase_at(elapsed),
+        };
+        let [re, im] = complex_exp(-self.decay_per_sample * elapsed, phase);
         [self.amplitude * re, self.amplitude * im]
     }
 
-    /// z = e^(−d + iω): the state's rotation per sample.
+    /// z = e^(−d + iω): the state's rotation per sample, without the glide.
     pub fn step(&self) -> [f64; 2] {
         complex_exp(-self.decay_per_sample, self.radians_per_sample)
     }
 
-    fn samples_since_onset(&self, sample: u64) -> f64 {
+    /// τ in samples: `sample` − n_i − x.
+    pub fn samples_since_onset(&self, sample: u64) -> f64 {
         (sample - self.onset_sample) as f64 - self.onset_fraction
     }
 }

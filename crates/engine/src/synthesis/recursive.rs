@@ -38,6 +38,10 @@ pub struct RecursiveComponent<T> {
     /// The first sample at which the component is below −120 dB; never rendered.
     silent_from: u64,
     component: Component,
+    /// A glide's second rotation (MODEL.md §5.2): the phase it adds from `next_sample` to the
+    /// sample after, and r = e^(−1/T), by which that angle shrinks each sample. Kept in f64 on
+    /// both paths: in f32, r^n's rounding would pile up over a long glide into radians of phase.
+    glide: Option<(f64, f64)>,
 }
 
 impl<T: Float> BankComponent for RecursiveComponent<T> {
@@ -53,6 +57,7 @@ impl<T: Float> BankComponent for RecursiveComponent<T> {
             next_sample: first_sample,
             silent_from: (audible_until.floor() as u64).saturating_add(1),
             component,
+            glide: None,
         };
         recursive.anchor_at(first_sample);
         recursive
@@ -93,6 +98,12 @@ impl<T: Float> RecursiveComponent<T> {
     fn anchor_at(&mut self, sample: u64) {
         self.state = to_complex(self.component.state_at(sample));
         self.next_sample = sample;
+        self.glide = self.component.glide.map(|glide| {
+            // K·e^(−τ/T)·(1 − e^(−1/T)): what the glide adds over this sample.
+            let elapsed = self.component.samples_since_onset(sample);
+            let angle = -glide.phase_left_at(elapsed) * (-1.0 / glide.time_samples).exp_m1();
+            (angle, (-1.0 / glide.time_samples).exp())
+        });
     }
 
     /// Adds samples to `out`, which starts at `span_start` and lies within one grid period.
@@ -110,9 +121,25 @@ impl<T: Float> RecursiveComponent<T> {
         let offset = (self.next_sample - span_start) as usize;
         let count = (end - self.next_sample) as usize;
         let mut state = self.state;
-        for y in &mut out[offset..offset + count] {
-            *y = *y + state.im;
-            state = state * self.step;
+        match &mut self.glide {
+            None => {
+                for y in &mut out[offset..offset + count] {
+                    *y = *y + state.im;
+                    state = state * self.step;
+                }
+            }
+            Some((angle, shrink)) => {
+                for y in &mut out[offset..offset + count] {
+                    *y = *y + state.im;
+                    let (sin, cos) = angle.sin_cos();
+                    let turn = Complex::new(
+                        T::from(cos).unwrap_or(T::one()),
+                        T::from(sin).unwrap_or(T::zero()),
+                    );
+                    state = state * self.step * turn;
+                    *angle *= *shrink;
+                }
+            }
         }
         self.state = state;
         self.next_sample = end;
@@ -146,6 +173,10 @@ mod tests {
                 frequency_spread: [1.0, 1.0],
                 decay_per_s: [decay_per_s; 2],
                 amplitude_factor: 1.0,
+                glide: crate::Glide {
+                    ratio: [1.0; 2],
+                    time_ms: [20.0; 2],
+                },
             },
             actuator_gain: [1.0, 1.0],
         }

@@ -7,7 +7,7 @@
 //! Everything else it computes itself from the contract, with its own copies of the contract's
 //! formulas and constants and none of the engine's: the drain of §3 and §8 through its own reading
 //! of the bottle's curves r, s and h (§2, §12), and from it each unit's V_i; the headspace law of
-//! §5.1 and each unit's f from it; the amplitude law
+//! §5.1 and each unit's f from it; the glide of §5.2, each phase from its closed form; the amplitude law
 //! a(V) with its V0 (§5, §12); the c / (1 − c) split, the gain in dB, the ceiling, the ranges
 //! inputs are brought into (§11), the onset cap and the start budget (§11). A unit the schedule
 //! starts in a sample where its own drain has no glugging outflow it leaves silent. So a fault in
@@ -104,6 +104,16 @@ const HEADSPACE_EXPONENT: Allowed = Allowed {
     min: -3.0,
     max: 3.0,
     default: 0.0,
+};
+const GLIDE_RATIO: Allowed = Allowed {
+    min: 0.25,
+    max: 4.0,
+    default: 1.0,
+};
+const GLIDE_MS: Allowed = Allowed {
+    min: 0.5,
+    max: 500.0,
+    default: 20.0,
 };
 const CEILING: Allowed = Allowed {
     min: 0.001,
@@ -271,6 +281,9 @@ struct Unit {
     amplitudes: [f64; 2],
     frequency_hz: [f64; 2],
     decay_per_s: [f64; 2],
+    /// ρ_k and τ_k (s) of the glide of §5.2, as the model gave them at the onset.
+    glide_ratio: [f64; 2],
+    glide_s: [f64; 2],
 }
 
 /// Evaluates samples `window` of a render that starts from a reset at sample 0.
@@ -336,6 +349,11 @@ pub fn evaluate(
                     onset.shape.frequency_spread,
                 ),
                 decay_per_s: onset.shape.decay_per_s,
+                glide_ratio: config.glide.ratio.map(|ratio| GLIDE_RATIO.bring_in(ratio)),
+                glide_s: config
+                    .glide
+                    .time_ms
+                    .map(|ms| GLIDE_MS.bring_in(ms) / 1000.0),
             });
         });
         let gain = gain.at(sample, 10f64.powf(GAIN_DB.bring_in(gain_db) / 20.0));
@@ -406,11 +424,15 @@ fn unit_frequencies(
 }
 
 /// q_i(τ) of MODEL.md §5 (without G), added at every sample of `window` with τ ≥ 0. A component
-/// at or above fs/2, at 0 Hz or of zero amplitude is omitted (§6).
+/// at or above fs/2 (a glide's start frequency included, §5.2), at 0 Hz or of zero amplitude is
+/// omitted (§6). A gliding component's phase is §5.2's closed form,
+/// 2π·f·[τ + (ρ − 1)·τ_k·(1 − e^(−τ/τ_k))].
 fn add_unit(unit: &Unit, sample_rate: f64, window: &Range<u64>, out: &mut [f64]) {
     for k in 0..2 {
         let (amplitude, frequency_hz) = (unit.amplitudes[k], unit.frequency_hz[k]);
-        if amplitude == 0.0 || frequency_hz <= 0.0 || frequency_hz >= 0.5 * sample_rate {
+        let (ratio, glide_s) = (unit.glide_ratio[k], unit.glide_s[k]);
+        let highest_hz = frequency_hz * ratio.max(1.0);
+        if amplitude == 0.0 || frequency_hz <= 0.0 || highest_hz >= 0.5 * sample_rate {
             continue;
         }
         let first = window.start.max(unit.first_sample);
@@ -420,7 +442,13 @@ fn add_unit(unit: &Unit, sample_rate: f64, window: &Range<u64>, out: &mut [f64])
             if envelope < NEGLIGIBLE_ENVELOPE {
                 break;
             }
-            let phase = std::f64::consts::TAU * frequency_hz * tau;
+            let phase = if ratio == 1.0 {
+                std::f64::consts::TAU * frequency_hz * tau
+            } else {
+                std::f64::consts::TAU
+                    * frequency_hz
+                    * (tau + (ratio - 1.0) * glide_s * (1.0 - (-tau / glide_s).exp()))
+            };
             out[(sample - window.start) as usize] += amplitude * envelope * phase.sin();
         }
     }

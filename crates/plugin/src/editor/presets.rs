@@ -95,9 +95,9 @@ mod tests {
                 preset.name
             );
             let gestures = host.gestures.lock().unwrap();
-            // Its values and the headspace law's three constants (their defaults where it
-            // leaves them out): 11 parameters, each begun, set and ended.
-            assert_eq!(gestures.len(), 11 * 3, "one gesture per parameter");
+            // Its values, the headspace law's three constants and the glide's four (their
+            // defaults where it leaves them out): 15 parameters, each begun, set and ended.
+            assert_eq!(gestures.len(), 15 * 3, "one gesture per parameter");
             assert!(gestures.chunks(3).all(|g| g == ["begin", "set", "end"]));
         }
     }
