@@ -38,6 +38,10 @@ const MIN_GLUGS_FOR_FALL: usize = 4;
 const MISSING: f64 = 4.0;
 /// The evaluations of one search.
 const MAX_ITERATIONS: u64 = 160;
+/// The pour time is matched to the heard rate in at most this many steps.
+const RATE_STEPS: usize = 4;
+/// The pour times searched (s).
+const POUR_SPAN_S: (f64, f64) = (0.2, 600.0);
 /// A units' interval is widened by this factor on each side before it bounds the search.
 const INTERVAL_SLACK: f64 = 1.1;
 
@@ -54,6 +58,8 @@ pub struct Listened {
     pub bright: f64,
     /// The log-spectral distance from the recording (dB; 0 for the recording itself).
     pub distance_db: f64,
+    /// The glugs heard.
+    pub glugs: usize,
 }
 
 impl Listened {
@@ -90,7 +96,17 @@ impl Listened {
             },
             bright: heard.high_share,
             distance_db,
+            glugs: heard.onsets_s.len(),
         }
+    }
+
+    /// As a candidate is judged: with fewer than 2 glugs heard in `duration_s`, a rate of half a
+    /// glug over it, so that a search that went too slow is led back rather than lost on a flat.
+    fn as_candidate(mut self, duration_s: f64) -> Self {
+        if !self.rate_per_s.is_finite() && duration_s > 0.0 {
+            self.rate_per_s = 0.5 / duration_s;
+        }
+        self
     }
 }
 
@@ -171,7 +187,7 @@ impl Knob {
 }
 
 /// The constants the listening fit sets, and the widest span each is searched over.
-fn knobs() -> [Knob; 7] {
+fn knobs() -> [Knob; 6] {
     let constant = |c: Constant| c.quantity().scene_key;
     [
         Knob {
@@ -213,13 +229,6 @@ fn knobs() -> [Knob; 7] {
             key: constant(Constant::FreqJitter),
             scale: Scale::Share,
             span: (0.002, 0.5),
-            frequency: false,
-            mode: None,
-        },
-        Knob {
-            key: Control::PourTime.quantity().scene_key,
-            scale: Scale::Log,
-            span: (0.2, 600.0),
             frequency: false,
             mode: None,
         },
@@ -267,7 +276,8 @@ impl Search<'_> {
                 f64::from(target.made.sample_rate),
                 target.glugs,
                 &target.spectrum,
-            );
+            )
+            .as_candidate(target.made.duration_s);
             total += misses(&target.listened, &listened, target.default_distance_db)
                 .iter()
                 .sum::<f64>();
@@ -437,17 +447,36 @@ pub(crate) fn fit_by_listening(
     if units_pass {
         return None;
     }
-    let starts = starting_points(&knobs, &bounds, &targets, capacity_ml, &units_value);
-    let mut best: Option<(Vec<f64>, f64)> = None;
+    let starts = starting_points(&knobs, &bounds, &targets, &units_value);
+    let pour_key = Control::PourTime.quantity().scene_key;
+    let units_pour_s = units_value(pour_key);
+    // (its pour time, its point, its cost)
+    let mut best: Option<(f64, Vec<f64>, f64)> = None;
     for start in starts {
-        let Some((x, cost)) = minimise(&search, start) else {
+        // Each start glugs at the recordings' rate before the search, and its end again after:
+        // the rate is the pour time's alone, and a search that set both would wander off where
+        // too few glugs are heard to tell.
+        let pour_s = matched_pour_time(&search.model(&start), units_pour_s, &targets);
+        let mut start_base = base.clone();
+        keys::insert(&mut start_base, pour_key, toml::Value::Float(pour_s));
+        let here = Search {
+            base: &start_base,
+            ..search
+        };
+        let Some((x, _)) = minimise(&here, start) else {
             continue;
         };
-        if best.as_ref().is_none_or(|(_, c)| cost < *c) {
-            best = Some((x, cost));
+        let pour_s = matched_pour_time(&here.model(&x), pour_s, &targets);
+        let mut end = here.model(&x);
+        keys::insert(&mut end, pour_key, toml::Value::Float(pour_s));
+        let Some(cost) = search.cost_of(&end) else {
+            continue;
+        };
+        if best.as_ref().is_none_or(|(_, _, c)| cost < *c) {
+            best = Some((pour_s, x, cost));
         }
     }
-    let (x, cost) = best?;
+    let (pour_s, x, cost) = best?;
     if cost >= units_cost {
         return None;
     }
@@ -475,6 +504,18 @@ pub(crate) fn fit_by_listening(
         }
         set.push(knob.key.to_owned());
     }
+    if (pour_s / units_pour_s - 1.0).abs() > 0.01 {
+        let note = "fitted by listening: the pour time that glugs at the recordings' heard rate";
+        match estimates.iter_mut().find(|e| e.key == pour_key) {
+            Some(estimate) => estimate.by_listening(pour_s, note.to_owned()),
+            None => {
+                let mut estimate = Estimate::measured(pour_key, pour_s, None, true);
+                estimate.by_listening(pour_s, note.to_owned());
+                estimates.push(estimate);
+            }
+        }
+        set.push(pour_key.to_owned());
+    }
     Some(ListeningFit {
         cost: [units_cost, cost],
         set,
@@ -487,7 +528,6 @@ fn starting_points(
     knobs: &[Knob],
     bounds: &[(f64, f64)],
     targets: &[Target],
-    capacity_ml: f64,
     units_value: &dyn Fn(&str) -> f64,
 ) -> Vec<Vec<f64>> {
     let at = |values: &dyn Fn(&Knob) -> f64| -> Vec<f64> {
@@ -518,23 +558,14 @@ fn starting_points(
             .find(|q| q.scene_key == knob.key)
             .map_or(f64::NAN, |q| q.range.default)
     });
-    // The recordings' own: the strongest peak below the split and above it, the share of the
-    // energy below it as c, and the pour time that glugs at the heard rate.
+    // The recordings' own: the strongest peak below the split and above it, and the share of the
+    // energy below it as c.
     let first = &targets[0];
     let (low_peak, high_peak) = strongest_peaks(&first.spectrum, first.made.sample_rate);
-    let rates: Vec<f64> = targets
-        .iter()
-        .map(|t| t.listened.rate_per_s)
-        .filter(|r| r.is_finite())
-        .collect();
-    let pocket_ml = units_value(Constant::Pocket.quantity().scene_key);
     let heard = at(&|knob| match knob.key {
         k if k == Constant::F1.quantity().scene_key => low_peak,
         k if k == Constant::F2.quantity().scene_key => high_peak,
         k if k == Control::Viscosity.quantity().scene_key => 1.0 - first.listened.bright,
-        k if k == Control::PourTime.quantity().scene_key && !rates.is_empty() => {
-            capacity_ml / (median(&rates) * pocket_ml)
-        }
         _ => f64::NAN,
     });
     vec![units, heard, defaults]
@@ -556,6 +587,38 @@ fn strongest_peaks(spectrum: &Spectrum, sample_rate: u32) -> (f64, f64) {
             4000.0f64.min(0.45 * f64::from(sample_rate)),
         ),
     )
+}
+
+/// The pour time (s) at which the model `table` glugs at the recordings' heard rate, from
+/// `pour_s`: the pour time scaled by the median ratio of the rate heard in its renders to the
+/// recordings', at most [`RATE_STEPS`] times (the rate is the outflow over the pocket, so it scales
+/// as 1/T but for glugs a listener hears as one).
+fn matched_pour_time(table: &toml::Table, mut pour_s: f64, targets: &[Target]) -> f64 {
+    let key = Control::PourTime.quantity().scene_key;
+    for _ in 0..RATE_STEPS {
+        let mut table = table.clone();
+        keys::insert(&mut table, key, toml::Value::Float(pour_s));
+        let ratios: Vec<f64> = targets
+            .iter()
+            .filter(|t| t.listened.rate_per_s.is_finite())
+            .filter_map(|target| {
+                let samples = render_as_recorded(&table, &target.made)?;
+                let heard = hear(&samples, f64::from(target.made.sample_rate), ONE_MODE_SPLIT_HZ);
+                let listened = Listened::from_heard(&heard, 0, 0.0).as_candidate(target.made.duration_s);
+                Some(listened.rate_per_s / target.listened.rate_per_s)
+            })
+            .filter(|r| r.is_finite() && *r > 0.0)
+            .collect();
+        if ratios.is_empty() {
+            break;
+        }
+        let ratio = median(&ratios);
+        pour_s = (pour_s * ratio).clamp(POUR_SPAN_S.0, POUR_SPAN_S.1);
+        if (ratio - 1.0).abs() < 0.03 {
+            break;
+        }
+    }
+    pour_s
 }
 
 /// Nelder–Mead from `start`: the best point and its cost.

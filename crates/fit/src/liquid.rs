@@ -364,7 +364,7 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
         .collect();
     let mut kept_default = kept_default;
     let mut model = model_toml(liquid, &estimates, inputs.curves, &kept_default, &cautions);
-    let listening = if units.len() >= MIN_UNITS_FOR_MODEL {
+    let listening = if !units.is_empty() {
         fit_by_listening(
             &model,
             &mut estimates,
