@@ -503,10 +503,25 @@ fn bad_discrimination_logs_are_refused_with_file_line_and_column() {
 /// The trials of the session `experiment --discriminate` runs of `design` unless told, as the
 /// session plans them.
 fn session_trials(design: Design) -> u64 {
+    // The files the spec names are read as it is parsed: an empty model (the default bottle) and
+    // three seconds of a tone.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("model.toml"), "").unwrap();
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: 48_000,
+        bits_per_sample: 32,
+        sample_format: hound::SampleFormat::Float,
+    };
+    let mut take = hound::WavWriter::create(dir.path().join("take.wav"), spec).unwrap();
+    for n in 0..144_000 {
+        take.write_sample((n as f32 * 0.05).sin() * 0.5).unwrap();
+    }
+    take.finalize().unwrap();
     let study = Discriminate {
         design,
-        recording: "take.wav".into(),
-        model: "model.toml".into(),
+        recording: dir.path().join("take.wav"),
+        model: dir.path().join("model.toml"),
         start_s: 0.0,
         duration_s: 2.0,
         repetitions: Discriminate::default_repetitions(design),
@@ -529,6 +544,8 @@ fn the_planner_assumes_the_session_that_is_run() {
                 "discrimination",
                 "--design",
                 name,
+                "--below",
+                "1",
                 "--studies",
                 "20",
                 "--json",
