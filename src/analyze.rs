@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 use clap::{Args, Subcommand};
 use sake_glug_io::text::{printable, quoted};
+use sake_glug_study::{Discriminate, DISCRIMINATE_DESIGNS};
 
 use sake_glug_analysis::{
     analyze_constant_logs, analyze_discrimination_logs, analyze_paired_logs, constant_json,
@@ -95,9 +96,10 @@ struct PlanDiscriminationArgs {
         value_name = "D"
     )]
     spread: f64,
-    /// Trials each participant answers.
-    #[arg(long = "trials-each", default_value_t = 12, value_name = "N")]
-    trials_each: u32,
+    /// Trials each participant answers (default: as many as the session `experiment
+    /// --discriminate` runs of the design).
+    #[arg(long = "trials-each", value_name = "N")]
+    trials_each: Option<u32>,
     /// The power wanted (0.8 is 80 %).
     #[arg(long, default_value_t = 0.8, allow_hyphen_values = true)]
     power: f64,
@@ -261,6 +263,16 @@ fn plan(args: PlanConstantArgs) -> ExitCode {
     }
 }
 
+/// The trials of the session `experiment --discriminate` runs of `design` unless told: what a
+/// plan assumes unless told, so that it plans the study that is run.
+fn session_trials(design: DiscriminationDesign) -> u32 {
+    let design = DISCRIMINATE_DESIGNS
+        .into_iter()
+        .find(|study| study.discrimination() == Some(design))
+        .expect("every discrimination design can be run");
+    Discriminate::default_trials(design)
+}
+
 /// Exit status 0 when simulated, 2 for an argument refused (named as its option).
 fn plan_discrimination_run(args: PlanDiscriminationArgs) -> ExitCode {
     let goal = match args.below {
@@ -272,7 +284,9 @@ fn plan_discrimination_run(args: PlanDiscriminationArgs) -> ExitCode {
         goal,
         d_prime: args.d_prime.unwrap_or(0.0),
         spread: args.spread,
-        trials_each: args.trials_each,
+        trials_each: args
+            .trials_each
+            .unwrap_or_else(|| session_trials(args.design)),
         power: args.power,
         studies: args.studies,
         seed: args.seed,

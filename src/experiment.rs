@@ -21,7 +21,9 @@ const ALSA_DEVICE: &str = "default";
 
 #[derive(Args, Debug)]
 pub struct ExperimentArgs {
-    /// The study's spec file (see experiments/README.md).
+    /// The study's spec file: its keys in experiments/README.md, installed with the two studies
+    /// of the paper in /usr/share/doc/sake-glug/experiments (the .deb) or
+    /// ~/.local/share/doc/sake-glug/experiments (the tarball).
     #[arg(required_unless_present = "discriminate")]
     spec: Option<PathBuf>,
     /// Without a spec file: a discrimination study of a recording against the model fitted to
@@ -218,12 +220,7 @@ fn load_spec(args: &ExperimentArgs) -> Result<(PathBuf, Spec), StudyError> {
                 }
             })?,
     };
-    // About two dozen trials whatever the design.
-    let repetitions = match design {
-        Design::Triangle => 4,
-        Design::Abx => 6,
-        _ => 10,
-    };
+    let repetitions = Discriminate::default_repetitions(design);
     let study = Discriminate {
         design,
         recording: files[0].clone(),

@@ -291,6 +291,9 @@ pub fn run(args: RenderArgs) -> ExitCode {
                     if let Some(reason) = silent {
                         out.error(&format!("warning: {name}: {reason}"));
                     }
+                    for clipped in &report.clipped {
+                        out.error(&format!("warning: {clipped}"));
+                    }
                     match fidelity {
                         Some(rows) => {
                             out.error(&summary(&name, &report, &outside, args.haptic_peak));

@@ -13,6 +13,7 @@ use rand::{Rng, RngExt, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use sake_glug_analysis::{estimate_discrimination, DiscriminationDesign};
+use sake_glug_study::{plan_trials, Design, Discriminate, Spec, DISCRIMINATE_DESIGNS};
 use statrs::distribution::{Binomial, Discrete, DiscreteCDF};
 
 use crate::{analyze, json_of};
@@ -499,6 +500,66 @@ fn bad_discrimination_logs_are_refused_with_file_line_and_column() {
     }
 }
 
+/// The trials of the session `experiment --discriminate` runs of `design` unless told, as the
+/// session plans them.
+fn session_trials(design: Design) -> u64 {
+    // The files the spec names are read as it is parsed: an empty model (the default bottle) and
+    // three seconds of a tone.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("model.toml"), "").unwrap();
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: 48_000,
+        bits_per_sample: 32,
+        sample_format: hound::SampleFormat::Float,
+    };
+    let mut take = hound::WavWriter::create(dir.path().join("take.wav"), spec).unwrap();
+    for n in 0..144_000 {
+        take.write_sample((n as f32 * 0.05).sin() * 0.5).unwrap();
+    }
+    take.finalize().unwrap();
+    let study = Discriminate {
+        design,
+        recording: dir.path().join("take.wav"),
+        model: dir.path().join("model.toml"),
+        start_s: 0.0,
+        duration_s: 2.0,
+        repetitions: Discriminate::default_repetitions(design),
+    };
+    let spec = Spec::parse(&study.spec_text(), Path::new("--discriminate")).unwrap();
+    plan_trials(&spec, 1).len() as u64
+}
+
+/// The planner plans the study that is run: unless told, each participant answers as many
+/// trials as the session `experiment --discriminate` runs of the design (the guide's "23
+/// participants" assumed 12 trials, the session ran 24: issue 49).
+#[test]
+fn the_planner_assumes_the_session_that_is_run() {
+    for design in DISCRIMINATE_DESIGNS {
+        let name = design.discrimination().unwrap().name();
+        let output = analyze(
+            &std::env::temp_dir(),
+            &[
+                "plan",
+                "discrimination",
+                "--design",
+                name,
+                "--below",
+                "1",
+                "--studies",
+                "20",
+                "--json",
+            ],
+        );
+        let json = json_of(&output);
+        assert_eq!(
+            json["plan"]["trials_each"].as_u64(),
+            Some(session_trials(design)),
+            "{name}: {json}"
+        );
+    }
+}
+
 #[test]
 fn the_planner_sizes_a_triangle_study_to_show_d_prime_below_one() {
     let output = analyze(
@@ -517,7 +578,7 @@ fn the_planner_sizes_a_triangle_study_to_show_d_prime_below_one() {
     let needed = &json["needed"];
     let participants = needed["participants"].as_u64().unwrap();
     let trials = needed["trials"].as_u64().unwrap();
-    assert_eq!(trials, participants * 12);
+    assert_eq!(trials, participants * session_trials(Design::Triangle));
     // A normal approximation: 1/3 + (z₀.₈ + z₀.₉₇₅)·√(pq/n) = P_c(1) needs n ≈ 240 trials.
     assert!((150..=350).contains(&trials), "{trials} trials");
     assert!(needed["power"].as_f64().unwrap() >= 0.8);

@@ -89,6 +89,8 @@ class Install:
         self.bin_dir = bin_dir
         self.lib_dir = lib_dir
         self.man_dir = man_dir
+        # The docs, beside the man pages: <share>/doc/sake-glug.
+        self.doc_dir = man_dir.parents[1] / "doc" / PACKAGE
         self.vst3 = vst3
         self.env = env
         self.files = files
@@ -213,6 +215,35 @@ def test_c_example_builds_through_pkg_config(install, cli_pour, tmp_path):
     out = tmp_path / "pour.wav"
     run([str(program), str(out)], env=install.env)
     assert_bit_identical(read_f32(out), cli_pour, f"{install}'s C library")
+
+
+MARKDOWN_LINK = re.compile(r"\[[^\]]*\]\(([^)\s]+)\)")
+
+
+def broken_links(root):
+    """Each link of the Markdown pages under `root` to a file that is not in that tree, as
+    `page: target`: links to the web and to a page's own headings left out, code (spans and
+    blocks, where a path is only named) too."""
+    broken = []
+    for page in sorted(root.rglob("*.md")):
+        text = re.sub(r"```.*?```", "", page.read_text(), flags=re.S)
+        text = re.sub(r"`[^`\n]*`", "", text)
+        for target in MARKDOWN_LINK.findall(text):
+            if re.match(r"[a-z][a-z0-9+.-]*:", target) or target.startswith("#"):
+                continue
+            if not (page.parent / target.split("#")[0]).exists():
+                broken.append(f"{page.relative_to(root)}: {target}")
+    return broken
+
+
+def test_every_link_of_the_installed_docs_is_installed(install):
+    """The guide's study specs (experiments/, which `experiment --help` names too), the licence
+    the README links: every page installed links only to what is installed beside it."""
+    assert (install.doc_dir / "docs" / "guide" / "researcher.md").is_file(), install.doc_dir
+    for spec in ["README.md", "paired-waves.toml", "viscosity-constant.toml"]:
+        assert (install.doc_dir / "experiments" / spec).is_file(), f"{install}: experiments/{spec}"
+    broken = broken_links(install.doc_dir)
+    assert not broken, f"{install}: {len(broken)} links lead out of the installed docs: {broken}"
 
 
 def subcommands():

@@ -223,7 +223,7 @@ fn bad_arguments_are_errors_not_panics() {
     let directory = tempfile::tempdir().unwrap();
     let cases: [&[&str]; 2] = [
         &["render", "missing.toml"],
-        &["render", "-o", "no/such/dir/out.wav"],
+        &["render", "-o", "/proc/no/such/dir/out.wav"],
     ];
     for args in cases {
         let output = sake_glug(directory.path(), args);

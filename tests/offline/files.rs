@@ -416,3 +416,51 @@ fn an_out_dir_that_is_a_file_is_a_command_line_error() {
         "{stderr}"
     );
 }
+
+/// Every command that writes makes the folder it writes into, as `--out-dir` does: the guide's
+/// `--variations 12 -o out/pour.wav` failed when `out/` did not exist, naming its hidden
+/// temporary file (issue 49). A folder that cannot be made is named, never a temporary file.
+#[test]
+fn a_missing_folder_is_made_and_one_that_cannot_be_is_named() {
+    let directory = tempfile::tempdir().unwrap();
+    let dir = directory.path();
+    let output = sake_glug(
+        dir,
+        &[
+            "render",
+            "--variations",
+            "2",
+            "-o",
+            "out/pour.wav",
+            "-o",
+            "out/clips/pour.haptic",
+            "--plot",
+            "plots/pour.png",
+        ],
+    );
+    assert!(output.status.success(), "{output:?}");
+    assert_eq!(
+        files_in(&dir.join("out")),
+        [
+            "clips",
+            "pour.variations.csv",
+            "pour.variations.json",
+            "pour_01.wav",
+            "pour_02.wav"
+        ]
+    );
+    assert_eq!(
+        files_in(&dir.join("out/clips")),
+        ["pour_01.haptic", "pour_02.haptic"]
+    );
+    assert_eq!(files_in(&dir.join("plots")), ["pour_01.png", "pour_02.png"]);
+
+    fs::write(dir.join("taken"), "").unwrap();
+    let output = sake_glug(dir, &["render", "-o", "taken/pour.wav"]);
+    assert_eq!(output.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("cannot make its folder taken") && !stderr.contains(".sake-glug-"),
+        "{stderr}"
+    );
+}

@@ -487,3 +487,56 @@ fn the_ahap_draws_decays_as_curves_within_the_limit() {
         );
     }
 }
+
+/// A file whose samples pass full scale is named, with how many: `--loudness -16
+/// --sample-format s16` clipped the default pour's peaks and only said "true peak 0.9 dBTP"
+/// (issue 49). The count is the float file's samples beyond ±1; under `--true-peak -1` nothing
+/// clips and nothing is said.
+#[test]
+fn a_file_that_clips_is_named_with_its_count() {
+    let directory = tempfile::tempdir().unwrap();
+    let dir = directory.path();
+    let render = |args: &[&str]| {
+        let output = sake_glug(dir, args);
+        assert!(output.status.success(), "{output:?}");
+        String::from_utf8(output.stderr).unwrap()
+    };
+    let float = render(&["render", "-o", "loud.wav", "--loudness", "-16"]);
+    let (samples, _) = wav(&dir.join("loud.wav"));
+    let beyond = samples.iter().filter(|y| y.abs() > 1.0).count();
+    assert!(beyond > 0, "the default pour at -16 LUFS passes full scale");
+    assert!(
+        float.contains(&format!(
+            "warning: loud.wav: {beyond} samples pass full scale (kept in the float file"
+        )),
+        "{float}"
+    );
+    let integer = render(&[
+        "render",
+        "-o",
+        "loud16.wav",
+        "--loudness",
+        "-16",
+        "--sample-format",
+        "s16",
+    ]);
+    assert!(
+        integer.contains(&format!(
+            "warning: loud16.wav: {beyond} samples pass full scale, clipped in the file"
+        )),
+        "{integer}"
+    );
+    let held = render(&[
+        "render",
+        "-o",
+        "held.wav",
+        "--loudness",
+        "-16",
+        "--true-peak",
+        "-1",
+        "--sample-format",
+        "s16",
+    ]);
+    assert!(!held.contains("warning"), "{held}");
+    assert!(!render(&["render", "-o", "plain.wav"]).contains("warning"));
+}

@@ -115,7 +115,9 @@ impl Layout {
             vst3: "usr/lib/vst3",
             pc_prefix: "/usr",
             pc_libdir: format!("lib/{MULTIARCH}"),
-            license_file: false,
+            // The installed README links to it; Debian's copyright file holds it too (lintian
+            // only notes the extra file).
+            license_file: true,
         }
     }
 
@@ -336,8 +338,11 @@ fn lay_out(
         copy_tree(Path::new(folder), &share.join(PACKAGE).join(folder))?;
     }
     let doc = root.join(&layout.doc);
-    copy_tree(Path::new("examples"), &doc.join("examples"))?;
-    copy_tree(Path::new("docs"), &doc.join("docs"))?;
+    // The folders the docs link to, as in the repository: the guide's study specs and their keys
+    // (experiments/), which `experiment --help` names too.
+    for folder in ["examples", "docs", "experiments"] {
+        copy_tree(Path::new(folder), &doc.join(folder))?;
+    }
     for file in ["README.md", "CHANGELOG.md"] {
         copy(Path::new(file), &doc.join(file), 0o644)?;
     }

@@ -6,10 +6,12 @@ use std::fs::{File, OpenOptions};
 use std::io;
 use std::path::Path;
 
+use crate::pending::made_folder_of;
 use crate::read::kind_of;
 
-/// The regular file at `path`, open to read and to append: created, and refused if it exists,
-/// when `new`; else an existing one. A FIFO, a device or a folder is refused at once, since the
+/// The regular file at `path`, open to read and to append: created (its folder too, as every
+/// written file's, [`made_folder_of`]), and refused if it exists, when `new`; else an existing
+/// one. A FIFO, a device or a folder is refused at once, since the
 /// opened file is checked, and opening does not wait (`O_NONBLOCK`: a FIFO opened to write waits
 /// for a reader without it); the error then says what it is (`InvalidInput`).
 pub fn open_to_append(path: &Path, new: bool) -> io::Result<File> {
@@ -19,6 +21,9 @@ pub fn open_to_append(path: &Path, new: bool) -> io::Result<File> {
     {
         use std::os::unix::fs::OpenOptionsExt;
         options.custom_flags(libc::O_NONBLOCK);
+    }
+    if new {
+        made_folder_of(path)?;
     }
     let file = options.open(path)?;
     let file_type = file.metadata()?.file_type();

@@ -195,7 +195,8 @@ pub fn temp_file_beside(target: &Path, suffix: &str) -> io::Result<NamedTempFile
     builder
         .prefix(&prefix)
         .suffix(&suffix)
-        .tempfile_in(folder_of(target))
+        .tempfile_in(made_folder_of(target)?)
+        .map_err(without_temp_name)
 }
 
 /// A new empty temporary folder beside the folder `target`, named as [`temp_file_beside`] names a
@@ -212,7 +213,8 @@ pub fn temp_dir_beside(target: &Path) -> io::Result<tempfile::TempDir> {
     builder
         .prefix(&prefix)
         .suffix(".tmp")
-        .tempdir_in(folder_of(target))
+        .tempdir_in(made_folder_of(target)?)
+        .map_err(without_temp_name)
 }
 
 /// The previous target kept under a name like its temporary file's (ending in `.old`), made by
@@ -320,6 +322,30 @@ fn folder_of(target: &Path) -> &Path {
     }
 }
 
+/// The folder `target` is written in, made (with its parents) if it is missing: every command
+/// that writes a file makes its folder, as `--out-dir` does. Refused, naming the folder.
+pub fn made_folder_of(target: &Path) -> io::Result<&Path> {
+    let folder = folder_of(target);
+    fs::create_dir_all(folder).map_err(|error| {
+        io::Error::new(
+            error.kind(),
+            format!("cannot make its folder {}: {error}", folder.display()),
+        )
+    })?;
+    Ok(folder)
+}
+
+/// The file system's error without the name of the temporary file it was about, a hidden name
+/// the user never asked for (the caller names the target). The `tempfile` crate appends it as
+/// ` at path "…"` to the system's own words, and keeps no other way to them.
+fn without_temp_name(error: io::Error) -> io::Error {
+    let text = error.to_string();
+    match text.rsplit_once(" at path ") {
+        Some((cause, _)) => io::Error::new(error.kind(), cause.to_owned()),
+        None => error,
+    }
+}
+
 fn is_folder(path: &Path) -> bool {
     fs::symlink_metadata(path).is_ok_and(|meta| meta.is_dir())
 }
@@ -387,6 +413,42 @@ mod tests {
     /// The second rename fails (its temporary file was replaced behind the render's back): the
     /// first target, already replaced, is put back, the second is as it was, the third is not
     /// written, and nothing is left beside them.
+    /// A target in a folder that is missing is written there, the folder made; one whose
+    /// folder cannot be made, or that cannot take a file, is refused naming the folder, never
+    /// the hidden temporary file (issue 49: `".pour_01.wav.sake-glug-8131….tmp"`).
+    #[test]
+    fn a_missing_folder_is_made_and_a_refusal_names_no_temporary_file() {
+        let folder = tempfile::tempdir().unwrap();
+        let target = folder.path().join("out/takes/pour.wav");
+        PendingFile::commit_all(vec![pending(&target, "glug")]).unwrap();
+        assert_eq!(fs::read_to_string(&target).unwrap(), "glug");
+
+        let obstacle = folder.path().join("a-file");
+        fs::write(&obstacle, "").unwrap();
+        let error = PendingFile::beside(&obstacle.join("out/pour.wav"), "")
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            error.contains(&format!(
+                "cannot make its folder {}",
+                obstacle.join("out").display()
+            )),
+            "{error}"
+        );
+        // A folder that takes no file (as root, only /proc refuses one).
+        for target in [Path::new("/proc/pour.wav"), &obstacle.join("pour.wav")] {
+            for error in [
+                PendingFile::beside(target, "").err().map(|e| e.to_string()),
+                temp_dir_beside(target).err().map(|e| e.to_string()),
+            ] {
+                let error = error.unwrap();
+                // (Every temporary file's name holds `.sake-glug-`: `temp_file_beside`.)
+                assert!(!error.contains(".sake-glug-"), "{error}");
+            }
+        }
+    }
+
     #[test]
     fn a_failed_replacement_puts_back_the_ones_done() {
         let folder = tempfile::tempdir().unwrap();

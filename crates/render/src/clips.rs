@@ -228,7 +228,7 @@ fn model_amplitudes(glug: &Glug) -> [f64; 2] {
 pub fn glug_peak(glug: &Glug, ceiling: f64) -> f64 {
     (glug.amplitudes[0].abs() + glug.amplitudes[1].abs())
         .min(ceiling)
-        .clamp(0.0, 1.0)
+        .clamp(0.0, FULL_SCALE)
 }
 
 /// The strength of a glug's transient (AHAP `HapticIntensity`, `.haptic` emphasis amplitude):
@@ -243,6 +243,10 @@ pub fn transient_intensity(glug: &Glug, ceiling: f64) -> f64 {
 /// looks vertical, long enough that the time is not duplicated (the spec allows duplicates
 /// but discourages them).
 pub const ONSET_LEAD_S: f64 = 0.0005;
+
+/// Full drive: the largest amplitude, intensity or magnitude of every clip format (a `.haptic`
+/// amplitude, an `.ahap` intensity, a `.haps` keyframe, a rumble motor, Android's 255).
+pub const FULL_SCALE: f64 = 1.0;
 
 /// The envelope level (−60 dB of full scale) below which a decay is no longer sampled.
 pub const ENVELOPE_FLOOR: f64 = 1e-3;
@@ -410,7 +414,11 @@ impl<'a> EnvelopeSum<'a> {
             ..
         } = self.ringing_at(t);
         let frequency_hz = (model_total > 0.0).then(|| weighted_hz / model_total);
-        (total.min(self.limit()), frequency_hz)
+        // A breakpoint is written as it is: never above full scale, the limit of every clip
+        // format. `--haptic-peak` scales the ceiling with the glugs by a gain whose rounding can
+        // leave their product a hair above 1 (MODEL.md §19), so the clamp comes after it. (The
+        // step formats average the envelope unclamped, and clamp each step.)
+        (total.min(self.limit()).min(FULL_SCALE), frequency_hz)
     }
 
     /// The largest value the envelope takes: the ceiling (at most 1, full scale, unless

@@ -31,7 +31,8 @@ pub use scene::{
     InputFile, LaneBuffers, Scene, SceneError, DEFAULT_SCENE, MAX_DURATION_S, MAX_SCENE_BYTES,
 };
 pub use sinks::{
-    Output, OutputError, OutputFormat, OutputOptions, PlatformOptions, SampleFormat, WavError,
+    Clipped, Output, OutputError, OutputFormat, OutputOptions, PlatformOptions, SampleFormat,
+    WavError,
 };
 pub use tables::{
     csv_header, render_tables, render_tables_until, Column, StateRate, StateRateError, StateRow,

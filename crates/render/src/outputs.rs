@@ -14,8 +14,8 @@ use super::render::{render_scene, BottleReport, RenderError, RenderObserver, Ren
 use super::scene::Scene;
 use super::sinks::read_back::ReadBack;
 use super::sinks::{
-    remove_own_temps, remove_stale_temps, Output, OutputError, OutputOptions, PendingFile, Sink,
-    SinkContext,
+    remove_own_temps, remove_stale_temps, Clipped, Output, OutputError, OutputOptions, PendingFile,
+    Sink, SinkContext,
 };
 use sake_glug_engine::{UnitOnset, Voicing};
 
@@ -35,6 +35,9 @@ pub struct RenderReport {
     /// The level of the waveform files (their gain and loudness), when a level was asked for
     /// ([`OutputOptions::level`]) or measured ([`OutputOptions::measure_loudness`]).
     pub levelled: Option<Levelled>,
+    /// The files whose samples pass full scale, in the order they were asked for: each is
+    /// named to the user.
+    pub clipped: Vec<Clipped>,
 }
 
 /// Renders `scene` once and writes every file of `outputs` from that pass, each in its format. `scene_name` goes into the clips' metadata; `observer` hears what the
@@ -117,8 +120,9 @@ pub fn render_to_files(
         &mut fanout,
     )?;
     let (observer, audible_units) = (fanout.observer, fanout.audible_units);
+    let sinks = sinks.into_inner();
+    let clipped = sinks.iter().filter_map(|sink| sink.clipped()).collect();
     let finished = sinks
-        .into_inner()
         .into_iter()
         .map(|sink| sink.finish(&summary))
         .collect::<Result<Vec<_>, _>>()?;
@@ -134,6 +138,7 @@ pub fn render_to_files(
         leftovers,
         audible_units,
         levelled,
+        clipped,
     })
 }
 

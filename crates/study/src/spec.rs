@@ -300,6 +300,24 @@ pub struct Discriminate {
 pub const DISCRIMINATE_DESIGNS: [Design; 3] = [Design::Triangle, Design::TwoAfc, Design::Abx];
 
 impl Discriminate {
+    /// Presentations of each order `--discriminate` gives `design` unless told: about two dozen
+    /// trials whatever the design.
+    pub fn default_repetitions(design: Design) -> u32 {
+        match design {
+            Design::Triangle => 4,
+            Design::Abx => 6,
+            _ => 10,
+        }
+    }
+
+    /// The trials of the session `--discriminate` runs of `design` by default (the
+    /// recording and the model, [`Discriminate::default_repetitions`] times): what a plan of the
+    /// study assumes unless told (`analyze plan discrimination --trials-each`).
+    pub fn default_trials(design: Design) -> u32 {
+        let trials = trial_count(design, 2, Self::default_repetitions(design));
+        u32::try_from(trials).expect("two dozen trials")
+    }
+
     /// The spec file of the study: its design (for 2AFC the recording the target: "which one is
     /// the recording?"), the model with the built-in pour's other keys, levels matched by RMS,
     /// half a second between stimuli.

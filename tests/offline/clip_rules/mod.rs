@@ -45,6 +45,7 @@ mod clips_written;
 pub mod dualsense;
 pub mod haps;
 pub mod haptic;
+mod limits_over_seeds;
 mod platforms_written;
 pub mod rumble;
 

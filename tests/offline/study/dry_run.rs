@@ -209,3 +209,30 @@ fn scripted_dry_run(dir: &Path) -> Output {
         "",
     )
 }
+
+/// A session's log and its dry run go into folders that do not exist yet: made, as every
+/// written file's folder is (issue 49).
+#[test]
+fn the_log_and_the_dry_run_make_their_folders() {
+    let dir = study();
+    let output = run(
+        dir.path(),
+        &[
+            "study.toml",
+            "--participant",
+            "p1",
+            "--log",
+            "logs/p1/log.csv",
+            "--dry-run",
+            "runs/p1/dry",
+        ],
+        &answers(12),
+    );
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert_eq!(names(&dir.path().join("runs/p1/dry")).len(), 2 * 12 + 1);
+    assert!(dir.path().join("logs/p1/log.csv").is_file());
+}

@@ -7,7 +7,7 @@ use super::read_back::{array, linear, number, ReadBack, Reading, WrittenClip};
 use super::{ClipSink, OutputError, OutputFormat, OutputOptions, Sink, SinkContext};
 use crate::clips::{
     clip_end_s, clip_onsets, envelope_breakpoints, felt_frequency_hz, glug_count,
-    transient_intensity, ClipSource, HapticBand,
+    transient_intensity, ClipSource, HapticBand, FULL_SCALE,
 };
 
 /// `.haptic`: a Meta Haptics Studio 1.0 clip.
@@ -121,7 +121,7 @@ pub fn haptic_json(source: &ClipSource, band: &HapticBand) -> String {
                 Emphasis {
                     amplitude: transient_intensity(glug, source.ceiling)
                         .max(point.amplitude)
-                        .min(1.0),
+                        .min(FULL_SCALE),
                     frequency: band.normalise(felt_frequency_hz(glug)),
                 }
             }),

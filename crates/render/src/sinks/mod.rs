@@ -52,7 +52,7 @@ pub use plot::{draw_pour_plot, PlotData, Waveform};
 pub use rumble::{rumble_json, DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE_RANGE_HZ};
 #[cfg(feature = "plot")]
 pub use sake_glug_plot::PlotError;
-pub use wav::{SampleFormat, WavError};
+pub use wav::{Clipped, SampleFormat, WavError};
 
 /// One file of a render, written from the render's single pass. Every method but
 /// [`Sink::finish`] has a default that ignores what it hears.
@@ -77,6 +77,11 @@ pub(crate) trait Sink {
     /// one ([`read_back::HapticChannel`]) over the samples [`Sink::samples`] hears, told before
     /// the first of them; its audio channels keep the samples as they are.
     fn haptic_gain(&mut self, _gain: f64) {}
+    /// Once the samples have all been heard: whether the file clips ([`Clipped`]), for the
+    /// render to warn.
+    fn clipped(&self) -> Option<Clipped> {
+        None
+    }
     /// The most memory (bytes) the sink may keep, as far as it can tell before the render: a
     /// render whose sinks may need more than the machine has is refused before it starts.
     fn memory_bytes(&self) -> u64 {

@@ -46,9 +46,42 @@ impl Sink for WavFile {
         Ok(self.write(block)?)
     }
 
+    fn clipped(&self) -> Option<Clipped> {
+        (self.clipped > 0).then(|| Clipped {
+            path: self.file.path().to_owned(),
+            samples: self.clipped,
+            format: self.format,
+        })
+    }
+
     fn finish(self: Box<Self>, _: &RenderSummary) -> Result<PendingFile, OutputError> {
         Ok(self.complete()?)
     }
+}
+
+/// Full scale of a waveform file's samples: a sample beyond ±1 clips, saturated in an integer
+/// file, and by a player or a converter in a float one.
+const FULL_SCALE: f32 = 1.0;
+
+/// A waveform file some of whose samples pass full scale (issue 49: `--loudness -16
+/// --sample-format s16` clipped 107 samples and said nothing): the render warns, naming it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "{}: {samples} samples pass full scale{}; lower --loudness, or hold the peak with \
+     --true-peak -1",
+    path.display(),
+    match format {
+        SampleFormat::F32 => " (kept in the float file: a player or a converter to integers clips them)",
+        SampleFormat::S24 | SampleFormat::S16 => ", clipped in the file",
+    }
+)]
+pub struct Clipped {
+    /// The file asked for.
+    pub path: PathBuf,
+    /// How many of its samples pass full scale.
+    pub samples: u64,
+    /// Its sample format.
+    pub format: SampleFormat,
 }
 
 /// The sample format of a WAV file.
@@ -140,6 +173,8 @@ pub(crate) struct WavFile {
     header_len: u64,
     /// A block of samples in the file's format, reused from block to block.
     bytes: Vec<u8>,
+    /// Samples written beyond full scale (|y| > 1): an integer format saturates them.
+    clipped: u64,
 }
 
 /// Bytes kept free of the 32-bit RIFF size for the headers: hound's largest header (the
@@ -203,6 +238,7 @@ impl WavFile {
             written: 0,
             header_len: header.len() as u64,
             bytes: Vec::new(),
+            clipped: 0,
         })
     }
 
@@ -212,6 +248,7 @@ impl WavFile {
         let written = self.written + samples.len() as u64;
         Self::check_length(self.file.path(), written, self.sample_rate, self.format)?;
         self.written = written;
+        self.clipped += samples.iter().filter(|y| y.abs() > FULL_SCALE).count() as u64;
         let bytes: &[u8] = match self.format {
             // A little-endian machine holds f32 samples as the file does: no conversion at all.
             SampleFormat::F32 if cfg!(target_endian = "little") => bytemuck::cast_slice(samples),
