@@ -186,6 +186,10 @@ fn third_party(notices: &Path) -> anyhow::Result<()> {
         ),
         ("The Python package, `sake_glug`", "python/Cargo.toml", ""),
     ];
+    // cargo-about reads `cargo metadata`, which needs the sources of every platform's crates in
+    // the lock file (Android's, Windows', macOS'), not only those a Linux build downloaded, and
+    // run offline it cannot fetch them: so they are fetched first (nothing to do once they are).
+    run_checked(Command::new(cargo()).args(["fetch", "--locked"]))?;
     let mut text = format!(
         "# Third-party licences of Sake Glug {VERSION}\n\n\
          Sake Glug itself is under the ISC licence (LICENSE). Each of its products links the \
