@@ -28,8 +28,9 @@
 //! - `cargo xtask wheel`: the Python package (python/) as a wheel in target/wheels/, built by
 //!   maturin from the virtual environment.
 //! - `cargo xtask dist`: the release in target/dist/ (the Debian package, the tarball with its
-//!   install.sh, the wheel, THIRD-PARTY.md), packed from the release builds that `cargo xtask
-//!   test` makes (built first if they are not; see dist.rs).
+//!   install.sh, the wheel, THIRD-PARTY.md; the Windows installer and zip, cross-built with
+//!   MinGW-w64: windows.rs), packed from the release builds that `cargo xtask test` makes (built
+//!   first if they are not; see dist.rs). `cargo xtask dist windows`: only the Windows ones.
 //!
 //! Each product is built with only its features: the bundles with `editor` (which brings
 //! `plugin`), the command line with `cli`, the standalone app with `standalone`, so none compiles
@@ -41,6 +42,7 @@ use std::process::Command;
 mod dist;
 mod paper;
 mod screenshots;
+mod windows;
 
 /// An error is said in one line, without the backtrace anyhow adds under `RUST_BACKTRACE`: it
 /// tells what is wrong with the machine or the code, not where in the xtask it was noticed.
@@ -85,6 +87,7 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             nice_plug_xtask::chdir_workspace_root()?;
             // Clippy and the suites build every feature, the standalone app's among them.
             require_standalone("cargo xtask test")?;
+            windows::require_tools("cargo xtask test")?;
             cargo(&["fmt", "--all", "--check"])?;
             cargo(&[
                 "clippy",
@@ -109,20 +112,34 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             // The C library that the examples of examples/ link (tests/host/test_capi.py).
             build_c_library()?;
             build_wheel()?;
+            // The Windows products, cross-built with MinGW-w64 (tests/host/test_windows.py runs
+            // them under Wine).
+            windows::build()?;
             // The release packed from those builds, for the host tests to install and check.
             dist()?;
             host_tests()?;
             python_tests()
         }
+        // The Windows release alone, beside whatever target/dist holds.
+        Some("dist") if args.get(1).is_some_and(|arg| arg == "windows") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            windows::build()?;
+            for artefact in windows::dist(&windows::Built::here()?, &target_dir().join("dist"))? {
+                println!("dist: {}", artefact.display());
+            }
+            Ok(())
+        }
         Some("dist") => {
             nice_plug_xtask::chdir_workspace_root()?;
             require_standalone("cargo xtask dist")?;
+            windows::require_tools("cargo xtask dist")?;
             // The builds of `cargo xtask test`, with the same features: nothing is built twice.
             build_bundles()?;
             build_cli()?;
             build_standalone()?;
             build_c_library()?;
             build_wheel()?;
+            windows::build()?;
             dist()
         }
         Some("wheel") => {
@@ -279,7 +296,10 @@ fn build_wheel() -> nice_plug_xtask::Result<()> {
 fn dist() -> nice_plug_xtask::Result<()> {
     let started = std::time::Instant::now();
     let built = dist::Built::under(&target_dir())?;
-    for artefact in dist::dist(&built, &target_dir().join("dist"))? {
+    let out = target_dir().join("dist");
+    let mut artefacts = dist::dist(&built, &out)?;
+    artefacts.extend(windows::dist(&windows::Built::here()?, &out)?);
+    for artefact in artefacts {
         println!(
             "dist: {} ({} bytes)",
             artefact.display(),
