@@ -150,7 +150,7 @@ pub fn dist(built: &Built, out: &Path) -> anyhow::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(&work)?;
     let generated = work.join("generated");
     let notices = out.join("THIRD-PARTY.md");
-    third_party(&notices)?;
+    third_party(&notices, LINUX_TARGET, &LINUX_PRODUCTS)?;
     generate(built, &generated)?;
 
     // Where dpkg-shlibdeps expects a package's tree: debian/<package> beside debian/control.
@@ -169,25 +169,30 @@ pub fn dist(built: &Built, out: &Path) -> anyhow::Result<Vec<PathBuf>> {
     Ok(vec![deb, tarball, wheel, notices])
 }
 
+/// A product as cargo builds it, for THIRD-PARTY.md: its title, manifest and features.
+pub type Product = (&'static str, &'static str, &'static str);
+
+/// The Linux products, for the target the Linux release is built for.
+const LINUX_TARGET: &str = "x86_64-unknown-linux-gnu";
+const LINUX_PRODUCTS: [Product; 4] = [
+    ("The command line, `sake-glug`", "Cargo.toml", "ogg,audio"),
+    (
+        "The plugin (CLAP, VST3) and the standalone app, `sake-glug-standalone`",
+        "crates/plugin/Cargo.toml",
+        "editor,standalone",
+    ),
+    (
+        "The C library, `libsake_glug`",
+        "crates/capi/Cargo.toml",
+        "",
+    ),
+    ("The Python package, `sake_glug`", "python/Cargo.toml", ""),
+];
+
 /// THIRD-PARTY.md: every crate (and the fonts, which epaint_default_fonts carries) that each
-/// product links, with its licence's text, written by cargo-about from the lock file; it fails
-/// when a crate's licence is not one that about.toml accepts.
-fn third_party(notices: &Path) -> anyhow::Result<()> {
-    // Each product as cargo builds it: its manifest and the features it is built with.
-    let products = [
-        ("The command line, `sake-glug`", "Cargo.toml", "ogg,audio"),
-        (
-            "The plugin (CLAP, VST3) and the standalone app, `sake-glug-standalone`",
-            "crates/plugin/Cargo.toml",
-            "editor,standalone",
-        ),
-        (
-            "The C library, `libsake_glug`",
-            "crates/capi/Cargo.toml",
-            "",
-        ),
-        ("The Python package, `sake_glug`", "python/Cargo.toml", ""),
-    ];
+/// product links when built for `target`, with its licence's text, written by cargo-about from
+/// the lock file; it fails when a crate's licence is not one that about.toml accepts.
+pub fn third_party(notices: &Path, target: &str, products: &[Product]) -> anyhow::Result<()> {
     // cargo-about reads `cargo metadata`, which needs the sources of every platform's crates in
     // the lock file (Android's, Windows', macOS'), not only those a Linux build downloaded, and
     // run offline it cannot fetch them: so they are fetched first (nothing to do once they are).
@@ -198,7 +203,7 @@ fn third_party(notices: &Path) -> anyhow::Result<()> {
          crates listed in its section, used under the licence named beside each, whose text \
          follows. Written by cargo-about (`cargo xtask dist`) from Cargo.lock.\n"
     );
-    for (product, manifest, features) in products {
+    for &(product, manifest, features) in products {
         // Offline and against the lock file; --fail: a crate whose licence cannot be read fails.
         let mut args = vec![
             "about",
@@ -206,6 +211,8 @@ fn third_party(notices: &Path) -> anyhow::Result<()> {
             "--offline",
             "--locked",
             "--fail",
+            "--target",
+            target,
             "--config",
             "about.toml",
             "--manifest-path",
@@ -642,7 +649,7 @@ fn symlink(target: &str, link: &Path) -> anyhow::Result<()> {
 
 /// Copies the files of the repository's folder `from` (those git tracks, none of a build's
 /// leftovers) under `to`.
-fn copy_tree(from: &Path, to: &Path) -> anyhow::Result<()> {
+pub fn copy_tree(from: &Path, to: &Path) -> anyhow::Result<()> {
     let listed = output_of(Command::new("git").args(["ls-files", "-z", "--"]).arg(from))?;
     for file in listed.split('\0').filter(|name| !name.is_empty()) {
         let file = Path::new(file);
@@ -662,7 +669,7 @@ fn files_of(folder: &Path) -> anyhow::Result<Vec<PathBuf>> {
 }
 
 /// Every file (and symbolic link) under `folder`, at any depth, sorted.
-fn files_under(folder: &Path) -> anyhow::Result<Vec<PathBuf>> {
+pub fn files_under(folder: &Path) -> anyhow::Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     let mut folders = vec![folder.to_path_buf()];
     while let Some(folder) = folders.pop() {
@@ -683,7 +690,7 @@ fn cargo() -> String {
     std::env::var("CARGO").unwrap_or_else(|_| "cargo".into())
 }
 
-fn run_checked(command: &mut Command) -> anyhow::Result<()> {
+pub fn run_checked(command: &mut Command) -> anyhow::Result<()> {
     let status = command
         .status()
         .with_context(|| format!("running {command:?}"))?;

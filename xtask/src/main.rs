@@ -30,6 +30,8 @@
 //! - `cargo xtask dist`: the release in target/dist/ (the Debian package, the tarball with its
 //!   install.sh, the wheel, THIRD-PARTY.md), packed from the release builds that `cargo xtask
 //!   test` makes (built first if they are not; see dist.rs).
+//! - `cargo xtask dist windows`: the Windows installer and zip in target/dist/, cross-built with
+//!   MinGW-w64 (windows.rs); not yet part of `cargo xtask test` (issue 46).
 //!
 //! Each product is built with only its features: the bundles with `editor` (which brings
 //! `plugin`), the command line with `cli`, the standalone app with `standalone`, so none compiles
@@ -41,6 +43,7 @@ use std::process::Command;
 mod dist;
 mod paper;
 mod screenshots;
+mod windows;
 
 /// An error is said in one line, without the backtrace anyhow adds under `RUST_BACKTRACE`: it
 /// tells what is wrong with the machine or the code, not where in the xtask it was noticed.
@@ -113,6 +116,15 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             dist()?;
             host_tests()?;
             python_tests()
+        }
+        // The Windows release alone, beside whatever target/dist holds.
+        Some("dist") if args.get(1).is_some_and(|arg| arg == "windows") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            windows::build()?;
+            for artefact in windows::dist(&windows::Built::here()?, &target_dir().join("dist"))? {
+                println!("dist: {}", artefact.display());
+            }
+            Ok(())
         }
         Some("dist") => {
             nice_plug_xtask::chdir_workspace_root()?;
