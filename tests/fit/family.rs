@@ -595,10 +595,12 @@ fn the_family_is_drawn_as_stated() {
             );
         }
     }
-    assert!(
-        DEVELOPMENT_SEEDS.end <= HELD_OUT_SEEDS.start
-            || HELD_OUT_SEEDS.end <= DEVELOPMENT_SEEDS.start
-    );
+    const {
+        assert!(
+            DEVELOPMENT_SEEDS.end <= HELD_OUT_SEEDS.start
+                || HELD_OUT_SEEDS.end <= DEVELOPMENT_SEEDS.start
+        )
+    };
 }
 
 /// A glide follows its law, f(τ) = f·(1 + (ρ − 1)·e^(−τ/τ_g)), and a fixed low mode stays put

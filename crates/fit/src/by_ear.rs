@@ -168,7 +168,7 @@ struct Knob {
 }
 
 impl Knob {
-    fn to_search(self, value: f64) -> f64 {
+    fn search_at(self, value: f64) -> f64 {
         match self.scale {
             Scale::Log => value.ln(),
             Scale::Share => {
@@ -178,7 +178,7 @@ impl Knob {
         }
     }
 
-    fn from_search(self, x: f64) -> f64 {
+    fn value_at(self, x: f64) -> f64 {
         match self.scale {
             Scale::Log => x.exp(),
             Scale::Share => 1.0 / (1.0 + (-x).exp()),
@@ -260,7 +260,7 @@ impl Search<'_> {
     fn model(&self, x: &[f64]) -> toml::Table {
         let mut table = self.base.clone();
         for ((knob, &(low, high)), &xi) in self.knobs.iter().zip(self.bounds).zip(x) {
-            let value = knob.from_search(xi.clamp(low, high));
+            let value = knob.value_at(xi.clamp(low, high));
             keys::insert(&mut table, knob.key, toml::Value::Float(value));
         }
         table
@@ -357,11 +357,8 @@ pub(crate) fn fit_by_listening(
         let glugs = heard.onsets_s.len();
         let listened = Listened::from_heard(&heard, glugs, 0.0);
         let default_render = render_as_recorded(&default, &made)?;
-        let default_distance_db = log_spectral_distance(
-            &spectrum,
-            &Spectrum::of(&default_render, fs),
-            fs,
-        );
+        let default_distance_db =
+            log_spectral_distance(&spectrum, &Spectrum::of(&default_render, fs), fs);
         targets.push(Target {
             made,
             glugs,
@@ -417,7 +414,7 @@ pub(crate) fn fit_by_listening(
                 high = high.min(to * INTERVAL_SLACK);
             }
             let (low, high) = if low < high { (low, high) } else { (high, low) };
-            (knob.to_search(low), knob.to_search(high))
+            (knob.search_at(low), knob.search_at(high))
         })
         .collect();
     let search = Search {
@@ -482,13 +479,15 @@ pub(crate) fn fit_by_listening(
     }
     let mut set = Vec::new();
     for ((knob, &(low, high)), &xi) in knobs.iter().zip(&bounds).zip(&x) {
-        let value = knob.from_search(xi.clamp(low, high));
-        let bounded = (knob.from_search(low), knob.from_search(high));
+        let value = knob.value_at(xi.clamp(low, high));
+        let bounded = (knob.value_at(low), knob.value_at(high));
         let within_units = estimates
             .iter()
             .find(|e| e.key == knob.key)
             .and_then(|e| e.interval)
-            .is_some_and(|(from, to)| bounded.0 >= from / INTERVAL_SLACK - 1e-9 && bounded.1 <= to * INTERVAL_SLACK + 1e-9);
+            .is_some_and(|(from, to)| {
+                bounded.0 >= from / INTERVAL_SLACK - 1e-9 && bounded.1 <= to * INTERVAL_SLACK + 1e-9
+            });
         let note = if within_units {
             "fitted by listening, within the units' 95 % interval".to_owned()
         } else {
@@ -536,7 +535,7 @@ fn starting_points(
             .zip(bounds)
             .map(|(knob, &(low, high))| {
                 let value = values(knob);
-                let x = knob.to_search(if value.is_finite() {
+                let x = knob.search_at(if value.is_finite() {
                     value
                 } else {
                     units_value(knob.key)
@@ -603,8 +602,13 @@ fn matched_pour_time(table: &toml::Table, mut pour_s: f64, targets: &[Target]) -
             .filter(|t| t.listened.rate_per_s.is_finite())
             .filter_map(|target| {
                 let samples = render_as_recorded(&table, &target.made)?;
-                let heard = hear(&samples, f64::from(target.made.sample_rate), ONE_MODE_SPLIT_HZ);
-                let listened = Listened::from_heard(&heard, 0, 0.0).as_candidate(target.made.duration_s);
+                let heard = hear(
+                    &samples,
+                    f64::from(target.made.sample_rate),
+                    ONE_MODE_SPLIT_HZ,
+                );
+                let listened =
+                    Listened::from_heard(&heard, 0, 0.0).as_candidate(target.made.duration_s);
                 Some(listened.rate_per_s / target.listened.rate_per_s)
             })
             .filter(|r| r.is_finite() && *r > 0.0)

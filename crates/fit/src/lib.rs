@@ -38,8 +38,8 @@ mod write;
 
 pub mod compare;
 
-pub use by_ear::{misses, Listened, ListeningFit};
 pub use audio::{Audio, FIT_BYTES_PER_SAMPLE, MIN_SAMPLE_RATE_HZ};
+pub use by_ear::{misses, Listened, ListeningFit};
 #[cfg(feature = "plot")]
 pub use compare_plot::draw_compare_plot;
 pub use curves::FittedCurves;

@@ -112,7 +112,8 @@ pub fn report_markdown(fit: &SessionFit) -> String {
             );
         }
         if let Some(listening) = &liquid.listening {
-            let _ = writeln!(
+            let _ =
+                writeln!(
                 out,
                 "\nFitted by listening (the units' model did not sound like the recordings): {}; \
                  the summed misses of what a listener hears (rate, pitch, fall, bright share, \
