@@ -902,7 +902,7 @@ fn fit_docs() -> nice_plug_xtask::Result<()> {
             "--all-features",
             "--test",
             "fit",
-            "listening::the_development_table_is_the_fits",
+            "listening::development_clips_sound_nearer_than_the_default_bottle",
         ])
         .env("SAKE_GLUG_WRITE_FIT_TABLES", "1")
         .status()?;

@@ -38,6 +38,8 @@ const MIN_GLUGS_FOR_FALL: usize = 4;
 const MISSING: f64 = 4.0;
 /// The evaluations of one search.
 const MAX_ITERATIONS: u64 = 160;
+/// c is matched to the bright share in this many halvings of its span.
+const BALANCE_STEPS: usize = 7;
 /// The pour time is matched to the heard rate in at most this many steps.
 const RATE_STEPS: usize = 4;
 /// The pour times searched (s).
@@ -134,7 +136,9 @@ pub fn misses(recording: &Listened, candidate: &Listened, default_distance_db: f
     [
         ratio(candidate.rate_per_s, recording.rate_per_s, RATE_TOLERANCE),
         ratio(candidate.pitch_hz, recording.pitch_hz, PITCH_TOLERANCE),
-        ratio(candidate.fall, recording.fall, FALL_TOLERANCE),
+        // A real recording's glug-by-glug pitch is noisy: its fall counts, but never for more
+        // than a miss at its tolerance.
+        ratio(candidate.fall, recording.fall, FALL_TOLERANCE).min(1.0),
         difference(candidate.bright, recording.bright, BRIGHT_TOLERANCE),
         if candidate.distance_db.is_finite() {
             (candidate.distance_db / default_distance_db.max(NEAR_DISTANCE_DB)).powi(2)
@@ -376,6 +380,9 @@ pub(crate) fn fit_by_listening(
         .map(|t| 0.45 * f64::from(t.made.sample_rate))
         .fold(f64::INFINITY, f64::min);
     let explained = recordings.iter().all(|r| r.explained >= LOW_EXPLAINED);
+    let bright_heard = targets
+        .iter()
+        .any(|t| t.listened.bright >= BRIGHT_TOLERANCE);
     let value_of = |key: &str, table: &toml::Table| {
         let (section, name) = keys::split(key);
         let holder = match section {
@@ -401,6 +408,13 @@ pub(crate) fn fit_by_listening(
             let (mut low, mut high) = knob.span;
             if knob.frequency {
                 high = high.min(nyquist);
+            }
+            // The glugs' pitch is heard below the split, so f1 stays there; where a tenth of a
+            // recording's energy or more lies above it, only a mode above it can play that share.
+            if knob.mode == Some(0) {
+                high = high.min(ONE_MODE_SPLIT_HZ);
+            } else if knob.mode == Some(1) && knob.frequency && bright_heard {
+                low = low.max(ONE_MODE_SPLIT_HZ);
             }
             let estimate = estimates.iter().find(|e| e.key == knob.key);
             let mode_heard = knob.mode != Some(1) || two_modes;
@@ -453,6 +467,8 @@ pub(crate) fn fit_by_listening(
         // Each start glugs at the recordings' rate before the search, and its end again after:
         // the rate is the pour time's alone, and a search that set both would wander off where
         // too few glugs are heard to tell.
+        let mut start = start;
+        balance(&search, &mut start, &targets);
         let pour_s = matched_pour_time(&search.model(&start), units_pour_s, &targets);
         let mut start_base = base.clone();
         keys::insert(&mut start_base, pour_key, toml::Value::Float(pour_s));
@@ -460,9 +476,10 @@ pub(crate) fn fit_by_listening(
             base: &start_base,
             ..search
         };
-        let Some((x, _)) = minimise(&here, start) else {
+        let Some((mut x, _)) = minimise(&here, start) else {
             continue;
         };
+        balance(&here, &mut x, &targets);
         let pour_s = matched_pour_time(&here.model(&x), pour_s, &targets);
         let mut end = here.model(&x);
         keys::insert(&mut end, pour_key, toml::Value::Float(pour_s));
@@ -592,9 +609,10 @@ fn strongest_peaks(spectrum: &Spectrum, sample_rate: u32) -> (f64, f64) {
 /// `pour_s`: the pour time scaled by the median ratio of the rate heard in its renders to the
 /// recordings', at most [`RATE_STEPS`] times (the rate is the outflow over the pocket, so it scales
 /// as 1/T but for glugs a listener hears as one).
-fn matched_pour_time(table: &toml::Table, mut pour_s: f64, targets: &[Target]) -> f64 {
+fn matched_pour_time(table: &toml::Table, pour_s: f64, targets: &[Target]) -> f64 {
     let key = Control::PourTime.quantity().scene_key;
-    for _ in 0..RATE_STEPS {
+    // The median ratio of the heard rate to the recordings' at a pour time.
+    let ratio_at = |pour_s: f64| {
         let mut table = table.clone();
         keys::insert(&mut table, key, toml::Value::Float(pour_s));
         let ratios: Vec<f64> = targets
@@ -613,16 +631,77 @@ fn matched_pour_time(table: &toml::Table, mut pour_s: f64, targets: &[Target]) -
             })
             .filter(|r| r.is_finite() && *r > 0.0)
             .collect();
-        if ratios.is_empty() {
+        (!ratios.is_empty()).then(|| median(&ratios))
+    };
+    let (mut best_s, Some(mut best_ratio)) = (pour_s, ratio_at(pour_s)) else {
+        return pour_s;
+    };
+    for _ in 0..RATE_STEPS {
+        if (best_ratio - 1.0).abs() < 0.03 {
             break;
         }
-        let ratio = median(&ratios);
-        pour_s = (pour_s * ratio).clamp(POUR_SPAN_S.0, POUR_SPAN_S.1);
-        if (ratio - 1.0).abs() < 0.03 {
-            break;
+        // The rate goes as 1/T until glugs run together: a step at most halves or doubles T,
+        // and is taken only where it brings the rate nearer.
+        let next_s = (best_s * best_ratio.clamp(0.5, 2.0)).clamp(POUR_SPAN_S.0, POUR_SPAN_S.1);
+        match ratio_at(next_s) {
+            Some(ratio) if ratio.ln().abs() < best_ratio.ln().abs() => {
+                (best_s, best_ratio) = (next_s, ratio);
+            }
+            _ => break,
         }
     }
-    pour_s
+    best_s
+}
+
+/// c set at `x` (a point of `search`) so that its renders' share of the energy above the split
+/// is the recordings' (the median of their differences, by bisection over c in [`BALANCE_STEPS`]
+/// halvings), where one mode lies above the split and the other below: the balance of the two
+/// modes is c's alone there, and a search over everything at once loses it on a steep slope.
+fn balance(search: &Search, x: &mut [f64], targets: &[Target]) {
+    let index = |key: &str| search.knobs.iter().position(|k| k.key == key);
+    let (Some(c), Some(f1), Some(f2)) = (
+        index(Control::Viscosity.quantity().scene_key),
+        index(Constant::F1.quantity().scene_key),
+        index(Constant::F2.quantity().scene_key),
+    ) else {
+        return;
+    };
+    let hz = |i: usize| search.knobs[i].value_at(x[i]);
+    // c is the low mode's share: more c, less above the split where f2 is the bright one.
+    let brighter_with_less_c = match (hz(f1) < ONE_MODE_SPLIT_HZ, hz(f2) < ONE_MODE_SPLIT_HZ) {
+        (true, false) => true,
+        (false, true) => false,
+        _ => return,
+    };
+    let (mut low, mut high) = search.bounds[c];
+    for _ in 0..BALANCE_STEPS {
+        let middle = 0.5 * (low + high);
+        x[c] = middle;
+        let table = search.model(x);
+        let excess: Vec<f64> = targets
+            .iter()
+            .filter(|t| t.listened.bright.is_finite())
+            .filter_map(|target| {
+                let samples = render_as_recorded(&table, &target.made)?;
+                let fs = f64::from(target.made.sample_rate);
+                Some(
+                    super::listen::high_share(&samples, fs, ONE_MODE_SPLIT_HZ)
+                        - target.listened.bright,
+                )
+            })
+            .filter(|e| e.is_finite())
+            .collect();
+        if excess.is_empty() {
+            return;
+        }
+        // Too bright: more of the low mode (more c where f1 is the low one).
+        if (median(&excess) > 0.0) == brighter_with_less_c {
+            low = middle;
+        } else {
+            high = middle;
+        }
+    }
+    x[c] = 0.5 * (low + high);
 }
 
 /// Nelder–Mead from `start`: the best point and its cost.
