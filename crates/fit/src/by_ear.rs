@@ -3,8 +3,8 @@
 //! constants are fitted again by rendering candidates as each recording was made and minimising
 //! how far what a listener hears of them lies from what they hear of the recording: the glug rate,
 //! the median glug pitch, the pitch's fall, the share of the energy above 700 Hz and the
-//! log-spectral distance ([`super::listen`], [`super::compare`]). The unit fits, where they are
-//! good, start the search and bound it to their 95 % intervals.
+//! log-spectral distance ([`super::listen`], [`super::compare`]). Where the units explain at
+//! least half of every recording, their model is kept; elsewhere it is one of the search's starts.
 
 use argmin::core::{CostFunction, Error as ArgminError, Executor};
 use argmin::solver::neldermead::NelderMead;
@@ -32,6 +32,10 @@ pub const BRIGHT_TOLERANCE: f64 = 0.10;
 /// misses in units of the default bottle's distance, but never of less than this (a recording
 /// of the default bottle itself is no reason to fit again).
 pub const NEAR_DISTANCE_DB: f64 = 4.0;
+/// The units' model sounds like a recording if its log-spectral distance is no more than this
+/// many times the default bottle's (or [`NEAR_DISTANCE_DB`]): a recording of a bottle near the
+/// default, under noise, is as far from either, and that is no reason to fit again.
+const NO_FARTHER: f64 = 1.05;
 /// The fewest glugs a recording's pitch fall is listened for over.
 const MIN_GLUGS_FOR_FALL: usize = 4;
 /// What a measure the recording has and a candidate lacks costs: as far as twice its tolerance.
@@ -44,8 +48,6 @@ const BALANCE_STEPS: usize = 7;
 const RATE_STEPS: usize = 4;
 /// The pour times searched (s).
 const POUR_SPAN_S: (f64, f64) = (0.2, 600.0);
-/// A units' interval is widened by this factor on each side before it bounds the search.
-const INTERVAL_SLACK: f64 = 1.1;
 
 /// What a listener hears of one pour, as the listening fit compares it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -346,7 +348,6 @@ pub(crate) fn fit_by_listening(
     estimates: &mut Vec<Estimate>,
     recordings: &[&RecordingFit],
     capacity_ml: f64,
-    two_modes: bool,
 ) -> Option<ListeningFit> {
     let base: toml::Table = toml::from_str(model_toml).ok()?;
     let default: toml::Table = toml::from_str("tilt_deg = 135.0\n").ok()?;
@@ -379,7 +380,12 @@ pub(crate) fn fit_by_listening(
         .iter()
         .map(|t| 0.45 * f64::from(t.made.sample_rate))
         .fold(f64::INFINITY, f64::min);
+    // Where the units explain at least half of every recording, the model is theirs: the
+    // listening fit is for the recordings the paper's units describe poorly.
     let explained = recordings.iter().all(|r| r.explained >= LOW_EXPLAINED);
+    if explained {
+        return None;
+    }
     let bright_heard = targets
         .iter()
         .any(|t| t.listened.bright >= BRIGHT_TOLERANCE);
@@ -416,17 +422,6 @@ pub(crate) fn fit_by_listening(
             } else if knob.mode == Some(1) && knob.frequency && bright_heard {
                 low = low.max(ONE_MODE_SPLIT_HZ);
             }
-            let estimate = estimates.iter().find(|e| e.key == knob.key);
-            let mode_heard = knob.mode != Some(1) || two_modes;
-            // c is the balance of the two modes: the units tell it only where they show both.
-            let shared = knob.key == Control::Viscosity.quantity().scene_key;
-            if let Some((from, to)) = estimate
-                .filter(|e| e.in_model && explained && mode_heard && (!shared || two_modes))
-                .and_then(|e| e.interval)
-            {
-                low = low.max(from / INTERVAL_SLACK);
-                high = high.min(to * INTERVAL_SLACK);
-            }
             let (low, high) = if low < high { (low, high) } else { (high, low) };
             (knob.search_at(low), knob.search_at(high))
         })
@@ -448,10 +443,13 @@ pub(crate) fn fit_by_listening(
                 target.glugs,
                 &target.spectrum,
             );
+            // The four a listener is asked about (the fall is the headspace law's, which the
+            // units give and the search leaves alone).
+            let [rate, pitch, _, bright, distance] =
+                misses(&target.listened, &listened, target.default_distance_db);
             Some(
-                misses(&target.listened, &listened, target.default_distance_db)
-                    .iter()
-                    .all(|&m| m < 1.0),
+                [rate, pitch, bright].iter().all(|&m| m < 1.0)
+                    && distance < NO_FARTHER * NO_FARTHER,
             )
         })
         .all(|pass| pass == Some(true));
@@ -497,19 +495,8 @@ pub(crate) fn fit_by_listening(
     let mut set = Vec::new();
     for ((knob, &(low, high)), &xi) in knobs.iter().zip(&bounds).zip(&x) {
         let value = knob.value_at(xi.clamp(low, high));
-        let bounded = (knob.value_at(low), knob.value_at(high));
-        let within_units = estimates
-            .iter()
-            .find(|e| e.key == knob.key)
-            .and_then(|e| e.interval)
-            .is_some_and(|(from, to)| {
-                bounded.0 >= from / INTERVAL_SLACK - 1e-9 && bounded.1 <= to * INTERVAL_SLACK + 1e-9
-            });
-        let note = if within_units {
-            "fitted by listening, within the units' 95 % interval".to_owned()
-        } else {
-            "fitted by listening: the units' model did not sound like the recordings".to_owned()
-        };
+        let note =
+            "fitted by listening: the units' model did not sound like the recordings".to_owned();
         match estimates.iter_mut().find(|e| e.key == knob.key) {
             Some(estimate) => estimate.by_listening(value, note),
             None => {

@@ -365,13 +365,7 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
     let mut kept_default = kept_default;
     let mut model = model_toml(liquid, &estimates, inputs.curves, &kept_default, &cautions);
     let listening = if !units.is_empty() {
-        fit_by_listening(
-            &model,
-            &mut estimates,
-            recordings,
-            capacity_ml,
-            matches!(inputs.modes, Modes::Split(_)),
-        )
+        fit_by_listening(&model, &mut estimates, recordings, capacity_ml)
     } else {
         None
     };
