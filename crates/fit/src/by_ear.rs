@@ -349,6 +349,11 @@ pub(crate) fn fit_by_listening(
     recordings: &[&RecordingFit],
     capacity_ml: f64,
 ) -> Option<ListeningFit> {
+    // Where the units explain at least half of every recording, the model is theirs: the
+    // listening fit is for the recordings the paper's units describe poorly.
+    if recordings.iter().all(|r| r.explained >= LOW_EXPLAINED) {
+        return None;
+    }
     let base: toml::Table = toml::from_str(model_toml).ok()?;
     let default: toml::Table = toml::from_str("tilt_deg = 135.0\n").ok()?;
     let mut targets = Vec::new();
@@ -380,12 +385,6 @@ pub(crate) fn fit_by_listening(
         .iter()
         .map(|t| 0.45 * f64::from(t.made.sample_rate))
         .fold(f64::INFINITY, f64::min);
-    // Where the units explain at least half of every recording, the model is theirs: the
-    // listening fit is for the recordings the paper's units describe poorly.
-    let explained = recordings.iter().all(|r| r.explained >= LOW_EXPLAINED);
-    if explained {
-        return None;
-    }
     let bright_heard = targets
         .iter()
         .any(|t| t.listened.bright >= BRIGHT_TOLERANCE);
@@ -398,16 +397,8 @@ pub(crate) fn fit_by_listening(
         let value = holder.get(name)?;
         value.as_float().or(value.as_integer().map(|i| i as f64))
     };
-    let default_of = |key: &str| {
-        Constant::ALL
-            .iter()
-            .map(|c| c.quantity())
-            .chain(Control::ALL.iter().map(|c| c.quantity()))
-            .find(|q| q.scene_key == key)
-            .map_or(f64::NAN, |q| q.range.default)
-    };
     let units_value = |key: &str| value_of(key, &base).unwrap_or_else(|| default_of(key));
-    // Each constant's bounds: its units' interval where they are good, else its widest span.
+    // Each constant's bounds (in the search space): its widest span, narrowed below.
     let bounds: Vec<(f64, f64)> = knobs
         .iter()
         .map(|knob| {
@@ -525,6 +516,16 @@ pub(crate) fn fit_by_listening(
     })
 }
 
+/// The default of the constant or control whose scene key is `key` (NaN for none).
+fn default_of(key: &str) -> f64 {
+    Constant::ALL
+        .iter()
+        .map(|c| c.quantity())
+        .chain(Control::ALL.iter().map(|c| c.quantity()))
+        .find(|q| q.scene_key == key)
+        .map_or(f64::NAN, |q| q.range.default)
+}
+
 /// Where the searches start (in the search space): the units' model, the default bottle, and the
 /// recordings' own spectral peaks and rate.
 fn starting_points(
@@ -553,14 +554,7 @@ fn starting_points(
             .collect()
     };
     let units = at(&|knob| units_value(knob.key));
-    let defaults = at(&|knob| {
-        Constant::ALL
-            .iter()
-            .map(|c| c.quantity())
-            .chain(Control::ALL.iter().map(|c| c.quantity()))
-            .find(|q| q.scene_key == knob.key)
-            .map_or(f64::NAN, |q| q.range.default)
-    });
+    let defaults = at(&|knob| default_of(knob.key));
     // The recordings' own: the strongest peak below the split and above it, and the share of the
     // energy below it as c.
     let first = &targets[0];
