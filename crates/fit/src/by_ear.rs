@@ -40,7 +40,7 @@ const NO_FARTHER: f64 = 1.05;
 const MIN_GLUGS_FOR_FALL: usize = 4;
 /// What a measure the recording has and a candidate lacks costs: as far as twice its tolerance.
 const MISSING: f64 = 4.0;
-/// The evaluations of one search.
+/// Nelder–Mead iterations in one search (each renders one to a few candidates).
 const MAX_ITERATIONS: u64 = 160;
 /// c is matched to the bright share in this many halvings of its span.
 const BALANCE_STEPS: usize = 7;
