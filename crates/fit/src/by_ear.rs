@@ -11,10 +11,10 @@ use argmin::solver::neldermead::NelderMead;
 
 use sake_glug_engine::{Constant, Control};
 use sake_glug_io::keys;
-use sake_glug_render::{render_scene_to_vec, Scene};
 
-use super::compare::{log_spectral_distance, AsRecorded, ONE_MODE_SPLIT_HZ};
+use super::compare::{log_spectral_distance, render_table, AsRecorded, ONE_MODE_SPLIT_HZ};
 use super::estimate::Estimate;
+use super::liquid::range_of;
 use super::listen::{hear, Heard};
 use super::recording::{RecordingFit, LOW_EXPLAINED};
 use super::spectrum::Spectrum;
@@ -315,20 +315,7 @@ impl CostFunction for Search<'_> {
 
 /// `table` (a model file) rendered as a recording was made; None if the renderer refuses it.
 fn render_as_recorded(table: &toml::Table, made: &AsRecorded) -> Option<Vec<f32>> {
-    let mut table = table.clone();
-    let mut set = |key: &str, value: toml::Value| keys::insert(&mut table, key, value);
-    set("sample_rate", toml::Value::Integer(made.sample_rate.into()));
-    set("duration_s", toml::Value::Float(made.duration_s));
-    set(
-        Control::Tilt.quantity().scene_key,
-        toml::Value::Float(made.tilt_deg),
-    );
-    set(
-        Control::Fill.quantity().scene_key,
-        toml::Value::Float(100.0 * made.fill),
-    );
-    let scene = Scene::parse(&toml::to_string(&table).ok()?).ok()?;
-    render_scene_to_vec(&scene).ok().map(|(samples, _)| samples)
+    render_table(table.clone(), made).ok()
 }
 
 /// What the listening fit did for one liquid.
@@ -518,12 +505,7 @@ pub(crate) fn fit_by_listening(
 
 /// The default of the constant or control whose scene key is `key` (NaN for none).
 fn default_of(key: &str) -> f64 {
-    Constant::ALL
-        .iter()
-        .map(|c| c.quantity())
-        .chain(Control::ALL.iter().map(|c| c.quantity()))
-        .find(|q| q.scene_key == key)
-        .map_or(f64::NAN, |q| q.range.default)
+    range_of(key).map_or(f64::NAN, |range| range.default)
 }
 
 /// Where the searches start (in the search space): the units' model, the default bottle, and the

@@ -187,8 +187,14 @@ impl AsRecorded {
 /// The samples of the model file `model_toml` (a scene) rendered as the recording was made
 /// ([`AsRecorded`]); the renderer's message if it refuses.
 pub fn render_model(model_toml: &str, made: &AsRecorded) -> Result<Vec<f32>, String> {
-    let mut table: toml::Table =
+    let table: toml::Table =
         toml::from_str(model_toml).map_err(|error| keys::syntax_message(&error, model_toml))?;
+    render_table(table, made)
+}
+
+/// The model file `table` (parsed) rendered as the recording was made: its rate, length, tilt and
+/// fill set to the recording's.
+pub(crate) fn render_table(mut table: toml::Table, made: &AsRecorded) -> Result<Vec<f32>, String> {
     let mut set = |key: &str, value: toml::Value| keys::insert(&mut table, key, value);
     set("sample_rate", toml::Value::Integer(made.sample_rate.into()));
     set("duration_s", toml::Value::Float(made.duration_s));

@@ -590,7 +590,7 @@ fn kept_at_default(estimates: &[Estimate], curves: &FittedCurves) -> Vec<(String
 }
 
 /// The range of the constant or control whose scene key is `key`.
-fn range_of(key: &str) -> Option<Range> {
+pub(crate) fn range_of(key: &str) -> Option<Range> {
     Constant::ALL
         .iter()
         .map(|c| c.quantity())
