@@ -342,32 +342,95 @@ pub(crate) fn fit_by_listening(
         return None;
     }
     let base: toml::Table = toml::from_str(model_toml).ok()?;
-    let default: toml::Table = toml::from_str("tilt_deg = 135.0\n").ok()?;
-    let mut targets = Vec::new();
-    for recording in recordings {
-        let made = AsRecorded::of(recording, capacity_ml);
-        let fs = f64::from(made.sample_rate);
-        let length = ((made.duration_s * fs) as usize).min(recording.excerpt.len());
-        let samples = &recording.excerpt[..length];
-        let spectrum = Spectrum::of(samples, fs);
-        let heard = hear(samples, fs, ONE_MODE_SPLIT_HZ);
-        let glugs = heard.onsets_s.len();
-        let listened = Listened::from_heard(&heard, glugs, 0.0);
-        let default_render = render_as_recorded(&default, &made)?;
-        let default_distance_db =
-            log_spectral_distance(&spectrum, &Spectrum::of(&default_render, fs), fs);
-        targets.push(Target {
-            made,
-            glugs,
-            spectrum,
-            listened,
-            default_distance_db,
-        });
-    }
+    let targets = targets_of(recordings, capacity_ml)?;
     if targets.iter().all(|t| t.glugs < 2) {
         return None;
     }
     let knobs = knobs();
+    let units_value = |key: &str| value_in(&base, key).unwrap_or_else(|| default_of(key));
+    let bounds = search_bounds(&knobs, &targets);
+    let search = Search {
+        base: &base,
+        knobs: &knobs,
+        bounds: &bounds,
+        targets: &targets,
+    };
+    let units_cost = search.cost_of(&base)?;
+    if sounds_like_every_recording(&base, &targets) {
+        return None;
+    }
+    let starts = starting_points(&knobs, &bounds, &targets, &units_value);
+    let pour_key = Control::PourTime.quantity().scene_key;
+    let units_pour_s = units_value(pour_key);
+    let (pour_s, x, cost) = best_of_searches(&search, starts, units_pour_s)?;
+    if cost >= units_cost {
+        return None;
+    }
+    let mut set = Vec::new();
+    for ((knob, &(low, high)), &xi) in knobs.iter().zip(&bounds).zip(&x) {
+        let note = "fitted by listening: the units' model did not sound like the recordings";
+        set_by_listening(
+            estimates,
+            knob.key,
+            knob.value_at(xi.clamp(low, high)),
+            note,
+        );
+        set.push(knob.key.to_owned());
+    }
+    if (pour_s / units_pour_s - 1.0).abs() > 0.01 {
+        let note = "fitted by listening: the pour time that glugs at the recordings' heard rate";
+        set_by_listening(estimates, pour_key, pour_s, note);
+        set.push(pour_key.to_owned());
+    }
+    Some(ListeningFit {
+        cost: [units_cost, cost],
+        set,
+    })
+}
+
+/// What a listener hears in each recording, and how far the default bottle, rendered as it was
+/// made, lies from it.
+fn targets_of(recordings: &[&RecordingFit], capacity_ml: f64) -> Option<Vec<Target>> {
+    let default: toml::Table = toml::from_str("tilt_deg = 135.0\n").ok()?;
+    recordings
+        .iter()
+        .map(|recording| {
+            let made = AsRecorded::of(recording, capacity_ml);
+            let fs = f64::from(made.sample_rate);
+            let length = ((made.duration_s * fs) as usize).min(recording.excerpt.len());
+            let samples = &recording.excerpt[..length];
+            let spectrum = Spectrum::of(samples, fs);
+            let heard = hear(samples, fs, ONE_MODE_SPLIT_HZ);
+            let glugs = heard.onsets_s.len();
+            let listened = Listened::from_heard(&heard, glugs, 0.0);
+            let default_render = render_as_recorded(&default, &made)?;
+            let default_distance_db =
+                log_spectral_distance(&spectrum, &Spectrum::of(&default_render, fs), fs);
+            Some(Target {
+                made,
+                glugs,
+                spectrum,
+                listened,
+                default_distance_db,
+            })
+        })
+        .collect()
+}
+
+/// The value of scene key `key` in `table`, if it is set there.
+fn value_in(table: &toml::Table, key: &str) -> Option<f64> {
+    let (section, name) = keys::split(key);
+    let holder = match section {
+        Some(section) => table.get(section)?.as_table()?,
+        None => table,
+    };
+    let value = holder.get(name)?;
+    value.as_float().or(value.as_integer().map(|i| i as f64))
+}
+
+/// Each constant's bounds (in the search space): its widest span, narrowed to what the
+/// recordings can hold.
+fn search_bounds(knobs: &[Knob], targets: &[Target]) -> Vec<(f64, f64)> {
     let nyquist = targets
         .iter()
         .map(|t| 0.45 * f64::from(t.made.sample_rate))
@@ -375,18 +438,7 @@ pub(crate) fn fit_by_listening(
     let bright_heard = targets
         .iter()
         .any(|t| t.listened.bright >= BRIGHT_TOLERANCE);
-    let value_of = |key: &str, table: &toml::Table| {
-        let (section, name) = keys::split(key);
-        let holder = match section {
-            Some(section) => table.get(section)?.as_table()?,
-            None => table,
-        };
-        let value = holder.get(name)?;
-        value.as_float().or(value.as_integer().map(|i| i as f64))
-    };
-    let units_value = |key: &str| value_of(key, &base).unwrap_or_else(|| default_of(key));
-    // Each constant's bounds (in the search space): its widest span, narrowed below.
-    let bounds: Vec<(f64, f64)> = knobs
+    knobs
         .iter()
         .map(|knob| {
             let (mut low, mut high) = knob.span;
@@ -403,60 +455,54 @@ pub(crate) fn fit_by_listening(
             let (low, high) = if low < high { (low, high) } else { (high, low) };
             (knob.search_at(low), knob.search_at(high))
         })
-        .collect();
-    let search = Search {
-        base: &base,
-        knobs: &knobs,
-        bounds: &bounds,
-        targets: &targets,
-    };
-    let units_cost = search.cost_of(&base)?;
-    let units_pass = targets
-        .iter()
-        .map(|target| {
-            let samples = render_as_recorded(&base, &target.made)?;
-            let listened = Listened::of(
-                &samples,
-                f64::from(target.made.sample_rate),
-                target.glugs,
-                &target.spectrum,
-            );
-            // The four a listener is asked about (the fall is the headspace law's, which the
-            // units give and the search leaves alone).
-            let [rate, pitch, _, bright, distance] =
-                misses(&target.listened, &listened, target.default_distance_db);
-            Some(
-                [rate, pitch, bright].iter().all(|&m| m < 1.0)
-                    && distance < NO_FARTHER * NO_FARTHER,
-            )
-        })
-        .all(|pass| pass == Some(true));
-    if units_pass {
-        return None;
-    }
-    let starts = starting_points(&knobs, &bounds, &targets, &units_value);
+        .collect()
+}
+
+/// Whether `model`, rendered as each recording was made, passes on the four measures a listener
+/// is asked about (the fall is the headspace law's, which the units give and the search leaves
+/// alone).
+fn sounds_like_every_recording(model: &toml::Table, targets: &[Target]) -> bool {
+    targets.iter().all(|target| {
+        let Some(samples) = render_as_recorded(model, &target.made) else {
+            return false;
+        };
+        let listened = Listened::of(
+            &samples,
+            f64::from(target.made.sample_rate),
+            target.glugs,
+            &target.spectrum,
+        );
+        let [rate, pitch, _, bright, distance] =
+            misses(&target.listened, &listened, target.default_distance_db);
+        [rate, pitch, bright].iter().all(|&m| m < 1.0) && distance < NO_FARTHER * NO_FARTHER
+    })
+}
+
+/// The best of the searches from `starts`: (its pour time, its point, its cost).
+fn best_of_searches(
+    search: &Search,
+    starts: Vec<Vec<f64>>,
+    units_pour_s: f64,
+) -> Option<(f64, Vec<f64>, f64)> {
     let pour_key = Control::PourTime.quantity().scene_key;
-    let units_pour_s = units_value(pour_key);
-    // (its pour time, its point, its cost)
     let mut best: Option<(f64, Vec<f64>, f64)> = None;
-    for start in starts {
+    for mut start in starts {
         // Each start glugs at the recordings' rate before the search, and its end again after:
         // the rate is the pour time's alone, and a search that set both would wander off where
         // too few glugs are heard to tell.
-        let mut start = start;
-        balance(&search, &mut start, &targets);
-        let pour_s = matched_pour_time(&search.model(&start), units_pour_s, &targets);
-        let mut start_base = base.clone();
+        balance(search, &mut start, search.targets);
+        let pour_s = matched_pour_time(&search.model(&start), units_pour_s, search.targets);
+        let mut start_base = search.base.clone();
         keys::insert(&mut start_base, pour_key, toml::Value::Float(pour_s));
         let here = Search {
             base: &start_base,
-            ..search
+            ..*search
         };
         let Some((mut x, _)) = minimise(&here, start) else {
             continue;
         };
-        balance(&here, &mut x, &targets);
-        let pour_s = matched_pour_time(&here.model(&x), pour_s, &targets);
+        balance(&here, &mut x, search.targets);
+        let pour_s = matched_pour_time(&here.model(&x), pour_s, search.targets);
         let mut end = here.model(&x);
         keys::insert(&mut end, pour_key, toml::Value::Float(pour_s));
         let Some(cost) = search.cost_of(&end) else {
@@ -466,41 +512,19 @@ pub(crate) fn fit_by_listening(
             best = Some((pour_s, x, cost));
         }
     }
-    let (pour_s, x, cost) = best?;
-    if cost >= units_cost {
-        return None;
-    }
-    let mut set = Vec::new();
-    for ((knob, &(low, high)), &xi) in knobs.iter().zip(&bounds).zip(&x) {
-        let value = knob.value_at(xi.clamp(low, high));
-        let note =
-            "fitted by listening: the units' model did not sound like the recordings".to_owned();
-        match estimates.iter_mut().find(|e| e.key == knob.key) {
-            Some(estimate) => estimate.by_listening(value, note),
-            None => {
-                let mut estimate = Estimate::measured(knob.key, value, None, true);
-                estimate.by_listening(value, note);
-                estimates.push(estimate);
-            }
+    best
+}
+
+/// Marks the estimate of `key` as fitted by listening, at `value` (added if the units gave none).
+fn set_by_listening(estimates: &mut Vec<Estimate>, key: &'static str, value: f64, note: &str) {
+    match estimates.iter_mut().find(|e| e.key == key) {
+        Some(estimate) => estimate.by_listening(value, note.to_owned()),
+        None => {
+            let mut estimate = Estimate::measured(key, value, None, true);
+            estimate.by_listening(value, note.to_owned());
+            estimates.push(estimate);
         }
-        set.push(knob.key.to_owned());
     }
-    if (pour_s / units_pour_s - 1.0).abs() > 0.01 {
-        let note = "fitted by listening: the pour time that glugs at the recordings' heard rate";
-        match estimates.iter_mut().find(|e| e.key == pour_key) {
-            Some(estimate) => estimate.by_listening(pour_s, note.to_owned()),
-            None => {
-                let mut estimate = Estimate::measured(pour_key, pour_s, None, true);
-                estimate.by_listening(pour_s, note.to_owned());
-                estimates.push(estimate);
-            }
-        }
-        set.push(pour_key.to_owned());
-    }
-    Some(ListeningFit {
-        cost: [units_cost, cost],
-        set,
-    })
 }
 
 /// The default of the constant or control whose scene key is `key` (NaN for none).
