@@ -2,8 +2,12 @@
 //! and 256 frames (a game engine's or a haptics API's small buffers) against 4096, over the same
 //! second of pouring (the bottle refilled at each second's start, so units start and ring
 //! throughout). Goals (issue 40): 16-frame calls cost at most 1.5× per sample, 64-frame calls
-//! 1.1×. Nothing is asserted here: the group ends with the ratios of the medians measured in the
-//! same run. Times are the thread's CPU time, as the build machine is shared.
+//! 1.1×. Then many bottles at once (issue 47): a thousand handles processed in turn, each on its
+//! own pour and refill schedule, in calls of 64 and 256 frames, and how many bottles one core
+//! plays in real time. Nothing is asserted here: each group ends with figures from the medians
+//! measured in the same run, and the whole report is written to `<target>/bench-capi.md`, which
+//! `cargo xtask docs scaling` copies into docs/scaling.md. Times are the thread's CPU time, as
+//! the build machine is shared.
 
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -11,6 +15,8 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use sake_glug::*;
+
+mod report;
 
 const FS: u32 = 48_000;
 
@@ -50,7 +56,7 @@ fn median(times: &Times, block: usize) -> Option<f64> {
     Some(seconds[seconds.len() / 2])
 }
 
-fn small_blocks(c: &mut Criterion) {
+fn small_blocks(c: &mut Criterion, report: &mut Vec<String>) {
     let times = Times::default();
     let mut out = vec![0.0f32; 4096];
     let mut group = c.benchmark_group("capi: one second of pouring");
@@ -96,11 +102,123 @@ fn small_blocks(c: &mut Criterion) {
             ))
         })
         .collect();
-    println!(
+    report.push(format!(
         "capi, per sample against calls of {LARGE} frames: {} (goals: 16 ≤ 1.5×, 64 ≤ 1.1×)",
         ratios.join(", ")
-    );
+    ));
 }
 
-criterion_group!(benches, small_blocks);
-criterion_main!(benches);
+/// How many bottles play at once in the many-bottles group.
+const BOTTLES: usize = 1000;
+/// The call sizes of the many-bottles group.
+const BOTTLE_BLOCKS: [usize; 2] = [64, 256];
+/// The seconds of sound each bottle makes in one batch.
+const BOTTLE_BATCH_S: f64 = 1.0;
+
+/// One bottle of a crate: its handle, and its own schedule (a tilt, and a refill every so many
+/// samples, so that the bottles neither start nor refill together).
+struct Bottle {
+    glug: *mut SakeGlug,
+    refill_every: u64,
+    played: u64,
+}
+
+impl Bottle {
+    fn new(index: usize) -> Self {
+        let glug = unsafe { sake_glug_create(FS as f64, std::ptr::null(), index as u64 + 1) };
+        assert!(!glug.is_null(), "the default model opens");
+        // Tilts from 110° to 150°, refills every 0.6 to 1.55 s, each from its own offset.
+        let tilt = 110.0 + (index % 9) as f64 * 5.0;
+        let refill_every = FS as u64 * (60 + (index as u64 % 20) * 5) / 100;
+        unsafe {
+            sake_glug_ramp(glug, SakeGlugControl::Tilt as i32, tilt, FS as u64 / 5);
+        }
+        Self {
+            glug,
+            refill_every,
+            played: (index as u64 * 7919) % refill_every,
+        }
+    }
+
+    fn process(&mut self, out: &mut [f32]) {
+        if self.played >= self.refill_every {
+            self.played -= self.refill_every;
+            unsafe { sake_glug_refill(self.glug) };
+        }
+        unsafe { sake_glug_process(self.glug, out.as_mut_ptr(), out.len()) };
+        self.played += out.len() as u64;
+    }
+}
+
+impl Drop for Bottle {
+    fn drop(&mut self) {
+        unsafe { sake_glug_destroy(self.glug) };
+    }
+}
+
+fn many_bottles(c: &mut Criterion, report: &mut Vec<String>) {
+    let mut group = c.benchmark_group(format!("capi: {BOTTLES} bottles in turn"));
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(10));
+    let mut figures = Vec::new();
+    for block in BOTTLE_BLOCKS {
+        let mut bottles: Vec<Bottle> = (0..BOTTLES).map(Bottle::new).collect();
+        let mut out = vec![0.0f32; block];
+        let rounds = (BOTTLE_BATCH_S * FS as f64) as usize / block;
+        let sound_s = (rounds * block) as f64 / FS as f64;
+        // Every bottle glugs before the clock starts: the figure is of a crate in full flow.
+        for _ in 0..rounds {
+            bottles
+                .iter_mut()
+                .for_each(|bottle| bottle.process(&mut out));
+        }
+        let seconds = RefCell::new(Vec::new());
+        group.throughput(Throughput::Elements((BOTTLES * rounds * block) as u64));
+        group.bench_function(format!("calls of {block} frames"), |b| {
+            b.iter_custom(|iters| {
+                let start = thread_cpu_time();
+                for _ in 0..iters {
+                    for _ in 0..rounds {
+                        bottles
+                            .iter_mut()
+                            .for_each(|bottle| bottle.process(&mut out));
+                    }
+                }
+                let elapsed = thread_cpu_time() - start;
+                seconds
+                    .borrow_mut()
+                    .push(elapsed.as_secs_f64() / iters.max(1) as f64);
+                elapsed
+            })
+        });
+        let mut seconds = seconds.into_inner();
+        seconds.sort_by(f64::total_cmp);
+        if let Some(&median) = seconds.get(seconds.len() / 2) {
+            let per_sample_ns = median / (BOTTLES as f64 * sound_s * FS as f64) * 1e9;
+            figures.push(format!(
+                "calls of {block} frames: {:.0} bottles in real time ({per_sample_ns:.2} ns a \
+                 sample a bottle)",
+                BOTTLES as f64 * sound_s / median
+            ));
+        }
+    }
+    group.finish();
+    report.push(format!(
+        "capi, {BOTTLES} bottles at {} kHz processed in turn on one core, each on its own pour \
+         and refill schedule: {}",
+        FS / 1000,
+        figures.join("; ")
+    ));
+}
+
+fn benches(c: &mut Criterion) {
+    let mut report = Vec::new();
+    small_blocks(c, &mut report);
+    many_bottles(c, &mut report);
+    let lines: String = report.iter().map(|line| format!("{line}\n")).collect();
+    print!("{lines}");
+    report::save("capi", &lines);
+}
+
+criterion_group!(capi, benches);
+criterion_main!(capi);

@@ -21,6 +21,7 @@ use sake_glug_render::{render_scene, RenderError, RenderObserver, Scene};
 
 #[path = "render/fit.rs"]
 mod fit;
+mod report;
 
 /// One hour of repeated pours at 48 kHz: every 10 s tilt up and pour 6 s, put the bottle
 /// upright, and refill it. A change of the fill level refills in simulate mode, so the level
@@ -117,7 +118,7 @@ fn bench(c: &mut Criterion) {
         println!("{line}");
         writeln!(report, "{line}").expect("a String takes any text");
     }
-    save_report(&report);
+    report::save("render", &report);
 }
 
 /// The line the project quotes for one scene: × real time of the render, of filling the buffer
@@ -244,42 +245,6 @@ fn python_with(module: &str) -> Option<PathBuf> {
             .output()
             .is_ok_and(|out| out.status.success())
     })
-}
-
-/// Writes the report with the commit it measured to `<target>/bench-render.md` (the target
-/// directory is found from this executable's path, `<target>/release/deps/render-…`).
-fn save_report(lines: &str) {
-    let Some(target) = std::env::current_exe()
-        .ok()
-        .and_then(|exe| Some(exe.parent()?.parent()?.parent()?.to_owned()))
-    else {
-        return;
-    };
-    let commit = Command::new("git")
-        .args(["describe", "--always", "--dirty"])
-        .output()
-        .ok()
-        .filter(|out| out.status.success())
-        .map_or("unknown".into(), |out| {
-            String::from_utf8_lossy(&out.stdout).trim().to_owned()
-        });
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|info| {
-            info.lines()
-                .find(|line| line.starts_with("model name"))
-                .and_then(|line| line.split(':').nth(1))
-                .map(|name| name.trim().to_owned())
-        })
-        .unwrap_or_else(|| "unknown CPU".into());
-    let text = format!(
-        "`cargo bench --bench render` at commit {commit}, one core of {cpu}:\n\n```\n{lines}```\n"
-    );
-    let path = target.join("bench-render.md");
-    match std::fs::write(&path, text) {
-        Ok(()) => println!("written to {}", path.display()),
-        Err(error) => println!("cannot write {}: {error}", path.display()),
-    }
 }
 
 criterion_group!(benches, bench);

@@ -523,7 +523,7 @@ fn vst3_ramp_figures() -> nice_plug_xtask::Result<()> {
 const CALLGRIND_RENDERS_S: [u32; 2] = [1, 61];
 
 /// docs/scaling.md's cost figures: instructions per output sample from callgrind (when valgrind
-/// is installed), and the render benchmark's report (run first with `bench`).
+/// is installed), and the reports of the benchmarks that write one (each run first with `bench`).
 fn scaling_docs(bench: bool) -> nice_plug_xtask::Result<()> {
     if Command::new("valgrind").arg("--version").output().is_ok() {
         let figure = instructions_per_sample()?;
@@ -531,22 +531,26 @@ fn scaling_docs(bench: bool) -> nice_plug_xtask::Result<()> {
     } else {
         println!("valgrind is not installed: docs/scaling.md keeps its callgrind figure");
     }
-    if bench {
-        cargo(&["bench", "--bench", "render"])?;
-    }
-    let report = target_dir().join("bench-render.md");
-    match std::fs::read_to_string(&report) {
-        Ok(text) => replace_block("docs/scaling.md", "bench-render", &text),
-        Err(_) => {
-            println!(
-                "no {} (`cargo bench --bench render` writes it): docs/scaling.md keeps its \
-                 bench figures",
+    for name in REPORTING_BENCHES {
+        if bench {
+            cargo(&["bench", "--bench", name])?;
+        }
+        let report = target_dir().join(format!("bench-{name}.md"));
+        match std::fs::read_to_string(&report) {
+            Ok(text) => replace_block("docs/scaling.md", &format!("bench-{name}"), &text)?,
+            Err(_) => println!(
+                "no {} (`cargo bench --bench {name}` writes it): docs/scaling.md keeps its \
+                 figures",
                 report.display()
-            );
-            Ok(())
+            ),
         }
     }
+    Ok(())
 }
+
+/// The benchmarks whose report (benches/report.rs) docs/scaling.md holds, each in a block of
+/// its own.
+const REPORTING_BENCHES: [&str; 2] = ["render", "capi"];
 
 /// Instructions per output sample of `sake-glug render` on a minute of continuous pouring
 /// (follow mode, held full at 135°, writing an f32 WAV): callgrind's count for a 61 s render

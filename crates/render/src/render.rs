@@ -313,7 +313,7 @@ fn endless(scene: &Scene, engine: &Engine) -> bool {
 /// integer maximum, which vectorises (a float `max` does not, for its NaN rules); compiled for
 /// AVX2 too, picked at run time.
 #[multiversion::multiversion(targets("x86_64+avx2+avx"))]
-fn block_peak(block: &[f32]) -> f32 {
+pub(crate) fn block_peak(block: &[f32]) -> f32 {
     let magnitude = |y: &f32| (y.to_bits() & !(1 << 31)) as i32;
     f32::from_bits(block.iter().map(magnitude).max().unwrap_or(0) as u32)
 }
