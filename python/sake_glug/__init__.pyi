@@ -129,9 +129,17 @@ def render_tables(
     refuse them with the figure if they cannot fit in memory, then into the tables. Ctrl-C
     stops it. Raises SakeGlugError for what it refuses."""
 
-def fit(session: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
-    """Fits a model to the recordings of a session file (`sake-glug fit`, MODEL.md §13) and
-    returns what `sake-glug fit --json` prints: {"units": {"detected", "used"}, "explained":
+def fit(
+    inputs: Union[str, "os.PathLike[str]", List[Union[str, "os.PathLike[str]"]]],
+    *,
+    capacity_ml: Optional[float] = None,
+    tilt_deg: Optional[float] = None,
+) -> Dict[str, Any]:
+    """Fits a model (`sake-glug fit`, MODEL.md §13) to a session file (`.toml`), or to WAV clips
+    of one bottle as the command line takes them: `fit("glugs.wav")` or a list of clips, a
+    bottle of capacity_ml (default the model's) held at tilt_deg (default 135), full at each
+    clip's first sample (`--capacity-ml`, `--tilt-deg`; a session file gives its own). Returns
+    what `sake-glug fit --json` prints: {"units": {"detected", "used"}, "explained":
     {recording: share}, "estimates": {key: {"value", "low", "high", "n", "in_model", "note"}},
     "liquids": {name: {"estimates", "units", "detected", "kept_default", "model"}},
     "compared": {recording: {"rendered", "glugs", "rate_per_s", "pitch_fall", "pitch_hz",
@@ -141,13 +149,19 @@ def fit(session: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
     returns at once (the fit, which cannot be stopped, runs on in the background and its
     result is dropped)."""
 
-def analyze_paired(logs: List[Union[str, "os.PathLike[str]"]]) -> Dict[str, Any]:
+def analyze_paired(
+    logs: List[Union[str, "os.PathLike[str]"]], *, dry_run_logs: bool = False
+) -> Dict[str, Any]:
     """The paired-comparison analysis of trial logs, as `sake-glug analyze paired --json`.
+    A dry run's trials (the log's `dry_run` column 1: answered while nothing played) raise
+    SakeGlugError unless dry_run_logs=True (`--dry-run-logs`); "dry_run_trials" counts them.
     Ctrl-C returns at once (the analysis runs on in the background, its result dropped)."""
 
-def analyze_discrimination(logs: List[Union[str, "os.PathLike[str]"]]) -> Dict[str, Any]:
+def analyze_discrimination(
+    logs: List[Union[str, "os.PathLike[str]"]], *, dry_run_logs: bool = False
+) -> Dict[str, Any]:
     """The discrimination analysis of trial logs (triangle, 2AFC or ABX), as `sake-glug analyze
-    discrimination --json`: "trials", "correct", "proportion" with its exact interval
+    discrimination --json` (dry_run_logs and "dry_run_trials" as analyze_paired's): "trials", "correct", "proportion" with its exact interval
     ("proportion_low", "proportion_high"), the one-sided "p_value" against chance, "d_prime"
     with its profile-likelihood interval ("d_prime_low", "d_prime_high": None where infinite or
     the interval is empty) and the plain "sentence", pooled and under "participants". Ctrl-C
@@ -159,8 +173,10 @@ def analyze_constant(
     resamples: Optional[int] = None,
     seed: Optional[int] = None,
     lapse: Optional[float] = None,
+    dry_run_logs: bool = False,
 ) -> Dict[str, Any]:
-    """The constant-stimuli analysis of trial logs, as `sake-glug analyze constant --json`:
+    """The constant-stimuli analysis of trial logs, as `sake-glug analyze constant --json`
+    (dry_run_logs and "dry_run_trials" as analyze_paired's):
     resamples from 1 to 100,000 (default 2000), seed and lapse as its options. Each point
     ("25", "50", "75") has "value", "low", "high" and "placement" ("within", "below_levels",
     "above_levels"): only a point within the levels tested is an estimate, so outside them its

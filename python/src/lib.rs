@@ -21,10 +21,10 @@ use pyo3::types::{PyDict, PyInt, PyString};
 use sake_glug_actuator::ActuatorProfile;
 use sake_glug_analysis::{
     analyze_constant_logs, analyze_discrimination_logs, analyze_paired_logs, constant_json,
-    discrimination_json, paired_json, PsychometricOptions, MAX_RESAMPLES,
+    discrimination_json, paired_json, DryRuns, PsychometricOptions, MAX_RESAMPLES,
 };
 use sake_glug_engine::{Preset, UnitOnset, Voicing, PRESETS};
-use sake_glug_fit::{fit_json, fit_session, FitSession};
+use sake_glug_fit::{fit_json, fit_session, FitError, FitSession};
 use sake_glug_render::loudness::{
     check_loudness, check_true_peak, LevelError, LevelStage, LevelTarget, Loudness,
 };
@@ -716,18 +716,42 @@ fn columns<'py, R>(
     Ok(table)
 }
 
-/// Fits a model to the recordings of a session file (`sake-glug fit`, MODEL.md §13) and returns
-/// what `sake-glug fit --json` prints (`sake_glug_fit::fit_json`, the same numbers): {"units":
-/// {"detected", "used"}, "explained": {recording: share}, "estimates": {key: {"value", "low",
-/// "high", "n", "in_model", "note"}}, "liquids": {name: {...}}, "warnings": [...]}. Nothing is
-/// written. Raises SakeGlugError with the command line's message. Ctrl-C returns at once; the
-/// fit, which cannot be stopped, runs on in the background and its result is dropped.
+/// Fits a model (`sake-glug fit`, MODEL.md §13) to a session file, or to WAV clips of one bottle
+/// as the command line takes them (`fit("glugs.wav")`, or a list of clips, with `capacity_ml`
+/// and `tilt_deg` as its --capacity-ml and --tilt-deg), and returns what `sake-glug fit --json`
+/// prints (`sake_glug_fit::fit_json`, the same numbers): {"units": {"detected", "used"},
+/// "explained": {recording: share}, "estimates": {key: {"value", "low", "high", "n",
+/// "in_model", "note"}}, "liquids": {name: {...}}, "warnings": [...]}. Nothing is written.
+/// Raises SakeGlugError with the command line's message (a clip option named as the argument
+/// is). Ctrl-C returns at once; the fit, which cannot be stopped, runs on in the background and
+/// its result is dropped.
 #[pyfunction]
-fn fit(py: Python<'_>, session: PathBuf) -> PyResult<Bound<'_, PyAny>> {
+#[pyo3(signature = (inputs, *, capacity_ml=None, tilt_deg=None))]
+fn fit<'py>(
+    py: Python<'py>,
+    inputs: &Bound<'py, PyAny>,
+    capacity_ml: Option<f64>,
+    tilt_deg: Option<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    // One path (str or os.PathLike), or a list of them; a str is never read as a list of letters.
+    let inputs: Vec<PathBuf> = match inputs.extract::<PathBuf>() {
+        Ok(path) => vec![path],
+        Err(_) => inputs.extract().map_err(|_| {
+            PyTypeError::new_err(
+                "fit() takes a session file or a WAV clip (str or os.PathLike), or a list of clips",
+            )
+        })?,
+    };
     let fitted = interruptible(py, move || {
-        FitSession::load(&session).and_then(|session| fit_session(&session))
+        FitSession::from_inputs(&inputs, capacity_ml, tilt_deg)
+            .and_then(|session| fit_session(&session))
     })?
-    .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
+    .map_err(|error| match error {
+        FitError::ClipOption { key, value, why } => {
+            SakeGlugError::new_err(format!("{key}={value}: {why}"))
+        }
+        error => SakeGlugError::new_err(error.to_string()),
+    })?;
     Ok(pythonize::pythonize(py, &fit_json(&fitted))?)
 }
 
@@ -736,8 +760,14 @@ fn fit(py: Python<'_>, session: PathBuf) -> PyResult<Bound<'_, PyAny>> {
 /// Mosteller's "fit" test and the participants' "agreement" test, as a dict. Ctrl-C returns at
 /// once (the analysis runs on in the background, its result dropped).
 #[pyfunction]
-fn analyze_paired(py: Python<'_>, logs: Vec<PathBuf>) -> PyResult<Bound<'_, PyAny>> {
-    let analysis = interruptible(py, move || analyze_paired_logs(&logs))?
+#[pyo3(signature = (logs, *, dry_run_logs=false))]
+fn analyze_paired(
+    py: Python<'_>,
+    logs: Vec<PathBuf>,
+    dry_run_logs: bool,
+) -> PyResult<Bound<'_, PyAny>> {
+    let dry_runs = dry_runs(dry_run_logs);
+    let analysis = interruptible(py, move || analyze_paired_logs(&logs, dry_runs))?
         .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
     Ok(pythonize::pythonize(py, &paired_json(&analysis))?)
 }
@@ -749,14 +779,16 @@ fn analyze_paired(py: Python<'_>, logs: Vec<PathBuf>) -> PyResult<Bound<'_, PyAn
 /// line's options. Ctrl-C returns at once (the analysis runs on in the background, its result
 /// dropped).
 #[pyfunction]
-#[pyo3(signature = (logs, *, resamples=None, seed=None, lapse=None))]
+#[pyo3(signature = (logs, *, resamples=None, seed=None, lapse=None, dry_run_logs=false))]
 fn analyze_constant<'py>(
     py: Python<'py>,
     logs: Vec<PathBuf>,
     resamples: Option<&Bound<'py, PyInt>>,
     seed: Option<u64>,
     lapse: Option<f64>,
+    dry_run_logs: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let dry_runs = dry_runs(dry_run_logs);
     let defaults = PsychometricOptions::default();
     let resamples = match resamples {
         None => defaults.resamples,
@@ -773,7 +805,7 @@ fn analyze_constant<'py>(
         seed: seed.unwrap_or(defaults.seed),
         max_lapse: lapse.unwrap_or(defaults.max_lapse),
     };
-    let analysis = interruptible(py, move || analyze_constant_logs(&logs, &options))?
+    let analysis = interruptible(py, move || analyze_constant_logs(&logs, &options, dry_runs))?
         .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
     Ok(pythonize::pythonize(py, &constant_json(&analysis))?)
 }
@@ -784,10 +816,25 @@ fn analyze_constant<'py>(
 /// (None where infinite or empty) and the plain "sentence", pooled and per participant, as a
 /// dict. Ctrl-C returns at once.
 #[pyfunction]
-fn analyze_discrimination(py: Python<'_>, logs: Vec<PathBuf>) -> PyResult<Bound<'_, PyAny>> {
-    let analysis = interruptible(py, move || analyze_discrimination_logs(&logs))?
+#[pyo3(signature = (logs, *, dry_run_logs=false))]
+fn analyze_discrimination(
+    py: Python<'_>,
+    logs: Vec<PathBuf>,
+    dry_run_logs: bool,
+) -> PyResult<Bound<'_, PyAny>> {
+    let dry_runs = dry_runs(dry_run_logs);
+    let analysis = interruptible(py, move || analyze_discrimination_logs(&logs, dry_runs))?
         .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
     Ok(pythonize::pythonize(py, &discrimination_json(&analysis))?)
+}
+
+/// `dry_run_logs=`: whether an analysis reads a dry run's trials (`--dry-run-logs`); they are
+/// refused by default, and counted in the result's "dry_run_trials".
+fn dry_runs(read: bool) -> DryRuns {
+    match read {
+        true => DryRuns::Read,
+        false => DryRuns::Refused,
+    }
 }
 
 /// Every preset as (id, name, description, scene): the id that render(preset=...) and
