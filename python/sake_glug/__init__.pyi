@@ -67,7 +67,8 @@ def render(
     skin's threshold instead, as --felt does. A refused profile raises SakeGlugError naming
     the file and the key. seed overrides the scene's seed (--seed); take renders one take of a
     set again, bit for bit, from its row of the set's manifest (a row of render_variations(),
-    or of NAME.variations.json), as --take-from does; trim ends the samples once the last glug
+    or of NAME.variations.json), as --take-from does, with the set's trim and level options
+    the row records (one given that differs raises SakeGlugError); trim ends the samples once the last glug
     has decayed below a level re their peak, with a 10 ms fade (--trim): True for -60 dB, or a
     level in dB below 0. loudness brings the samples to an integrated loudness (LUFS, -70 to
     0; BS.1770-4 gated as EBU R128) and true_peak keeps their true peak (dBTP, -60 to 0, 4x
@@ -94,10 +95,11 @@ def render_variations(
 ) -> List[Tuple[Dict[str, Union[int, float]], npt.NDArray[np.float32]]]:
     """Renders a set of takes of a scene, as `sake-glug render --variations COUNT` does, and
     returns [(row, samples)] in take order: row is the take's row of the set's manifest
-    ({"take": k, "seed": ..., each drawn value by its key, then loudness_lufs and
-    true_peak_dbtp, measured on the samples returned}), samples those of the command line's
-    take k, bit for bit; render(scene, take=row) renders it again (the measured columns are
-    ignored). count defaults to the scene's [variations] count; seed is the master seed
+    ({"take": k, "seed": ..., each drawn value by its key, the set's options trim_db,
+    loudness_target_lufs, true_peak_ceiling_dbtp and haptic_peak (None where not given), then
+    loudness_lufs and true_peak_dbtp, measured on the samples returned}), samples those of the
+    command line's take k, bit for bit; render(scene, take=row) renders it again with the
+    set's options (the measured columns are ignored). count defaults to the scene's [variations] count; seed is the master seed
     (default: the scene's seed); the other arguments are render()'s, for every take (loudness
     and true_peak level each take on its own)."""
 

@@ -31,8 +31,8 @@ use sake_glug_render::loudness::{
 use sake_glug_render::silence::why_silent;
 use sake_glug_render::trim::{check_trim_db, trimmed, DEFAULT_TRIM_DB};
 use sake_glug_render::variations::{
-    draw_takes, is_measured_column, manifest_row, Cell, Take, VariationError, MAX_TAKES,
-    NAME_COLUMN, SEED_COLUMN, TAKE_COLUMN,
+    draw_takes, is_measured_column, manifest_row, Cell, Take, TakeOptions, VariationError,
+    MAX_TAKES, NAME_COLUMN, OPTION_COLUMNS, SEED_COLUMN, TAKE_COLUMN,
 };
 use sake_glug_render::{
     render_scene, render_tables_until, Column, RenderError, RenderObserver, Scene, SceneError,
@@ -192,6 +192,33 @@ impl Shaping {
         })
     }
 
+    /// A take's row records the options its set was rendered with (MODEL.md §10.2): they are
+    /// applied (its trim, and the level returned for `level`), and one given that differs is
+    /// refused, as --take-from refuses it. The haptic peak is a haptic clip's, which Python does
+    /// not write.
+    fn take_options(&mut self, level: LevelTarget) -> PyResult<LevelTarget> {
+        let typed = TakeOptions {
+            trim_db: self.trim_db,
+            loudness_lufs: level.loudness_lufs,
+            true_peak_dbtp: level.true_peak_dbtp,
+            haptic_peak: None,
+        };
+        let recorded = self.take.as_ref().and_then(|take| take.recorded);
+        let options = TakeOptions::resolve(
+            typed,
+            recorded.map(|recorded| TakeOptions {
+                haptic_peak: None,
+                ..recorded
+            }),
+        )
+        .map_err(|error| SakeGlugError::new_err(format!("take: {error}")))?;
+        self.trim_db = options.trim_db;
+        Ok(LevelTarget {
+            loudness_lufs: options.loudness_lufs,
+            true_peak_dbtp: options.true_peak_dbtp,
+        })
+    }
+
     fn apply(&self, mut scene: Scene) -> Result<Scene, Refused> {
         if let Some(seed) = self.seed {
             scene.config.seed = seed;
@@ -255,6 +282,12 @@ fn take_of(take: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Take>> {
                     SakeGlugError::new_err("take: `take` is the take's number, an int from 1")
                 })?;
                 continue;
+            }
+            // An option the set was rendered without.
+            column
+                if value.is_none() && OPTION_COLUMNS.iter().any(|(name, ..)| *name == column) =>
+            {
+                String::new()
             }
             SEED_COLUMN => value
                 .extract::<u64>()
@@ -375,7 +408,9 @@ impl Refused {
 ///     --felt does.
 /// seed: overrides the scene's seed, as --seed does.
 /// take: renders one take of a set again, bit for bit, as --take-from does: its row of the
-///     set's manifest as a dict (a row of render_variations(), or of NAME.variations.json).
+///     set's manifest as a dict (a row of render_variations(), or of NAME.variations.json),
+///     with the set's trim, loudness and true peak the row records (one given that differs is
+///     refused).
 /// trim: ends the samples once the last glug has decayed below a level re their peak, with a
 ///     10 ms fade, as --trim does: True for -60 dB, or a level in dB below 0.
 /// loudness: brings the samples to this integrated loudness (LUFS, -70 to 0; ITU-R BS.1770-4
@@ -416,8 +451,8 @@ fn render<'py>(
     let source = SceneSource::of(scene)?;
     let progress = callback("progress", progress)?;
     let actuator = actuator_profile(actuator, felt)?;
-    let shaping = Shaping::of(seed, take, trim)?;
-    let level = level_target(loudness, true_peak)?;
+    let mut shaping = Shaping::of(seed, take, trim)?;
+    let level = shaping.take_options(level_target(loudness, true_peak)?)?;
     let rendered = py.detach(|| {
         let scene = shaping.apply(source.load(preset, sample_rate, actuator.as_ref())?)?;
         let total = scene.duration_samples();
@@ -445,8 +480,10 @@ fn render<'py>(
 /// trim, sample_rate, preset, actuator, felt, loudness, true_peak: as render()'s, for every
 ///     take (each take brought to the level on its own, as the command line's files are).
 ///
-/// Each row ends with the take's loudness_lufs and true_peak_dbtp, measured on its samples as
-/// returned, as the manifest's last columns are; render(scene, take=row) ignores them.
+/// Each row records the set's options (trim_db, loudness_target_lufs, true_peak_ceiling_dbtp,
+/// haptic_peak; None where not given), which render(scene, take=row) applies, and ends with the
+/// take's loudness_lufs and true_peak_dbtp, measured on its samples as returned, as the
+/// manifest's last columns are; render(scene, take=row) ignores those.
 #[pyfunction]
 #[pyo3(signature = (
     scene=None, *, count=None, seed=None, sample_rate=None, preset=None, trim=None,
@@ -470,6 +507,13 @@ fn render_variations<'py>(
     let actuator = actuator_profile(actuator, felt)?;
     let trim_db = trim_of(trim)?;
     let level = level_target(loudness, true_peak)?;
+    // What the command line's manifest records of the same call.
+    let options = TakeOptions {
+        trim_db,
+        loudness_lufs: level.loudness_lufs,
+        true_peak_dbtp: level.true_peak_dbtp,
+        haptic_peak: None,
+    };
     if let Some(count) = count.filter(|count| !(1..=MAX_TAKES).contains(count)) {
         return Err(SakeGlugError::new_err(format!(
             "count = {count}: a set has 1 to {MAX_TAKES} takes"
@@ -521,9 +565,10 @@ fn render_variations<'py>(
         let measured = measured.expect("render_levelled measures every take");
         // The manifest's row, but for the file name a set of samples has not.
         let row = PyDict::new(py);
-        for (column, cell) in manifest_row(&take, "", count, &measured) {
+        for (column, cell) in manifest_row(&take, "", count, &options, &measured) {
             match cell {
                 _ if column == NAME_COLUMN => {}
+                Cell::Empty => row.set_item(column, py.None())?,
                 Cell::Whole(value) => row.set_item(column, value)?,
                 Cell::Number(value) => row.set_item(column, value)?,
                 Cell::Text(text) => row.set_item(column, text)?,
