@@ -678,7 +678,9 @@ fn render_tables<'py>(
     let state_rate = StateRate::new(state_rate)
         .map_err(|error| SakeGlugError::new_err(format!("state_rate: {error}")))?;
     let actuator = actuator_profile(actuator, felt)?;
-    let shaping = Shaping::of(seed, take, trim)?;
+    let mut shaping = Shaping::of(seed, take, trim)?;
+    // A take's row gives its set's trim; the tables' samples are never levelled.
+    shaping.take_options(LevelTarget::default())?;
     let rendered = py.detach(|| {
         let scene = shaping.apply(source.load(preset, sample_rate, actuator.as_ref())?)?;
         // A bound: row k is at sample ⌈k·fs/R⌉, before the end.

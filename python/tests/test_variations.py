@@ -67,6 +67,7 @@ def test_a_set_is_the_clis_set_and_a_row_renders_its_take_again(cli, tmp_path, s
         assert same_bits(sake_glug.render(set_file, take=row, trim=True), samples)
         assert same_bits(sake_glug.render(set_file, take=row), samples)
         assert same_bits(sake_glug.render(set_file, take=json_row), samples)
+        assert same_bits(sake_glug.render_tables(set_file, take=row).samples, samples)
         with pytest.raises(sake_glug.SakeGlugError, match="the set's takes were rendered with --trim -60"):
             sake_glug.render(set_file, take=row, trim=-40.0)
     # The same seed, the same set; the count of the call over the scene's.
