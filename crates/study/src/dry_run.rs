@@ -49,7 +49,7 @@ pub fn check_dry_run_folder(dir: &Path) -> Result<(), StudyError> {
 }
 
 /// The files of a dry run's folder: each trial's stimuli in the order played
-/// (`trial-007-1-model.wav`, …; a practice trial's `practice-01-1-model.wav`, …), and the trial
+/// (`trial-007-1-model.wav`, …; a practice trial's `practice-001-1-model.wav`, …), and the trial
 /// list, which lists the study's trials.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DryRunFiles {
