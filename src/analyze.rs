@@ -16,8 +16,8 @@ use sake_glug_analysis::{
     paired_json, plan_constant, plan_discrimination, plan_json, AnalysisError, ChiSquareTest,
     ConstantAnalysis, ConstantPlan, DiscriminationAnalysis, DiscriminationDesign,
     DiscriminationEstimate, DiscriminationGoal, DiscriminationPlan, DiscriminationPlanOutcome,
-    PairedAnalysis, Placement, PlanOutcome, PsychometricFit, PsychometricOptions, MAX_RESAMPLES,
-    POINT_PERCENTS,
+    DryRuns, PairedAnalysis, Placement, PlanOutcome, PsychometricFit, PsychometricOptions,
+    MAX_RESAMPLES, POINT_PERCENTS,
 };
 
 #[derive(Args, Debug)]
@@ -57,6 +57,8 @@ enum Design {
         /// Prints one JSON object instead of tables.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        dry_runs: DryRunLogs,
     },
     /// Plans a study: simulates its design with observers of a known curve or d′, and says how
     /// wide its intervals would be and how often they would hold the truth, or how many
@@ -161,6 +163,34 @@ struct PlanConstantArgs {
     json: bool,
 }
 
+/// Whether a dry run's trials are analysed.
+#[derive(Args, Debug)]
+struct DryRunLogs {
+    /// Analyses a dry run's trials too (`experiment --dry-run` marks them: answered while
+    /// nothing played), saying how many; without it they are refused.
+    #[arg(long = "dry-run-logs")]
+    read: bool,
+}
+
+impl DryRunLogs {
+    fn dry_runs(&self) -> DryRuns {
+        match self.read {
+            true => DryRuns::Read,
+            false => DryRuns::Refused,
+        }
+    }
+}
+
+/// Says on stderr that `count` of the trials analysed were a dry run's.
+fn warn_dry_run(count: usize) {
+    if count > 0 {
+        eprintln!(
+            "warning: {count} of these trials were answered in a dry run (nothing played): \
+             the figures are no listening result"
+        );
+    }
+}
+
 #[derive(Args, Debug)]
 struct Common {
     /// The trial logs (CSV with a header), read together.
@@ -172,6 +202,8 @@ struct Common {
     /// Prints one JSON object instead of tables.
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    dry_runs: DryRunLogs,
 }
 
 /// Exit status 0 when analysed (and plotted), 1 for a bad log or an unwritable plot, 2 for a
@@ -184,21 +216,28 @@ pub fn run(args: AnalyzeArgs) -> ExitCode {
         Design::Plan {
             design: PlanDesign::Discrimination(args),
         } => return plan_discrimination_run(args),
-        Design::Discrimination { logs, json } => {
-            analyze_discrimination_logs(&logs).map(|analysis| match json {
+        Design::Discrimination {
+            logs,
+            json,
+            dry_runs,
+        } => analyze_discrimination_logs(&logs, dry_runs.dry_runs()).map(|analysis| {
+            warn_dry_run(analysis.dry_run_trials);
+            match json {
                 true => discrimination_json(&analysis).to_string(),
                 false => discrimination_text(&analysis),
-            })
-        }
-        Design::Paired { common } => analyze_paired_logs(&common.logs).and_then(|analysis| {
-            if let Some(path) = &common.plot {
-                draw_paired_plot(&analysis, path)?;
             }
-            Ok(match common.json {
-                true => paired_json(&analysis).to_string(),
-                false => paired_text(&analysis),
-            })
         }),
+        Design::Paired { common } => analyze_paired_logs(&common.logs, common.dry_runs.dry_runs())
+            .and_then(|analysis| {
+                warn_dry_run(analysis.dry_run_trials);
+                if let Some(path) = &common.plot {
+                    draw_paired_plot(&analysis, path)?;
+                }
+                Ok(match common.json {
+                    true => paired_json(&analysis).to_string(),
+                    false => paired_text(&analysis),
+                })
+            }),
         Design::Constant {
             common,
             resamples,
@@ -210,15 +249,18 @@ pub fn run(args: AnalyzeArgs) -> ExitCode {
                 seed,
                 max_lapse: lapse,
             };
-            analyze_constant_logs(&common.logs, &options).and_then(|analysis| {
-                if let Some(path) = &common.plot {
-                    draw_constant_plot(&analysis, path)?;
-                }
-                Ok(match common.json {
-                    true => constant_json(&analysis).to_string(),
-                    false => constant_text(&analysis),
-                })
-            })
+            analyze_constant_logs(&common.logs, &options, common.dry_runs.dry_runs()).and_then(
+                |analysis| {
+                    warn_dry_run(analysis.dry_run_trials);
+                    if let Some(path) = &common.plot {
+                        draw_constant_plot(&analysis, path)?;
+                    }
+                    Ok(match common.json {
+                        true => constant_json(&analysis).to_string(),
+                        false => constant_text(&analysis),
+                    })
+                },
+            )
         }
     };
     match outcome {

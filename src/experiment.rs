@@ -9,7 +9,8 @@ use sake_glug_io::text::{printable, quoted};
 
 use sake_glug_study::{
     check_dry_run_folder, order_seed, plan_trials, render_stimuli, write_dry_run, Design,
-    Discriminate, Equalize, Silent, Spec, StudyError, StudySession, TrialLog, DISCRIMINATE_DESIGNS,
+    Discriminate, DryRun, DryRunFiles, Equalize, Spec, StudyError, StudySession, TrialLog,
+    DISCRIMINATE_DESIGNS,
 };
 #[cfg(feature = "audio")]
 use sake_glug_study::{AlsaOutput, Channels, JackOutput, Presenter};
@@ -329,6 +330,7 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         seed,
         trials: &trials,
         rendered: &rendered,
+        dry_run: args.dry_run.is_some(),
     };
     // Locked and checked whole before anything is written, its own rows or the dry run's.
     let resumed = match (&args.log, args.resume) {
@@ -343,18 +345,22 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
         }
         _ => None,
     };
-    if let Some(dir) = &args.dry_run {
+    let dry_run_files = match &args.dry_run {
         // A resumed dry run keeps the folder its first run wrote.
-        let already = args.resume && dir.join(sake_glug_study::TRIAL_LIST).exists();
-        if !already {
+        Some(dir) if args.resume && dir.join(sake_glug_study::TRIAL_LIST).exists() => {
+            Some(DryRunFiles::planned(&session, dir))
+        }
+        Some(dir) => {
             let written = write_dry_run(dir, &session, sample_rate).map_err(usage)?;
             println!(
                 "Wrote {} files into {}.",
-                written.len(),
+                written.count(),
                 printable(&dir.to_string_lossy())
             );
+            Some(written)
         }
-    }
+        None => None,
+    };
     let Some(log_path) = &args.log else {
         // --no-answers: the folder was the whole job.
         return Ok(());
@@ -368,8 +374,8 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
 
     let mut input = std::io::stdin().lock();
     let mut prompt = std::io::stdout();
-    let result = match &args.dry_run {
-        Some(_) => session.run(done, &mut Silent, &mut log, &mut input, &mut prompt),
+    let result = match &dry_run_files {
+        Some(files) => session.run(done, &mut DryRun(files), &mut log, &mut input, &mut prompt),
         #[cfg(feature = "audio")]
         None => {
             // The player takes the samples; the session keeps the gains for the log.
@@ -383,6 +389,7 @@ fn session(args: ExperimentArgs) -> Result<(), (u8, StudyError)> {
                 seed,
                 trials: &trials,
                 rendered: &rendered,
+                dry_run: false,
             };
             let gap = (spec.gap_s * sample_rate as f64).round() as u64;
             let output = output.expect("opened above without --dry-run");

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use clap::Args;
 
-use sake_glug_fit::{fit_json, fit_session, write_fit, FitOutputs, FitSession};
+use sake_glug_fit::{fit_json, fit_session, write_fit, FitError, FitOutputs, FitSession};
 
 #[derive(Args)]
 pub struct FitArgs {
@@ -49,12 +49,6 @@ pub struct FitArgs {
     tilt_deg: Option<f64>,
 }
 
-/// Whether `path` names a session file rather than a recording.
-fn is_session(path: &std::path::Path) -> bool {
-    path.extension()
-        .is_some_and(|extension| extension.eq_ignore_ascii_case("toml"))
-}
-
 pub fn run(args: FitArgs) -> ExitCode {
     let outputs = FitOutputs {
         model: args.output,
@@ -71,23 +65,12 @@ pub fn run(args: FitArgs) -> ExitCode {
         );
         return ExitCode::from(2);
     }
-    let sessions = args.inputs.iter().filter(|p| is_session(p)).count();
-    let session = match (sessions, args.inputs.as_slice()) {
-        (0, clips) => FitSession::of_clips(clips, args.capacity_ml, args.tilt_deg),
-        (1, [session]) if args.capacity_ml.is_none() && args.tilt_deg.is_none() => {
-            FitSession::load(session)
-        }
-        (1, [_]) => {
-            eprintln!(
-                "error: --capacity-ml and --tilt-deg are for clips; a session file gives them"
-            );
-            return ExitCode::from(2);
-        }
-        _ => {
-            eprintln!("error: give one session file, or WAV clips without one");
-            return ExitCode::from(2);
-        }
-    };
+    let session = FitSession::from_inputs(&args.inputs, args.capacity_ml, args.tilt_deg);
+    // Inputs that make no one fit are a usage error, as clap's own.
+    if let Err(error @ FitError::Inputs(_)) = &session {
+        eprintln!("error: {error}");
+        return ExitCode::from(2);
+    }
     let result = session
         .and_then(|session| fit_session(&session))
         .and_then(|fit| Ok((write_fit(&fit, &outputs)?, fit)));

@@ -39,7 +39,8 @@ enum Command {
     Stability(stability::StabilityArgs),
     /// Lists the presets, or prints one as a scene file.
     Presets(presets::PresetsArgs),
-    /// Every control and model constant: parameter id, scene key, range, step and default.
+    /// Every control and model constant: parameter id, pedalboard key, scene key, range, step
+    /// and default.
     Parameters(parameters::ParametersArgs),
     /// Fits a model (a scene file) to recordings of a bottle: see MODEL.md §13.
     Fit(fit::FitArgs),

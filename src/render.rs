@@ -24,7 +24,7 @@ use sake_glug_render::sinks::{AudioChannels, DEFAULT_RUMBLE_RATE_HZ, RUMBLE_RATE
 use sake_glug_render::trim::{check_trim_db, trimmed, DEFAULT_TRIM_DB, TRIM_FADE_S};
 use sake_glug_render::variations::{
     draw_takes, manifest_csv, manifest_json, manifest_paths, read_take, set_name_of, take_path,
-    Take, VariationError, MAX_TAKES,
+    Take, TakeOptions, VariationError, MAX_TAKES,
 };
 use sake_glug_render::{
     human_bytes, render_to_files, Output, OutputError, OutputFormat, OutputOptions,
@@ -210,7 +210,20 @@ impl From<RenderError> for JobError {
 /// Runs the command: every scene is rendered, a bad one is reported and skipped; the exit
 /// status is 1 if any failed, 2 if the command line itself is wrong (nothing is rendered then),
 /// 128 + the signal's number if a signal stopped it.
-pub fn run(args: RenderArgs) -> ExitCode {
+pub fn run(mut args: RenderArgs) -> ExitCode {
+    // A take rendered again is rendered with the options its set was (its row records them).
+    if let Some((manifest, number)) = &args.take_from {
+        // A manifest that cannot be read is refused where the take is applied, as before.
+        if let Ok(take) = read_take(manifest, *number) {
+            match TakeOptions::resolve(args.take_options(), take.recorded) {
+                Ok(options) => args.set_take_options(options),
+                Err(error) => {
+                    eprintln!("error: --take-from: {error}");
+                    return ExitCode::from(2);
+                }
+            }
+        }
+    }
     let jobs = match plan(&args) {
         Ok(jobs) => jobs,
         Err(message) => {
@@ -576,6 +589,28 @@ fn rumble_rate(text: &str) -> Result<f64, String> {
     }
 }
 
+impl RenderArgs {
+    /// The options a set's manifest records (MODEL.md §10.2), as given.
+    fn take_options(&self) -> TakeOptions {
+        TakeOptions {
+            trim_db: self.trim.map(|level| level.unwrap_or(DEFAULT_TRIM_DB)),
+            loudness_lufs: self.loudness,
+            true_peak_dbtp: self.true_peak,
+            haptic_peak: self.haptic_peak.map(HapticPeak::level),
+        }
+    }
+
+    /// Sets the options a manifest recorded, each checked when it was read.
+    fn set_take_options(&mut self, options: TakeOptions) {
+        self.trim = options.trim_db.map(Some);
+        self.loudness = options.loudness_lufs;
+        self.true_peak = options.true_peak_dbtp;
+        self.haptic_peak = options
+            .haptic_peak
+            .map(|level| HapticPeak::of_level(level).expect("checked as the row was read"));
+    }
+}
+
 /// `--variations`' value parser: a count of takes from 1 to [`MAX_TAKES`].
 fn take_count(text: &str) -> Result<u32, String> {
     match text.trim().parse::<u32>() {
@@ -761,6 +796,7 @@ fn render_job(
         job.scene.as_deref(),
         master_seed,
         &ranges,
+        &args.take_options(),
         &measured,
     )?;
     Ok(JobDone {
@@ -789,14 +825,15 @@ fn write_manifests(
     scene_file: Option<&Path>,
     master_seed: u64,
     ranges: &[(sake_glug_render::variations::Varied, [f64; 2])],
+    options: &TakeOptions,
     takes: &[(Take, Loudness)],
 ) -> Result<Vec<(PathBuf, u64)>, JobError> {
     let [csv_path, json_path] = manifest_paths(folder, set_name);
     let texts = [
-        (csv_path, manifest_csv(set_name, takes)),
+        (csv_path, manifest_csv(set_name, options, takes)),
         (
             json_path,
-            manifest_json(set_name, scene_file, master_seed, ranges, takes),
+            manifest_json(set_name, scene_file, master_seed, ranges, options, takes),
         ),
     ];
     let mut files = Vec::new();

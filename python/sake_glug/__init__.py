@@ -14,7 +14,7 @@ The offline renderer of the ``sake-glug`` command line, for Python::
   each take's row, which ``render(scene, take=row)`` renders again bit for bit;
 - :func:`render_tables` renders the same samples with the glug data: one row per unit and the
   bottle's state at a fixed rate, the tables of ``sake-glug render --units/--state``;
-- :func:`fit` fits a model to a session's recordings (``sake-glug fit``), and
+- :func:`fit` fits a model to a session file or to WAV clips (``sake-glug fit``), and
   :func:`analyze_paired` / :func:`analyze_constant` / :func:`analyze_discrimination`
   analyse a study's trial logs
   (``sake-glug analyze … --json``), each returning its numbers as a dict;

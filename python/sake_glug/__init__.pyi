@@ -67,7 +67,8 @@ def render(
     skin's threshold instead, as --felt does. A refused profile raises SakeGlugError naming
     the file and the key. seed overrides the scene's seed (--seed); take renders one take of a
     set again, bit for bit, from its row of the set's manifest (a row of render_variations(),
-    or of NAME.variations.json), as --take-from does; trim ends the samples once the last glug
+    or of NAME.variations.json), as --take-from does, with the set's trim and level options
+    the row records (one given that differs raises SakeGlugError); trim ends the samples once the last glug
     has decayed below a level re their peak, with a 10 ms fade (--trim): True for -60 dB, or a
     level in dB below 0. loudness brings the samples to an integrated loudness (LUFS, -70 to
     0; BS.1770-4 gated as EBU R128) and true_peak keeps their true peak (dBTP, -60 to 0, 4x
@@ -94,10 +95,11 @@ def render_variations(
 ) -> List[Tuple[Dict[str, Union[int, float]], npt.NDArray[np.float32]]]:
     """Renders a set of takes of a scene, as `sake-glug render --variations COUNT` does, and
     returns [(row, samples)] in take order: row is the take's row of the set's manifest
-    ({"take": k, "seed": ..., each drawn value by its key, then loudness_lufs and
-    true_peak_dbtp, measured on the samples returned}), samples those of the command line's
-    take k, bit for bit; render(scene, take=row) renders it again (the measured columns are
-    ignored). count defaults to the scene's [variations] count; seed is the master seed
+    ({"take": k, "seed": ..., each drawn value by its key, the set's options trim_db,
+    loudness_target_lufs, true_peak_ceiling_dbtp and haptic_peak (None where not given), then
+    loudness_lufs and true_peak_dbtp, measured on the samples returned}), samples those of the
+    command line's take k, bit for bit; render(scene, take=row) renders it again with the
+    set's options (the measured columns are ignored). count defaults to the scene's [variations] count; seed is the master seed
     (default: the scene's seed); the other arguments are render()'s, for every take (loudness
     and true_peak level each take on its own)."""
 
@@ -129,9 +131,17 @@ def render_tables(
     refuse them with the figure if they cannot fit in memory, then into the tables. Ctrl-C
     stops it. Raises SakeGlugError for what it refuses."""
 
-def fit(session: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
-    """Fits a model to the recordings of a session file (`sake-glug fit`, MODEL.md §13) and
-    returns what `sake-glug fit --json` prints: {"units": {"detected", "used"}, "explained":
+def fit(
+    inputs: Union[str, "os.PathLike[str]", List[Union[str, "os.PathLike[str]"]]],
+    *,
+    capacity_ml: Optional[float] = None,
+    tilt_deg: Optional[float] = None,
+) -> Dict[str, Any]:
+    """Fits a model (`sake-glug fit`, MODEL.md §13) to a session file (`.toml`), or to WAV clips
+    of one bottle as the command line takes them: `fit("glugs.wav")` or a list of clips, a
+    bottle of capacity_ml (default the model's) held at tilt_deg (default 135), full at each
+    clip's first sample (`--capacity-ml`, `--tilt-deg`; a session file gives its own). Returns
+    what `sake-glug fit --json` prints: {"units": {"detected", "used"}, "explained":
     {recording: share}, "estimates": {key: {"value", "low", "high", "n", "in_model", "note"}},
     "liquids": {name: {"estimates", "units", "detected", "kept_default", "model"}},
     "compared": {recording: {"rendered", "glugs", "rate_per_s", "pitch_fall", "pitch_hz",
@@ -141,13 +151,19 @@ def fit(session: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
     returns at once (the fit, which cannot be stopped, runs on in the background and its
     result is dropped)."""
 
-def analyze_paired(logs: List[Union[str, "os.PathLike[str]"]]) -> Dict[str, Any]:
+def analyze_paired(
+    logs: List[Union[str, "os.PathLike[str]"]], *, dry_run_logs: bool = False
+) -> Dict[str, Any]:
     """The paired-comparison analysis of trial logs, as `sake-glug analyze paired --json`.
+    A dry run's trials (the log's `dry_run` column 1: answered while nothing played) raise
+    SakeGlugError unless dry_run_logs=True (`--dry-run-logs`); "dry_run_trials" counts them.
     Ctrl-C returns at once (the analysis runs on in the background, its result dropped)."""
 
-def analyze_discrimination(logs: List[Union[str, "os.PathLike[str]"]]) -> Dict[str, Any]:
+def analyze_discrimination(
+    logs: List[Union[str, "os.PathLike[str]"]], *, dry_run_logs: bool = False
+) -> Dict[str, Any]:
     """The discrimination analysis of trial logs (triangle, 2AFC or ABX), as `sake-glug analyze
-    discrimination --json`: "trials", "correct", "proportion" with its exact interval
+    discrimination --json` (dry_run_logs and "dry_run_trials" as analyze_paired's): "trials", "correct", "proportion" with its exact interval
     ("proportion_low", "proportion_high"), the one-sided "p_value" against chance, "d_prime"
     with its profile-likelihood interval ("d_prime_low", "d_prime_high": None where infinite or
     the interval is empty) and the plain "sentence", pooled and under "participants". Ctrl-C
@@ -159,8 +175,10 @@ def analyze_constant(
     resamples: Optional[int] = None,
     seed: Optional[int] = None,
     lapse: Optional[float] = None,
+    dry_run_logs: bool = False,
 ) -> Dict[str, Any]:
-    """The constant-stimuli analysis of trial logs, as `sake-glug analyze constant --json`:
+    """The constant-stimuli analysis of trial logs, as `sake-glug analyze constant --json`
+    (dry_run_logs and "dry_run_trials" as analyze_paired's):
     resamples from 1 to 100,000 (default 2000), seed and lapse as its options. Each point
     ("25", "50", "75") has "value", "low", "high" and "placement" ("within", "below_levels",
     "above_levels"): only a point within the levels tested is an estimate, so outside them its

@@ -21,18 +21,18 @@ use pyo3::types::{PyDict, PyInt, PyString};
 use sake_glug_actuator::ActuatorProfile;
 use sake_glug_analysis::{
     analyze_constant_logs, analyze_discrimination_logs, analyze_paired_logs, constant_json,
-    discrimination_json, paired_json, PsychometricOptions, MAX_RESAMPLES,
+    discrimination_json, paired_json, DryRuns, PsychometricOptions, MAX_RESAMPLES,
 };
 use sake_glug_engine::{Preset, UnitOnset, Voicing, PRESETS};
-use sake_glug_fit::{fit_json, fit_session, FitSession};
+use sake_glug_fit::{fit_json, fit_session, FitError, FitSession};
 use sake_glug_render::loudness::{
     check_loudness, check_true_peak, LevelError, LevelStage, LevelTarget, Loudness,
 };
 use sake_glug_render::silence::why_silent;
 use sake_glug_render::trim::{check_trim_db, trimmed, DEFAULT_TRIM_DB};
 use sake_glug_render::variations::{
-    draw_takes, is_measured_column, manifest_row, Cell, Take, VariationError, MAX_TAKES,
-    NAME_COLUMN, SEED_COLUMN, TAKE_COLUMN,
+    draw_takes, is_measured_column, manifest_row, Cell, Take, TakeOptions, VariationError,
+    MAX_TAKES, NAME_COLUMN, OPTION_COLUMNS, SEED_COLUMN, TAKE_COLUMN,
 };
 use sake_glug_render::{
     render_scene, render_tables_until, Column, RenderError, RenderObserver, Scene, SceneError,
@@ -192,6 +192,33 @@ impl Shaping {
         })
     }
 
+    /// A take's row records the options its set was rendered with (MODEL.md §10.2): they are
+    /// applied (its trim, and the level returned for `level`), and one given that differs is
+    /// refused, as --take-from refuses it. The haptic peak is a haptic clip's, which Python does
+    /// not write.
+    fn take_options(&mut self, level: LevelTarget) -> PyResult<LevelTarget> {
+        let typed = TakeOptions {
+            trim_db: self.trim_db,
+            loudness_lufs: level.loudness_lufs,
+            true_peak_dbtp: level.true_peak_dbtp,
+            haptic_peak: None,
+        };
+        let recorded = self.take.as_ref().and_then(|take| take.recorded);
+        let options = TakeOptions::resolve(
+            typed,
+            recorded.map(|recorded| TakeOptions {
+                haptic_peak: None,
+                ..recorded
+            }),
+        )
+        .map_err(|error| SakeGlugError::new_err(format!("take: {error}")))?;
+        self.trim_db = options.trim_db;
+        Ok(LevelTarget {
+            loudness_lufs: options.loudness_lufs,
+            true_peak_dbtp: options.true_peak_dbtp,
+        })
+    }
+
     fn apply(&self, mut scene: Scene) -> Result<Scene, Refused> {
         if let Some(seed) = self.seed {
             scene.config.seed = seed;
@@ -255,6 +282,12 @@ fn take_of(take: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Take>> {
                     SakeGlugError::new_err("take: `take` is the take's number, an int from 1")
                 })?;
                 continue;
+            }
+            // An option the set was rendered without.
+            column
+                if value.is_none() && OPTION_COLUMNS.iter().any(|(name, ..)| *name == column) =>
+            {
+                String::new()
             }
             SEED_COLUMN => value
                 .extract::<u64>()
@@ -375,7 +408,9 @@ impl Refused {
 ///     --felt does.
 /// seed: overrides the scene's seed, as --seed does.
 /// take: renders one take of a set again, bit for bit, as --take-from does: its row of the
-///     set's manifest as a dict (a row of render_variations(), or of NAME.variations.json).
+///     set's manifest as a dict (a row of render_variations(), or of NAME.variations.json),
+///     with the set's trim, loudness and true peak the row records (one given that differs is
+///     refused).
 /// trim: ends the samples once the last glug has decayed below a level re their peak, with a
 ///     10 ms fade, as --trim does: True for -60 dB, or a level in dB below 0.
 /// loudness: brings the samples to this integrated loudness (LUFS, -70 to 0; ITU-R BS.1770-4
@@ -416,8 +451,8 @@ fn render<'py>(
     let source = SceneSource::of(scene)?;
     let progress = callback("progress", progress)?;
     let actuator = actuator_profile(actuator, felt)?;
-    let shaping = Shaping::of(seed, take, trim)?;
-    let level = level_target(loudness, true_peak)?;
+    let mut shaping = Shaping::of(seed, take, trim)?;
+    let level = shaping.take_options(level_target(loudness, true_peak)?)?;
     let rendered = py.detach(|| {
         let scene = shaping.apply(source.load(preset, sample_rate, actuator.as_ref())?)?;
         let total = scene.duration_samples();
@@ -445,8 +480,10 @@ fn render<'py>(
 /// trim, sample_rate, preset, actuator, felt, loudness, true_peak: as render()'s, for every
 ///     take (each take brought to the level on its own, as the command line's files are).
 ///
-/// Each row ends with the take's loudness_lufs and true_peak_dbtp, measured on its samples as
-/// returned, as the manifest's last columns are; render(scene, take=row) ignores them.
+/// Each row records the set's options (trim_db, loudness_target_lufs, true_peak_ceiling_dbtp,
+/// haptic_peak; None where not given), which render(scene, take=row) applies, and ends with the
+/// take's loudness_lufs and true_peak_dbtp, measured on its samples as returned, as the
+/// manifest's last columns are; render(scene, take=row) ignores those.
 #[pyfunction]
 #[pyo3(signature = (
     scene=None, *, count=None, seed=None, sample_rate=None, preset=None, trim=None,
@@ -470,6 +507,13 @@ fn render_variations<'py>(
     let actuator = actuator_profile(actuator, felt)?;
     let trim_db = trim_of(trim)?;
     let level = level_target(loudness, true_peak)?;
+    // What the command line's manifest records of the same call.
+    let options = TakeOptions {
+        trim_db,
+        loudness_lufs: level.loudness_lufs,
+        true_peak_dbtp: level.true_peak_dbtp,
+        haptic_peak: None,
+    };
     if let Some(count) = count.filter(|count| !(1..=MAX_TAKES).contains(count)) {
         return Err(SakeGlugError::new_err(format!(
             "count = {count}: a set has 1 to {MAX_TAKES} takes"
@@ -521,9 +565,10 @@ fn render_variations<'py>(
         let measured = measured.expect("render_levelled measures every take");
         // The manifest's row, but for the file name a set of samples has not.
         let row = PyDict::new(py);
-        for (column, cell) in manifest_row(&take, "", count, &measured) {
+        for (column, cell) in manifest_row(&take, "", count, &options, &measured) {
             match cell {
                 _ if column == NAME_COLUMN => {}
+                Cell::Empty => row.set_item(column, py.None())?,
                 Cell::Whole(value) => row.set_item(column, value)?,
                 Cell::Number(value) => row.set_item(column, value)?,
                 Cell::Text(text) => row.set_item(column, text)?,
@@ -633,7 +678,9 @@ fn render_tables<'py>(
     let state_rate = StateRate::new(state_rate)
         .map_err(|error| SakeGlugError::new_err(format!("state_rate: {error}")))?;
     let actuator = actuator_profile(actuator, felt)?;
-    let shaping = Shaping::of(seed, take, trim)?;
+    let mut shaping = Shaping::of(seed, take, trim)?;
+    // A take's row gives its set's trim; the tables' samples are never levelled.
+    shaping.take_options(LevelTarget::default())?;
     let rendered = py.detach(|| {
         let scene = shaping.apply(source.load(preset, sample_rate, actuator.as_ref())?)?;
         // A bound: row k is at sample ⌈k·fs/R⌉, before the end.
@@ -716,18 +763,42 @@ fn columns<'py, R>(
     Ok(table)
 }
 
-/// Fits a model to the recordings of a session file (`sake-glug fit`, MODEL.md §13) and returns
-/// what `sake-glug fit --json` prints (`sake_glug_fit::fit_json`, the same numbers): {"units":
-/// {"detected", "used"}, "explained": {recording: share}, "estimates": {key: {"value", "low",
-/// "high", "n", "in_model", "note"}}, "liquids": {name: {...}}, "warnings": [...]}. Nothing is
-/// written. Raises SakeGlugError with the command line's message. Ctrl-C returns at once; the
-/// fit, which cannot be stopped, runs on in the background and its result is dropped.
+/// Fits a model (`sake-glug fit`, MODEL.md §13) to a session file, or to WAV clips of one bottle
+/// as the command line takes them (`fit("glugs.wav")`, or a list of clips, with `capacity_ml`
+/// and `tilt_deg` as its --capacity-ml and --tilt-deg), and returns what `sake-glug fit --json`
+/// prints (`sake_glug_fit::fit_json`, the same numbers): {"units": {"detected", "used"},
+/// "explained": {recording: share}, "estimates": {key: {"value", "low", "high", "n",
+/// "in_model", "note"}}, "liquids": {name: {...}}, "warnings": [...]}. Nothing is written.
+/// Raises SakeGlugError with the command line's message (a clip option named as the argument
+/// is). Ctrl-C returns at once; the fit, which cannot be stopped, runs on in the background and
+/// its result is dropped.
 #[pyfunction]
-fn fit(py: Python<'_>, session: PathBuf) -> PyResult<Bound<'_, PyAny>> {
+#[pyo3(signature = (inputs, *, capacity_ml=None, tilt_deg=None))]
+fn fit<'py>(
+    py: Python<'py>,
+    inputs: &Bound<'py, PyAny>,
+    capacity_ml: Option<f64>,
+    tilt_deg: Option<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    // One path (str or os.PathLike), or a list of them; a str is never read as a list of letters.
+    let inputs: Vec<PathBuf> = match inputs.extract::<PathBuf>() {
+        Ok(path) => vec![path],
+        Err(_) => inputs.extract().map_err(|_| {
+            PyTypeError::new_err(
+                "fit() takes a session file or a WAV clip (str or os.PathLike), or a list of clips",
+            )
+        })?,
+    };
     let fitted = interruptible(py, move || {
-        FitSession::load(&session).and_then(|session| fit_session(&session))
+        FitSession::from_inputs(&inputs, capacity_ml, tilt_deg)
+            .and_then(|session| fit_session(&session))
     })?
-    .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
+    .map_err(|error| match error {
+        FitError::ClipOption { key, value, why } => {
+            SakeGlugError::new_err(format!("{key}={value}: {why}"))
+        }
+        error => SakeGlugError::new_err(error.to_string()),
+    })?;
     Ok(pythonize::pythonize(py, &fit_json(&fitted))?)
 }
 
@@ -736,8 +807,14 @@ fn fit(py: Python<'_>, session: PathBuf) -> PyResult<Bound<'_, PyAny>> {
 /// Mosteller's "fit" test and the participants' "agreement" test, as a dict. Ctrl-C returns at
 /// once (the analysis runs on in the background, its result dropped).
 #[pyfunction]
-fn analyze_paired(py: Python<'_>, logs: Vec<PathBuf>) -> PyResult<Bound<'_, PyAny>> {
-    let analysis = interruptible(py, move || analyze_paired_logs(&logs))?
+#[pyo3(signature = (logs, *, dry_run_logs=false))]
+fn analyze_paired(
+    py: Python<'_>,
+    logs: Vec<PathBuf>,
+    dry_run_logs: bool,
+) -> PyResult<Bound<'_, PyAny>> {
+    let dry_runs = dry_runs(dry_run_logs);
+    let analysis = interruptible(py, move || analyze_paired_logs(&logs, dry_runs))?
         .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
     Ok(pythonize::pythonize(py, &paired_json(&analysis))?)
 }
@@ -749,14 +826,16 @@ fn analyze_paired(py: Python<'_>, logs: Vec<PathBuf>) -> PyResult<Bound<'_, PyAn
 /// line's options. Ctrl-C returns at once (the analysis runs on in the background, its result
 /// dropped).
 #[pyfunction]
-#[pyo3(signature = (logs, *, resamples=None, seed=None, lapse=None))]
+#[pyo3(signature = (logs, *, resamples=None, seed=None, lapse=None, dry_run_logs=false))]
 fn analyze_constant<'py>(
     py: Python<'py>,
     logs: Vec<PathBuf>,
     resamples: Option<&Bound<'py, PyInt>>,
     seed: Option<u64>,
     lapse: Option<f64>,
+    dry_run_logs: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let dry_runs = dry_runs(dry_run_logs);
     let defaults = PsychometricOptions::default();
     let resamples = match resamples {
         None => defaults.resamples,
@@ -773,7 +852,7 @@ fn analyze_constant<'py>(
         seed: seed.unwrap_or(defaults.seed),
         max_lapse: lapse.unwrap_or(defaults.max_lapse),
     };
-    let analysis = interruptible(py, move || analyze_constant_logs(&logs, &options))?
+    let analysis = interruptible(py, move || analyze_constant_logs(&logs, &options, dry_runs))?
         .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
     Ok(pythonize::pythonize(py, &constant_json(&analysis))?)
 }
@@ -784,10 +863,25 @@ fn analyze_constant<'py>(
 /// (None where infinite or empty) and the plain "sentence", pooled and per participant, as a
 /// dict. Ctrl-C returns at once.
 #[pyfunction]
-fn analyze_discrimination(py: Python<'_>, logs: Vec<PathBuf>) -> PyResult<Bound<'_, PyAny>> {
-    let analysis = interruptible(py, move || analyze_discrimination_logs(&logs))?
+#[pyo3(signature = (logs, *, dry_run_logs=false))]
+fn analyze_discrimination(
+    py: Python<'_>,
+    logs: Vec<PathBuf>,
+    dry_run_logs: bool,
+) -> PyResult<Bound<'_, PyAny>> {
+    let dry_runs = dry_runs(dry_run_logs);
+    let analysis = interruptible(py, move || analyze_discrimination_logs(&logs, dry_runs))?
         .map_err(|error| SakeGlugError::new_err(error.to_string()))?;
     Ok(pythonize::pythonize(py, &discrimination_json(&analysis))?)
+}
+
+/// `dry_run_logs=`: whether an analysis reads a dry run's trials (`--dry-run-logs`); they are
+/// refused by default, and counted in the result's "dry_run_trials".
+fn dry_runs(read: bool) -> DryRuns {
+    match read {
+        true => DryRuns::Read,
+        false => DryRuns::Refused,
+    }
 }
 
 /// Every preset as (id, name, description, scene): the id that render(preset=...) and

@@ -105,3 +105,7 @@ def test_a_levelled_set_is_the_clis_with_each_takes_level(cli, tmp_path):
         assert row["loudness_lufs"] <= -18.0 + 0.05
         # The row, its level columns in it, renders the take again at the same level.
         assert same_bits(sake_glug.render(scene, take=row, loudness=-18.0, true_peak=-1.0), samples)
+        # Its level options are in it too: the row alone renders the take at the set's level.
+        assert row["loudness_target_lufs"] == -18.0 and row["true_peak_ceiling_dbtp"] == -1.0
+        assert same_bits(sake_glug.render(scene, take=row), samples)
+        assert same_bits(sake_glug.render(scene, take=json_row), samples)

@@ -55,14 +55,21 @@ def test_a_set_is_the_clis_set_and_a_row_renders_its_take_again(cli, tmp_path, s
     for (row, samples), cli_row, json_row in zip(takes, rows, manifest["takes"]):
         number = row["take"]
         assert same_bits(samples, read_f32_wav(out / f"set_{number:02d}.wav")), number
-        # The row is the manifest's, value for value (the CSV's text reads back as the same float).
-        assert {key: float(value) for key, value in row.items()} == {
-            key: float(value) for key, value in cli_row.items() if key != "name"
+        # The row is the manifest's, value for value (the CSV's text reads back as the same float;
+        # an option the set was rendered without is empty there, None here).
+        assert {key: None if value is None else float(value) for key, value in row.items()} == {
+            key: float(value) if value else None for key, value in cli_row.items() if key != "name"
         }
+        assert row["trim_db"] == -60.0 and row["loudness_target_lufs"] is None
         assert {**row, "name": f"set_{number:02d}"} == json_row
-        # The row alone renders the take again; so does the CLI's JSON row.
+        # The row alone renders the take again, with the set's trim it records; so does the
+        # CLI's JSON row. A trim that is not the set's is refused.
         assert same_bits(sake_glug.render(set_file, take=row, trim=True), samples)
-        assert same_bits(sake_glug.render(set_file, take=json_row, trim=True), samples)
+        assert same_bits(sake_glug.render(set_file, take=row), samples)
+        assert same_bits(sake_glug.render(set_file, take=json_row), samples)
+        assert same_bits(sake_glug.render_tables(set_file, take=row).samples, samples)
+        with pytest.raises(sake_glug.SakeGlugError, match="the set's takes were rendered with --trim -60"):
+            sake_glug.render(set_file, take=row, trim=-40.0)
     # The same seed, the same set; the count of the call over the scene's.
     again = sake_glug.render_variations(set_file, seed=9, trim=True, count=2)
     assert [row for row, _ in again] == [row for row, _ in takes[:2]]

@@ -11,7 +11,9 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::Duration;
 
-use sake_glug_analysis::{analyze_constant_logs, analyze_paired_logs, PsychometricOptions};
+use sake_glug_analysis::{
+    analyze_constant_logs, analyze_paired_logs, DryRuns, PsychometricOptions,
+};
 use sake_glug_fit::{fit_session, FitSession};
 use sake_glug_model_file::ModelFile;
 use sake_glug_render::Scene;
@@ -74,12 +76,12 @@ fn readers() -> Vec<(&'static str, Reader)> {
                 .map_err(|e| e.to_string())
         }),
         ("paired study log", |bad, _| {
-            analyze_paired_logs(&[bad])
+            analyze_paired_logs(&[bad], DryRuns::Refused)
                 .map(drop)
                 .map_err(|e| e.to_string())
         }),
         ("constant study log", |bad, _| {
-            analyze_constant_logs(&[bad], &PsychometricOptions::default())
+            analyze_constant_logs(&[bad], &PsychometricOptions::default(), DryRuns::Refused)
                 .map(drop)
                 .map_err(|e| e.to_string())
         }),

@@ -73,3 +73,72 @@ fn the_threshold_presets_change_viscosity_alone() {
         );
     }
 }
+
+/// `glass-bottle` fell silent for the last part of its pour with no word why (issue 49): its
+/// text names the amplitude law's V0 by its key, and says true: every unit below V0 is
+/// silent and some are, and with the key at 0 it glugs to the end.
+#[test]
+fn the_glass_bottles_text_says_why_its_pour_ends_silent() {
+    use sake_glug_engine::Constant;
+    let preset = Preset::find("glass-bottle").unwrap();
+    let key = Constant::SilentBelow.quantity().scene_key;
+    assert!(preset.description.contains(key), "{}", preset.description);
+    let config = preset.config(ModelConfig::default());
+    let (v0, pocket_ml) = (
+        Constant::SilentBelow.get(&config),
+        Constant::Pocket.get(&config),
+    );
+    let folder = tempfile::tempdir().unwrap();
+    let scene = Scene::preset_toml(preset);
+    let to_the_end = format!("{scene}\n[amplitude]\nsilent_below_ml = 0.0\n");
+    let mut last_audible_ml = Vec::new();
+    for (name, text) in [("preset", scene), ("to-the-end", to_the_end)] {
+        std::fs::write(folder.path().join(format!("{name}.toml")), text).unwrap();
+        let output = crate::command::sake_glug(
+            folder.path(),
+            &[
+                "render",
+                &format!("{name}.toml"),
+                "-o",
+                &format!("units:{name}.csv"),
+            ],
+        );
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let mut units = csv::Reader::from_path(folder.path().join(format!("{name}.csv"))).unwrap();
+        let header = units.headers().unwrap().clone();
+        let column = |wanted: &str| header.iter().position(|c| c == wanted).unwrap();
+        let (volume, audible) = (column("volume_ml"), column("audible"));
+        let rows: Vec<(f64, bool)> = units
+            .records()
+            .map(|row| {
+                let row = row.unwrap();
+                (row[volume].parse().unwrap(), &row[audible] == "1")
+            })
+            .collect();
+        if name == "preset" {
+            assert!(
+                rows.iter().all(|&(ml, heard)| ml >= v0 || !heard),
+                "a glug below V0"
+            );
+            assert!(
+                rows.iter().any(|&(ml, _)| ml < v0),
+                "no unit below V0 ({v0} ml)"
+            );
+        }
+        last_audible_ml.push(
+            rows.iter()
+                .filter(|(_, heard)| *heard)
+                .map(|(ml, _)| *ml)
+                .fold(f64::INFINITY, f64::min),
+        );
+    }
+    // At 0 the last glug comes with the bottle all but empty: less than a pocket left.
+    assert!(
+        last_audible_ml[1] < pocket_ml && last_audible_ml[0] >= v0,
+        "{last_audible_ml:?}"
+    );
+}

@@ -16,7 +16,9 @@ use std::sync::OnceLock;
 
 use proptest::prelude::*;
 
-use sake_glug_analysis::{analyze_constant_logs, analyze_paired_logs, PsychometricOptions};
+use sake_glug_analysis::{
+    analyze_constant_logs, analyze_paired_logs, DryRuns, PsychometricOptions,
+};
 use sake_glug_fit::FitSession;
 use sake_glug_model_file::ModelFile;
 use sake_glug_study::{
@@ -177,6 +179,7 @@ impl ResumeBase {
             seed: self.seed,
             trials: &self.trials,
             rendered: &self.rendered,
+            dry_run: false,
         }
     }
 }
@@ -230,9 +233,9 @@ proptest! {
         std::fs::write(&log, mutate(base, &edits)).unwrap();
         let refused = if constant {
             let options = PsychometricOptions { resamples: 20, ..PsychometricOptions::default() };
-            analyze_constant_logs(&[&log], &options).err()
+            analyze_constant_logs(&[&log], &options, DryRuns::Refused).err()
         } else {
-            analyze_paired_logs(&[&log]).err()
+            analyze_paired_logs(&[&log], DryRuns::Refused).err()
         };
         if let Some(error) = refused {
             assert_clean("study log", &error.to_string());
@@ -287,9 +290,9 @@ fn the_bases_are_valid() {
                 resamples: 20,
                 ..PsychometricOptions::default()
             };
-            analyze_constant_logs(&[&log], &options).unwrap();
+            analyze_constant_logs(&[&log], &options, DryRuns::Refused).unwrap();
         } else {
-            analyze_paired_logs(&[&log]).unwrap();
+            analyze_paired_logs(&[&log], DryRuns::Refused).unwrap();
         }
     }
 }

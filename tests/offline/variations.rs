@@ -142,15 +142,17 @@ fn a_take_renders_again_bit_for_bit_from_its_row_alone() {
     assert_eq!(
         header,
         "take,name,seed,tilt_end_deg,ramp_s,viscosity_c,fill_percent,pour_time_s,glug.f1_hz,\
-         loudness_lufs,true_peak_dbtp"
+         trim_db,loudness_target_lufs,true_peak_ceiling_dbtp,haptic_peak,loudness_lufs,\
+         true_peak_dbtp"
     );
     let row = lines.nth(2).unwrap();
     assert!(row.starts_with("3,set_03,"), "{row}");
     // A manifest of that one row, the others gone: the take comes back from it alone, with no
     // --seed (the row's seed is the take's).
     std::fs::write(set.path().join("one.csv"), format!("{header}\n{row}\n")).unwrap();
-    // The manifests as written before each take's level was in them: without its columns.
-    let without_level = |line: &str| line.rsplitn(3, ',').nth(2).unwrap().to_owned();
+    // The manifests as written before each take's options and level were in them: without
+    // their columns (a take from them needs its options typed again).
+    let without_level = |line: &str| line.rsplitn(7, ',').nth(6).unwrap().to_owned();
     std::fs::write(
         set.path().join("old.csv"),
         format!("{}\n{}\n", without_level(header), without_level(row)),
@@ -161,7 +163,18 @@ fn a_take_renders_again_bit_for_bit_from_its_row_alone() {
     let json = std::fs::read_to_string(out.join("set.variations.json")).unwrap();
     let old_json: String = json
         .lines()
-        .filter(|line| !line.contains("\"loudness_lufs\"") && !line.contains("\"true_peak_dbtp\""))
+        .filter(|line| {
+            ![
+                "\"loudness_lufs\"",
+                "\"true_peak_dbtp\"",
+                "\"trim_db\"",
+                "\"loudness_target_lufs\"",
+                "\"true_peak_ceiling_dbtp\"",
+                "\"haptic_peak\"",
+            ]
+            .iter()
+            .any(|key| line.contains(key))
+        })
         .map(|line| format!("{line}\n"))
         .collect();
     let old: serde_json::Value = serde_json::from_str(&old_json).unwrap();
@@ -209,6 +222,87 @@ fn a_take_renders_again_bit_for_bit_from_its_row_alone() {
     );
     assert_eq!(output.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&output.stderr).contains("no take 4"));
+}
+
+/// A set rendered with `--trim`, `--loudness`, `--true-peak` and `--haptic-peak` could not be
+/// remade from its manifest alone: `--take-from` without them gave other files (issue 49). Its
+/// rows record them, `--take-from` applies them, and refuses one typed that differs, naming
+/// both; a recorded option out of its range is refused by its column.
+#[test]
+fn a_take_is_remade_with_its_sets_options_from_the_manifest_alone() {
+    let set = render_set(&[
+        "--seed",
+        "6",
+        "--trim=-50",
+        "--loudness",
+        "-20",
+        "--true-peak",
+        "-2",
+        "--haptic-peak",
+        "-3dB",
+    ]);
+    let out = set.path().join("out");
+    let again = |manifest: &str, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "set.toml",
+            "--take-from",
+            manifest,
+            "-o",
+            "again.wav",
+            "-o",
+            "again.haptic",
+        ];
+        args.extend(extra);
+        sake_glug(set.path(), &args)
+    };
+    for manifest in ["out/set.variations.csv:2", "out/set.variations.json:2"] {
+        // Alone, and with an option typed as the set had it.
+        for extra in [&[][..], &["--loudness", "-20"]] {
+            succeeded(&again(manifest, extra));
+            for extension in ["wav", "haptic"] {
+                let take = std::fs::read(out.join(format!("set_02.{extension}"))).unwrap();
+                let remade = std::fs::read(set.path().join(format!("again.{extension}"))).unwrap();
+                assert!(
+                    take == remade,
+                    "{manifest} {extra:?}: the .{extension} differs"
+                );
+            }
+        }
+    }
+    for (extra, said) in [
+        (
+            &["--loudness", "-16"][..],
+            "--loudness -16: the set's takes were rendered with --loudness -20",
+        ),
+        (
+            &["--trim"],
+            "--trim -60: the set's takes were rendered with --trim -50",
+        ),
+    ] {
+        let output = again("out/set.variations.csv:2", extra);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains(said), "{stderr}");
+    }
+    let csv = std::fs::read_to_string(out.join("set.variations.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap();
+    let trim = header
+        .split(',')
+        .position(|column| column == "trim_db")
+        .unwrap();
+    let mut cells: Vec<&str> = lines.next().unwrap().split(',').collect();
+    cells[trim] = "5";
+    std::fs::write(
+        set.path().join("bad.csv"),
+        format!("{header}\n{}\n", cells.join(",")),
+    )
+    .unwrap();
+    let output = again("bad.csv:1", &[]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("`trim_db` = 5 (--trim)"), "{stderr}");
 }
 
 /// Each take's loudness and true peak are in its manifest's row (CSV and JSON), as measured

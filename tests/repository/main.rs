@@ -81,6 +81,35 @@ fn every_repository_path_named_exists() {
     );
 }
 
+/// Installing the wheel fetches its dependencies from PyPI (issue 49): README.md's Python install
+/// line names each one python/pyproject.toml declares, and PyPI.
+#[test]
+fn the_python_install_line_names_what_pip_fetches() {
+    let pyproject: toml::Table = toml::from_str(&read(Path::new("python/pyproject.toml"))).unwrap();
+    let dependencies = pyproject["project"]["dependencies"]
+        .as_array()
+        .expect("a list of dependencies");
+    let readme = read(Path::new("README.md"));
+    let start = readme
+        .find("- **Python:**")
+        .expect("README's Python install line");
+    let line = &readme[start..];
+    let line = line[..line.find("\n\n").unwrap_or(line.len())].to_lowercase();
+    assert!(line.contains("pypi"), "{line}");
+    for dependency in dependencies {
+        let name = dependency.as_str().unwrap();
+        let name = name
+            .split(|c: char| !(c.is_ascii_alphanumeric() || "-_.".contains(c)))
+            .next()
+            .unwrap()
+            .to_lowercase();
+        assert!(
+            line.contains(&name),
+            "README's Python install line names no {name}: {line}"
+        );
+    }
+}
+
 /// A link to a heading (`page.md#anchor`, or `#anchor` within a page) finds it: every heading of
 /// README.md and docs/ is an anchor as GitHub makes it (lower case, spaces to hyphens, other
 /// punctuation left out), and the pages link to one another by those.

@@ -12,7 +12,7 @@ use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, Normal};
 
 use super::error::AnalysisError;
-use super::log::read_rows;
+use super::log::{read_rows, DryRuns, Rows};
 
 /// The columns the constant-stimuli analysis reads.
 pub const CONSTANT_COLUMNS: [&str; 3] = ["participant", "level", "chose_comparison"];
@@ -194,12 +194,16 @@ pub struct ConstantAnalysis {
     pub pooled: PsychometricFit,
     /// Each participant's, in the order they first appear.
     pub participants: Vec<(String, Result<PsychometricFit, PsychometricFitError>)>,
+    /// How many trials a dry run answered (nothing played): read only with [`DryRuns::Read`].
+    pub dry_run_trials: usize,
 }
 
-/// Reads constant-stimuli logs (columns [`CONSTANT_COLUMNS`], others ignored) and fits them.
+/// Reads constant-stimuli logs (columns [`CONSTANT_COLUMNS`], others ignored) and fits them; a
+/// dry run's trials as `dry_runs` says.
 pub fn analyze_constant_logs(
     files: &[impl AsRef<Path>],
     options: &PsychometricOptions,
+    dry_runs: DryRuns,
 ) -> Result<ConstantAnalysis, AnalysisError> {
     if !(0.0..=MAX_LAPSE).contains(&options.max_lapse) {
         return Err(AnalysisError::Option(format!(
@@ -213,7 +217,10 @@ pub fn analyze_constant_logs(
             options.resamples
         )));
     }
-    let rows = read_rows(files, CONSTANT_COLUMNS)?;
+    let Rows {
+        rows,
+        dry_run_trials,
+    } = read_rows(files, CONSTANT_COLUMNS, dry_runs)?;
     let mut participants: Vec<(String, Vec<(f64, bool)>)> = Vec::new();
     let mut pooled = Vec::with_capacity(rows.len());
     for row in &rows {
@@ -270,6 +277,7 @@ pub fn analyze_constant_logs(
     Ok(ConstantAnalysis {
         pooled: pooled_fit,
         participants,
+        dry_run_trials,
     })
 }
 

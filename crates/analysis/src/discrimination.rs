@@ -20,7 +20,7 @@ use serde::Serialize;
 use statrs::distribution::{Binomial, ContinuousCDF, DiscreteCDF, Normal};
 
 use super::error::AnalysisError;
-use super::log::read_rows;
+use super::log::{read_rows, DryRuns, Rows};
 use super::plan::clopper_pearson;
 
 /// The columns the discrimination analysis reads.
@@ -386,14 +386,20 @@ pub struct DiscriminationAnalysis {
     pub pooled: DiscriminationEstimate,
     /// Each participant's, in the order they first appear.
     pub participants: Vec<(String, DiscriminationEstimate)>,
+    /// How many trials a dry run answered (nothing played): read only with [`DryRuns::Read`].
+    pub dry_run_trials: usize,
 }
 
 /// Reads discrimination logs (columns [`DISCRIMINATION_COLUMNS`], others ignored): every row of
-/// one design, `correct` 1 or 0.
+/// one design, `correct` 1 or 0; a dry run's trials as `dry_runs` says.
 pub fn analyze_discrimination_logs(
     files: &[impl AsRef<Path>],
+    dry_runs: DryRuns,
 ) -> Result<DiscriminationAnalysis, AnalysisError> {
-    let rows = read_rows(files, DISCRIMINATION_COLUMNS)?;
+    let Rows {
+        rows,
+        dry_run_trials,
+    } = read_rows(files, DISCRIMINATION_COLUMNS, dry_runs)?;
     let mut design: Option<(DiscriminationDesign, String, u64)> = None;
     let mut participants: Vec<(String, u32, u32)> = Vec::new();
     for row in &rows {
@@ -459,6 +465,7 @@ pub fn analyze_discrimination_logs(
             .into_iter()
             .map(|(name, right, trials)| (name, estimate_discrimination(design, right, trials)))
             .collect(),
+        dry_run_trials,
     })
 }
 

@@ -27,6 +27,7 @@ pub fn paired_json(analysis: &PairedAnalysis) -> Value {
         "stimuli": analysis.stimuli,
         "participants": analysis.participants.len(),
         "trials": analysis.trials,
+        "dry_run_trials": analysis.dry_run_trials,
         "counts": analysis.counts,
         "proportions": analysis.proportions,
         "z": analysis.z,
@@ -91,6 +92,7 @@ pub fn constant_json(analysis: &ConstantAnalysis) -> Value {
     let mut object = fit_json(&analysis.pooled);
     object["design"] = json!("constant");
     object["participants"] = Value::Object(participants);
+    object["dry_run_trials"] = json!(analysis.dry_run_trials);
     object
 }
 
@@ -173,6 +175,7 @@ pub fn discrimination_json(analysis: &DiscriminationAnalysis) -> Value {
     object["decision_model"] = json!(design.decision_model());
     object["interval"] = json!("profile likelihood, 95 %");
     object["participants"] = Value::Object(participants);
+    object["dry_run_trials"] = json!(analysis.dry_run_trials);
     object
 }
 

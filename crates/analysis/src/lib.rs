@@ -43,6 +43,7 @@ pub use error::AnalysisError;
 pub use json::{
     constant_json, discrimination_json, discrimination_plan_json, paired_json, plan_json,
 };
+pub use log::DryRuns;
 pub use paired::{
     analyze_paired_logs, scale_paired, ChiSquareTest, PairedAnalysis, PairedTrial,
     MAX_PAIRED_STIMULI, PAIRED_COLUMNS,

@@ -3,7 +3,9 @@
 //! A cell the runner marked as text for spreadsheets (a leading `'`) is read as the text it was.
 //! A trial is counted once: a file named twice, or a participant's trial number found twice
 //! (where the logs have a `trial` column), is refused with both places. A practice trial (a
-//! row whose `practice` column, where the logs have one, is 1) is no data, and is left out.
+//! row whose `practice` column, where the logs have one, is 1) is no data, and is left out. A
+//! dry run's trial (`dry_run` 1: answered while nothing played) is no data either: refused,
+//! unless the caller asks to read dry runs ([`DryRuns::Read`]), and then counted.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -18,6 +20,28 @@ const PARTICIPANT: &str = "participant";
 const TRIAL: &str = "trial";
 /// The column that marks a practice trial (1), read where a log has it.
 const PRACTICE: &str = "practice";
+/// The column that marks a dry run's trial (1), read where a log has it.
+const DRY_RUN: &str = "dry_run";
+
+/// Whether an analysis reads the trials of a dry run (`experiment --dry-run`, answered while
+/// nothing played): refused by default, for they are no listening result; read when asked
+/// (`--dry-run-logs`), and counted in the analysis, which says so.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum DryRuns {
+    /// A dry run's trial is refused, naming its file and line.
+    #[default]
+    Refused,
+    /// A dry run's trials are read as any, and counted.
+    Read,
+}
+
+/// The rows an analysis reads, and how many of them are a dry run's.
+pub(crate) struct Rows<const N: usize> {
+    /// Every row read, in order.
+    pub rows: Vec<LogRow<N>>,
+    /// How many of them a dry run answered.
+    pub dry_run_trials: usize,
+}
 
 /// One row of a log: where it is, and the fields of the columns asked for, trimmed, in the order
 /// asked for.
@@ -48,17 +72,21 @@ impl<const N: usize> LogRow<N> {
 }
 
 /// Every row of every log, the fields of `columns` (the first of which is the participant's);
-/// blank lines are skipped.
+/// blank lines are skipped, a dry run's trials refused or counted as `dry_runs` says.
 pub(crate) fn read_rows<const N: usize>(
     files: &[impl AsRef<Path>],
     columns: [&'static str; N],
-) -> Result<Vec<LogRow<N>>, AnalysisError> {
+    dry_runs: DryRuns,
+) -> Result<Rows<N>, AnalysisError> {
     debug_assert_eq!(columns.first(), Some(&PARTICIPANT));
     refuse_repeated_files(files)?;
-    let mut rows = Vec::new();
+    let mut rows = Rows {
+        rows: Vec::new(),
+        dry_run_trials: 0,
+    };
     let mut trials: HashMap<(String, String), (String, u64)> = HashMap::new();
     for file in files {
-        read_file(file.as_ref(), columns, &mut rows, &mut trials)?;
+        read_file(file.as_ref(), columns, dry_runs, &mut rows, &mut trials)?;
     }
     Ok(rows)
 }
@@ -104,7 +132,8 @@ fn identity(file: &Path) -> Option<(u64, u64)> {
 fn read_file<const N: usize>(
     file: &Path,
     columns: [&'static str; N],
-    rows: &mut Vec<LogRow<N>>,
+    dry_runs: DryRuns,
+    rows: &mut Rows<N>,
     trials: &mut HashMap<(String, String), (String, u64)>,
 ) -> Result<(), AnalysisError> {
     let name = shown(file);
@@ -128,12 +157,26 @@ fn read_file<const N: usize>(
     }
     let trial_column = column(TRIAL);
     let practice_column = column(PRACTICE);
+    let dry_run_column = column(DRY_RUN);
     for record in reader.records() {
         let record = record.map_err(|error| row_error(&name, &error, 0))?;
         let line = record.position().map_or(0, |position| position.line());
         let field = |index: usize| from_csv_cell(record.get(index).unwrap_or("").trim()).to_owned();
         if practice_column.is_some_and(|index| field(index) == "1") {
             continue;
+        }
+        if dry_run_column.is_some_and(|index| field(index) == "1") {
+            if dry_runs == DryRuns::Refused {
+                return Err(AnalysisError::Row {
+                    file: name,
+                    line,
+                    message: "a dry run's trial (`dry_run` is 1): it was answered while nothing \
+                              played, so it is no listening result; --dry-run-logs (Python: \
+                              dry_run_logs=True) analyses a dry run's log, said to be one"
+                        .into(),
+                });
+            }
+            rows.dry_run_trials += 1;
         }
         let fields = indices.map(field);
         if let Some(trial) = trial_column.map(field).filter(|trial| !trial.is_empty()) {
@@ -152,7 +195,7 @@ fn read_file<const N: usize>(
             }
             trials.insert(key, (name.clone(), line));
         }
-        rows.push(LogRow {
+        rows.rows.push(LogRow {
             file: name.clone(),
             line,
             fields,

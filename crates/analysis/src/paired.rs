@@ -9,7 +9,7 @@ use serde::Serialize;
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 
 use super::error::AnalysisError;
-use super::log::read_rows;
+use super::log::{read_rows, DryRuns, Rows};
 
 /// The columns the paired analysis reads, in the order of [`PairedTrial`]'s fields.
 pub const PAIRED_COLUMNS: [&str; 4] = ["participant", "first", "second", "answer"];
@@ -75,11 +75,20 @@ pub struct PairedAnalysis {
     pub participants: Vec<String>,
     /// Trials read.
     pub trials: usize,
+    /// How many of them a dry run answered (nothing played): read only with [`DryRuns::Read`].
+    pub dry_run_trials: usize,
 }
 
-/// Reads paired-comparison logs (columns [`PAIRED_COLUMNS`], others ignored) and scales them.
-pub fn analyze_paired_logs(files: &[impl AsRef<Path>]) -> Result<PairedAnalysis, AnalysisError> {
-    let rows = read_rows(files, PAIRED_COLUMNS)?;
+/// Reads paired-comparison logs (columns [`PAIRED_COLUMNS`], others ignored) and scales them;
+/// a dry run's trials as `dry_runs` says.
+pub fn analyze_paired_logs(
+    files: &[impl AsRef<Path>],
+    dry_runs: DryRuns,
+) -> Result<PairedAnalysis, AnalysisError> {
+    let Rows {
+        rows,
+        dry_run_trials,
+    } = read_rows(files, PAIRED_COLUMNS, dry_runs)?;
     let mut trials = Vec::with_capacity(rows.len());
     for row in &rows {
         for (index, column) in PAIRED_COLUMNS.iter().enumerate() {
@@ -112,7 +121,12 @@ pub fn analyze_paired_logs(files: &[impl AsRef<Path>]) -> Result<PairedAnalysis,
             answer,
         });
     }
-    scale_paired(&trials).map_err(|message| AnalysisError::design(files, message))
+    let analysis =
+        scale_paired(&trials).map_err(|message| AnalysisError::design(files, message))?;
+    Ok(PairedAnalysis {
+        dry_run_trials,
+        ..analysis
+    })
 }
 
 /// The most stimuli a paired analysis scales: its matrices grow with the square of the count
@@ -243,6 +257,8 @@ pub fn scale_paired(trials: &[PairedTrial]) -> Result<PairedAnalysis, String> {
         agreement,
         participants,
         trials: trials.len(),
+        // Trials handed in are data; the log reader counts a dry run's.
+        dry_run_trials: 0,
     })
 }
 

@@ -176,7 +176,9 @@ pub const PRESETS: [Preset; 8] = [
         id: "glass-bottle",
         description: "a 720 ml glass bottle of water whose glug falls in pitch as it empties: \
                       f1 follows its headspace as a Helmholtz cavity (γ1 = 0.5) over a bright \
-                      1.15 kHz pocket",
+                      1.15 kHz pocket. Like the paper's bottle it pours its last part without \
+                      a glug, below the amplitude law's V0 (amplitude.silent_below_ml, the \
+                      paper's share of its capacity); 0 there glugs to the end",
         values: &GLASS_BOTTLE,
     },
 ];

@@ -171,6 +171,21 @@ pub enum FitError {
     /// The outputs asked for do not fit the session (one model for several liquids).
     #[error("{0}")]
     Outputs(String),
+    /// The inputs named make no one fit: two session files, a session among clips, the clips'
+    /// capacity or tilt given with a session, or nothing at all.
+    #[error("{0}")]
+    Inputs(&'static str),
+    /// A clips' option out of its range. `key` is its name in a session file (`capacity_ml`,
+    /// `tilt_deg`): the command line's option is `--capacity-ml`, Python's argument the key.
+    #[error("--{} {value}: {why}", key.replace('_', "-"))]
+    ClipOption {
+        /// The session file's key of the option.
+        key: &'static str,
+        /// The value given.
+        value: f64,
+        /// What was expected.
+        why: &'static str,
+    },
 }
 
 /// A path for a message.

@@ -203,6 +203,31 @@ impl FitSession {
         })
     }
 
+    /// What a fit reads, as the command line and Python name it: one session file (a `.toml`
+    /// path), or WAV clips of one bottle ([`Self::of_clips`], with the clips' `capacity_ml` and
+    /// `tilt_deg`, which a session file gives itself).
+    pub fn from_inputs(
+        inputs: &[PathBuf],
+        capacity_ml: Option<f64>,
+        tilt_deg: Option<f64>,
+    ) -> Result<Self, FitError> {
+        let sessions = inputs.iter().filter(|path| is_session_file(path)).count();
+        match (sessions, inputs) {
+            (_, []) => Err(FitError::Inputs(
+                "no recording: name a session file or WAV clips",
+            )),
+            (0, clips) => Self::of_clips(clips, capacity_ml, tilt_deg),
+            (1, [session]) if capacity_ml.is_none() && tilt_deg.is_none() => Self::load(session),
+            (1, [_]) => Err(FitError::Inputs(
+                "the capacity and the tilt are given for clips; a session file gives its own \
+                 (capacity_ml, and each recording's tilt_deg)",
+            )),
+            _ => Err(FitError::Inputs(
+                "give one session file, or WAV clips without one",
+            )),
+        }
+    }
+
     /// A session of clips without a session file: a bottle of `capacity_ml` (default: the
     /// model's) held at `tilt_deg` (default 135°), full at each clip's first sample, one liquid.
     pub fn of_clips(
@@ -210,28 +235,25 @@ impl FitSession {
         capacity_ml: Option<f64>,
         tilt_deg: Option<f64>,
     ) -> Result<Self, FitError> {
-        let first = clips.first().ok_or_else(|| {
-            FitError::Outputs("no recording: name a session file or WAV clips".into())
-        })?;
-        let argument_error = |name: &str, value: f64, why: &str| {
-            FitError::Outputs(format!("--{name} {value}: {why}"))
-        };
+        let first = clips.first().ok_or(FitError::Inputs(
+            "no recording: name a session file or WAV clips",
+        ))?;
         let capacity = Constant::Capacity.quantity();
         let capacity_ml = capacity_ml.unwrap_or(capacity.range.default);
         if !capacity.range.contains(capacity_ml) {
-            return Err(argument_error(
-                "capacity-ml",
-                capacity_ml,
-                "outside the capacity's range (see `sake-glug parameters`)",
-            ));
+            return Err(FitError::ClipOption {
+                key: "capacity_ml",
+                value: capacity_ml,
+                why: "outside the capacity's range (see `sake-glug parameters`)",
+            });
         }
         let tilt_deg = tilt_deg.unwrap_or(REFERENCE_TILT_DEG);
         if !Control::Tilt.range().contains(tilt_deg) {
-            return Err(argument_error(
-                "tilt-deg",
-                tilt_deg,
-                "a tilt lies within 0 to 180 degrees",
-            ));
+            return Err(FitError::ClipOption {
+                key: "tilt_deg",
+                value: tilt_deg,
+                why: "a tilt lies within 0 to 180 degrees",
+            });
         }
         let recordings = clips
             .iter()
@@ -268,10 +290,16 @@ impl FitSession {
     }
 }
 
-/// Whether `name` can name a file `<name>.toml` in any folder, on any system.
+/// Whether `path` names a session file rather than a recording: its extension is `.toml`.
+fn is_session_file(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|extension| extension.eq_ignore_ascii_case("toml"))
+}
+
 /// The longest liquid name: it names a file `<name>.toml`, whose name must fit every system.
 const MAX_LIQUID_CHARS: usize = 64;
 
+/// Whether `name` can name a file `<name>.toml` in any folder, on any system.
 fn is_file_name(name: &str) -> bool {
     !name.is_empty()
         && name.len() <= MAX_LIQUID_CHARS

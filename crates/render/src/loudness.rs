@@ -472,12 +472,28 @@ impl FromStr for HapticPeak {
         } else {
             lower.parse::<f64>()
         };
-        match level {
-            Ok(level) if level > 0.0 && level <= 1.0 + 1e-12 => Ok(Self(level.min(1.0))),
-            _ => Err(format!(
-                "`{text}` is not a drive above 0 and at most full: give a percentage (100%), a \
-                 level in dB (-3dB) or a fraction (0.8)"
-            )),
+        level
+            .ok()
+            .and_then(|level| Self::of_level(level).ok())
+            .ok_or_else(|| {
+                format!(
+                    "`{text}` is not a drive above 0 and at most full: give a percentage (100%), \
+                     a level in dB (-3dB) or a fraction (0.8)"
+                )
+            })
+    }
+}
+
+impl HapticPeak {
+    /// The drive of `level`: above 0, at most full (a hair over, a percentage's or a level in
+    /// dB's rounding, is full).
+    pub fn of_level(level: f64) -> Result<Self, String> {
+        if level > 0.0 && level <= 1.0 + 1e-12 {
+            Ok(Self(level.min(1.0)))
+        } else {
+            Err(format!(
+                "{level} is not a drive above 0 and at most full (1)"
+            ))
         }
     }
 }

@@ -15,12 +15,13 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 use serde_json::value::RawValue;
 
 use super::automation::Automation;
-use super::loudness::Loudness;
+use super::loudness::{check_loudness, check_true_peak, HapticPeak, Loudness};
 use super::scene::variations_table::known_keys;
 pub use super::scene::variations_table::{
     VariationError, VariationSpec, Varied, COUNT_KEY, MAX_TAKES, VARIATIONS_KEY,
 };
 use super::scene::Scene;
+use super::trim::check_trim_db;
 use sake_glug_engine::config;
 use sake_glug_io::read::{self, InputKind};
 use sake_glug_io::text::printable;
@@ -48,9 +49,93 @@ pub fn is_measured_column(column: &str) -> bool {
     MEASURED_COLUMNS.iter().any(|&(name, _)| name == column)
 }
 
+/// The options a set was rendered with that change its takes' samples beyond the scene and each
+/// take's draws (MODEL.md §10.2): recorded in every row of its manifest (empty where not
+/// given), and applied to a take rendered again from its row.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct TakeOptions {
+    /// `--trim`'s level (dB re the file's peak).
+    pub trim_db: Option<f64>,
+    /// `--loudness` (LUFS).
+    pub loudness_lufs: Option<f64>,
+    /// `--true-peak` (dBTP).
+    pub true_peak_dbtp: Option<f64>,
+    /// `--haptic-peak`, as its level (above 0, at most 1).
+    pub haptic_peak: Option<f64>,
+}
+
+/// A recorded option: its manifest column, the command line's option that sets it, its field
+/// of [`TakeOptions`], and its check (the option's own).
+pub type OptionColumn = (
+    &'static str,
+    &'static str,
+    fn(&mut TakeOptions) -> &mut Option<f64>,
+    fn(f64) -> Result<f64, String>,
+);
+
+/// The options a manifest records, each a column, between the drawn values and
+/// [`MEASURED_COLUMNS`].
+pub const OPTION_COLUMNS: [OptionColumn; 4] = [
+    (
+        "trim_db",
+        "--trim",
+        |options| &mut options.trim_db,
+        |db| check_trim_db(db).map_err(|error| error.to_string()),
+    ),
+    (
+        "loudness_target_lufs",
+        "--loudness",
+        |options| &mut options.loudness_lufs,
+        check_loudness,
+    ),
+    (
+        "true_peak_ceiling_dbtp",
+        "--true-peak",
+        |options| &mut options.true_peak_dbtp,
+        check_true_peak,
+    ),
+    (
+        "haptic_peak",
+        "--haptic-peak",
+        |options| &mut options.haptic_peak,
+        |level| HapticPeak::of_level(level).map(HapticPeak::level),
+    ),
+];
+
+impl TakeOptions {
+    /// The options a take rendered again from its row is rendered with: the row's (`recorded`;
+    /// `None` for a manifest written before they were recorded, which leaves `typed` as given).
+    /// An option typed that differs from the row's is refused, naming both: the take would not
+    /// be the set's.
+    pub fn resolve(
+        mut typed: TakeOptions,
+        recorded: Option<TakeOptions>,
+    ) -> Result<TakeOptions, VariationError> {
+        let Some(mut recorded) = recorded else {
+            return Ok(typed);
+        };
+        for (_, option, field, _) in OPTION_COLUMNS {
+            let (now, then) = (*field(&mut typed), *field(&mut recorded));
+            if let Some(now) = now.filter(|&now| Some(now) != then) {
+                let set = match then {
+                    Some(then) => format!("with {option} {then}"),
+                    None => format!("without {option}"),
+                };
+                return Err(VariationError::Row(format!(
+                    "{option} {now}: the set's takes were rendered {set}, which its manifest \
+                     records; leave {option} out to render the take as the set did"
+                )));
+            }
+        }
+        Ok(recorded)
+    }
+}
+
 /// A cell of a manifest's row.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Cell {
+    /// An option not given: empty in the CSV, `null` in the JSON, `None` in Python.
+    Empty,
     /// A whole number (the take's number, its seed).
     Whole(u64),
     /// Text (the take's name).
@@ -63,6 +148,7 @@ pub enum Cell {
 impl Cell {
     fn csv(&self) -> String {
         match self {
+            Cell::Empty => String::new(),
             Cell::Whole(value) => value.to_string(),
             Cell::Text(text) => text.clone(),
             Cell::Number(value) => value.to_string(),
@@ -71,6 +157,7 @@ impl Cell {
 
     fn json(&self) -> serde_json::Value {
         match self {
+            Cell::Empty => serde_json::Value::Null,
             Cell::Whole(value) => (*value).into(),
             Cell::Text(text) => text.as_str().into(),
             // serde_json writes a non-finite number as null.
@@ -81,11 +168,13 @@ impl Cell {
 
 /// A take's row of its set's manifest, column by column: the one list both manifests (the
 /// CSV's header and cells, the JSON's keys and values) and Python's rows are written from.
-/// `take`, `name`, `seed`, each drawn value by its key, then [`MEASURED_COLUMNS`] of `measured`.
+/// `take`, `name`, `seed`, each drawn value by its key, the set's [`OPTION_COLUMNS`] of
+/// `options`, then [`MEASURED_COLUMNS`] of `measured`.
 pub fn manifest_row(
     take: &Take,
     set_name: &str,
     count: u32,
+    options: &TakeOptions,
     measured: &Loudness,
 ) -> Vec<(&'static str, Cell)> {
     let mut row = vec![
@@ -98,6 +187,13 @@ pub fn manifest_row(
             .iter()
             .map(|&(varied, value)| (varied.key(), Cell::Number(value))),
     );
+    let mut options = *options;
+    row.extend(OPTION_COLUMNS.iter().map(|&(column, _, field, _)| {
+        (
+            column,
+            field(&mut options).map_or(Cell::Empty, Cell::Number),
+        )
+    }));
     row.extend(
         MEASURED_COLUMNS
             .iter()
@@ -153,6 +249,9 @@ pub struct Take {
     pub seed: u64,
     /// Each drawn value, in [`Varied::all`]'s order.
     pub values: Vec<(Varied, f64)>,
+    /// The set's options as its row records them; `None` for a take drawn now, or read from a
+    /// manifest written before they were recorded.
+    pub recorded: Option<TakeOptions>,
 }
 
 impl Take {
@@ -173,7 +272,8 @@ impl Take {
         format!("{set_name}_{:0width$}", self.number)
     }
 
-    /// A take from a row's fields (column name, text): `seed` and the varied keys; `take`,
+    /// A take from a row's fields (column name, text): `seed`, the varied keys and the
+    /// [`OPTION_COLUMNS`] (empty for an option not given; each checked as its option); `take`,
     /// `name` and the [`MEASURED_COLUMNS`] are the row's own and change nothing. Unknown columns
     /// and unreadable numbers are refused by name.
     pub fn from_fields<'a>(
@@ -182,8 +282,28 @@ impl Take {
     ) -> Result<Self, VariationError> {
         let mut seed = None;
         let mut values = Vec::new();
+        let mut recorded: Option<TakeOptions> = None;
         for (column, text) in fields {
             let text = text.trim();
+            if let Some(&(_, option, field, check)) =
+                OPTION_COLUMNS.iter().find(|(name, ..)| *name == column)
+            {
+                let options = recorded.get_or_insert_default();
+                if !text.is_empty() && text != "null" {
+                    let value = text
+                        .parse::<f64>()
+                        .map_err(|_| "not a number".to_owned())
+                        .and_then(check)
+                        .map_err(|why| {
+                            VariationError::Row(format!(
+                                "`{column}` = {} ({option}): {why}",
+                                printable(text)
+                            ))
+                        })?;
+                    *field(options) = Some(value);
+                }
+                continue;
+            }
             match column {
                 TAKE_COLUMN | NAME_COLUMN => {}
                 column if is_measured_column(column) => {}
@@ -221,6 +341,7 @@ impl Take {
             number,
             seed,
             values,
+            recorded,
         })
     }
 }
@@ -282,6 +403,7 @@ pub fn draw_takes(ranges: &[(Varied, [f64; 2])], count: u32, master_seed: u64) -
                 number,
                 seed,
                 values,
+                recorded: None,
             }
         })
         .collect()
@@ -289,11 +411,11 @@ pub fn draw_takes(ranges: &[(Varied, [f64; 2])], count: u32, master_seed: u64) -
 
 /// The manifest of a set as CSV: a header ([`manifest_row`]'s columns) and a row per take,
 /// each take with what it measured.
-pub fn manifest_csv(set_name: &str, takes: &[(Take, Loudness)]) -> String {
+pub fn manifest_csv(set_name: &str, options: &TakeOptions, takes: &[(Take, Loudness)]) -> String {
     let count = takes.len() as u32;
     let rows: Vec<_> = takes
         .iter()
-        .map(|(take, measured)| manifest_row(take, set_name, count, measured))
+        .map(|(take, measured)| manifest_row(take, set_name, count, options, measured))
         .collect();
     let Some(first) = rows.first() else {
         return [TAKE_COLUMN, NAME_COLUMN, SEED_COLUMN].join(",") + "\n";
@@ -314,13 +436,14 @@ pub fn manifest_json(
     scene_file: Option<&Path>,
     master_seed: u64,
     ranges: &[(Varied, [f64; 2])],
+    options: &TakeOptions,
     takes: &[(Take, Loudness)],
 ) -> String {
     let count = takes.len() as u32;
     let rows: Vec<serde_json::Value> = takes
         .iter()
         .map(|(take, measured)| {
-            let row = manifest_row(take, set_name, count, measured)
+            let row = manifest_row(take, set_name, count, options, measured)
                 .into_iter()
                 .map(|(column, cell)| (column.to_owned(), cell.json()))
                 .collect();
@@ -457,11 +580,21 @@ mod tests {
         };
         let rows: Vec<(Take, Loudness)> =
             takes.iter().map(|take| (take.clone(), measured)).collect();
-        let csv = manifest_csv("pour", &rows);
-        let json = manifest_json("pour", None, 99, &ranges, &rows);
+        let options = TakeOptions {
+            trim_db: Some(-40.0),
+            true_peak_dbtp: Some(-1.0),
+            haptic_peak: Some(10f64.powf(-3.0 / 20.0)),
+            ..TakeOptions::default()
+        };
+        let csv = manifest_csv("pour", &options, &rows);
+        let json = manifest_json("pour", None, 99, &ranges, &options, &rows);
         for take in &takes {
-            assert_eq!(&take_from_csv(&csv, take.number).unwrap(), take);
-            assert_eq!(&take_from_json(&json, take.number).unwrap(), take);
+            let read = Take {
+                recorded: Some(options),
+                ..take.clone()
+            };
+            assert_eq!(take_from_csv(&csv, take.number).unwrap(), read);
+            assert_eq!(take_from_json(&json, take.number).unwrap(), read);
         }
         assert_eq!(takes[6].name("pour", 12), "pour_07");
     }

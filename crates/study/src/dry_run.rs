@@ -1,5 +1,6 @@
-//! The dry run's folder: every trial's stimuli (two, or three in the triangle and ABX) as mono 32-bit float WAV files, with the
-//! trial list, written all or nothing (a temporary folder beside the target, renamed onto it).
+//! The dry run's folder: every trial's stimuli (two, or three in the triangle and ABX; the
+//! practice trials' too) as mono 32-bit float WAV files, with the trial list, written all or
+//! nothing (a temporary folder beside the target, renamed onto it).
 //!
 //! What it writes is known before it starts, and refused with the figure if the disk has not the
 //! room; a session has at most [`MAX_TRIALS`](crate::MAX_TRIALS) trials, so a dry run at most
@@ -9,7 +10,8 @@
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
-use super::session::StudySession;
+use super::session::{Place, StudySession};
+use super::trials::Trial;
 use super::StudyError;
 use sake_glug_io::text::csv_cell;
 use sake_glug_io::{remove_stale_temps, temp_dir_beside};
@@ -46,6 +48,68 @@ pub fn check_dry_run_folder(dir: &Path) -> Result<(), StudyError> {
     Ok(())
 }
 
+/// The files of a dry run's folder: each trial's stimuli in the order played
+/// (`trial-007-1-model.wav`, …; a practice trial's `practice-001-1-model.wav`, …), and the trial
+/// list, which lists the study's trials.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DryRunFiles {
+    /// The folder.
+    pub folder: PathBuf,
+    /// Each practice trial's files, in the order played.
+    pub practice: Vec<Vec<String>>,
+    /// Each of the study's trials' files.
+    pub trials: Vec<Vec<String>>,
+}
+
+impl DryRunFiles {
+    /// The names `session`'s dry run into `folder` writes (and a resumed one wrote).
+    pub fn planned(session: &StudySession, folder: &Path) -> Self {
+        let names = |kind: &str, trials: &[Trial]| -> Vec<Vec<String>> {
+            trials
+                .iter()
+                .enumerate()
+                .map(|(index, trial)| {
+                    trial
+                        .played()
+                        .zip(1..)
+                        .map(|(stimulus, place)| {
+                            format!(
+                                "{kind}-{:03}-{place}-{}.wav",
+                                index + 1,
+                                file_safe(&session.spec.stimuli[stimulus].name)
+                            )
+                        })
+                        .collect()
+                })
+                .collect()
+        };
+        Self {
+            folder: folder.to_owned(),
+            practice: names("practice", &session.practice()),
+            trials: names("trial", session.trials),
+        }
+    }
+
+    /// The files of the trial at `place`.
+    pub fn of_place(&self, place: Place) -> &[String] {
+        let trials = match place.practice {
+            true => &self.practice,
+            false => &self.trials,
+        };
+        &trials[place.number - 1]
+    }
+
+    /// How many files the folder holds: every trial's and the trial list.
+    pub fn count(&self) -> usize {
+        self.practice
+            .iter()
+            .chain(&self.trials)
+            .map(Vec::len)
+            .sum::<usize>()
+            + 1
+    }
+}
+
 /// Writes `session`'s files into the folder `dir`, which must not exist or be empty. Each
 /// stimulus is written once and every trial's file is a hard link to it (a copy where the
 /// file system has none), so a long session takes the room of its stimuli alone.
@@ -53,7 +117,7 @@ pub fn write_dry_run(
     dir: &Path,
     session: &StudySession,
     sample_rate: u32,
-) -> Result<Vec<PathBuf>, StudyError> {
+) -> Result<DryRunFiles, StudyError> {
     check_dry_run_folder(dir)?;
     let folder_error = |message: String| StudyError::DryRunFolder {
         path: dir.to_owned(),
@@ -68,7 +132,15 @@ pub fn write_dry_run(
         move |source| StudyError::Io { path, source }
     };
     let spec = session.spec;
-    let (list, files) = trial_list(session, dir)?;
+    let files = DryRunFiles::planned(session, dir);
+    let list = trial_list(session, &files)?;
+    let practice = session.practice();
+    // Every trial played, practice first, with its files.
+    let played: Vec<(&Trial, &Vec<String>)> = practice
+        .iter()
+        .zip(&files.practice)
+        .chain(session.trials.iter().zip(&files.trials))
+        .collect();
     let stimulus_bytes: Vec<u64> = session
         .rendered
         .iter()
@@ -114,19 +186,17 @@ pub fn write_dry_run(
             .map_err(io(&path))?;
         stimulus_files.push(path);
     }
-    let mut written = Vec::new();
     let mut copies_checked = false;
-    for (trial, names) in session.trials.iter().zip(&files) {
+    for &(trial, names) in &played {
         for (stimulus, name) in trial.played().zip(names) {
             let path = temp.path().join(name);
             let source = &stimulus_files[stimulus];
             if std::fs::hard_link(source, &path).is_err() {
                 if !copies_checked {
                     // No links here: every trial's file is a copy.
-                    let copies = session
-                        .trials
+                    let copies = played
                         .iter()
-                        .map(|trial| {
+                        .map(|(trial, _)| {
                             trial
                                 .played()
                                 .map(|stimulus| stimulus_bytes[stimulus])
@@ -141,7 +211,6 @@ pub fn write_dry_run(
                 }
                 std::fs::copy(source, &path).map_err(io(&path))?;
             }
-            written.push(dir.join(name));
         }
     }
     for file in &stimulus_files {
@@ -151,7 +220,6 @@ pub fn write_dry_run(
     std::fs::write(&list_path, list)
         .and_then(|()| File::open(&list_path)?.sync_all())
         .map_err(io(&list_path))?;
-    written.push(dir.join(TRIAL_LIST));
     // The names in the folder are durable before it is renamed into place.
     File::open(temp.path())
         .and_then(|folder| folder.sync_all())
@@ -160,19 +228,15 @@ pub fn write_dry_run(
     std::fs::rename(temp.path(), dir).map_err(|error| folder_error(error.to_string()))?;
     // Renamed: nothing left for the guard to remove.
     let _ = temp.keep();
-    Ok(written)
+    Ok(files)
 }
 
-/// The trial list's bytes and each trial's file names, one a stimulus played:
-/// `trial-007-1-model.wav`, ….
-fn trial_list(
-    session: &StudySession,
-    dir: &Path,
-) -> Result<(Vec<u8>, Vec<Vec<String>>), StudyError> {
+/// The trial list's bytes: a row per trial of the study, its stimuli and their `files`.
+fn trial_list(session: &StudySession, files: &DryRunFiles) -> Result<Vec<u8>, StudyError> {
     let spec = session.spec;
     let mut list = csv::Writer::from_writer(Vec::new());
     let list_error = |error: csv::Error| StudyError::Io {
-        path: dir.join(TRIAL_LIST),
+        path: files.folder.join(TRIAL_LIST),
         source: error.into(),
     };
     list.write_record([
@@ -188,19 +252,7 @@ fn trial_list(
         "third_gain_db",
     ])
     .map_err(list_error)?;
-    let mut files = Vec::with_capacity(session.trials.len());
-    for (index, trial) in session.trials.iter().enumerate() {
-        let names: Vec<String> = trial
-            .played()
-            .zip(1..)
-            .map(|(stimulus, place)| {
-                format!(
-                    "trial-{:03}-{place}-{}.wav",
-                    index + 1,
-                    file_safe(&spec.stimuli[stimulus].name)
-                )
-            })
-            .collect();
+    for (index, (trial, names)) in session.trials.iter().zip(&files.trials).enumerate() {
         // The names are the spec's: a spreadsheet shows them as text, never runs them.
         let name = |stimulus: usize| csv_cell(&spec.stimuli[stimulus].name).into_owned();
         let gain = |stimulus: usize| session.rendered[stimulus].gain_db.to_string();
@@ -217,9 +269,8 @@ fn trial_list(
             trial.third.map(gain).unwrap_or_default(),
         ])
         .map_err(list_error)?;
-        files.push(names);
     }
-    Ok((list.into_inner().expect("a Vec never fails"), files))
+    Ok(list.into_inner().expect("a Vec never fails"))
 }
 
 /// The bytes an ordinary user may still write on the file system of `folder`; `None` where the

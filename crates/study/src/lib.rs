@@ -6,8 +6,8 @@
 //! [`render_stimuli`] renders each stimulus once with the offline renderer (or reads a
 //! recording) and matches their levels; a [`StudySession`]
 //! presents the trials through a [`Presenter`] (with feature `audio` a JACK server or an ALSA
-//! device, whose samples come from one mix; or [`Silent`] for a dry run, whose files
-//! [`write_dry_run`] writes), reads each answer and appends it to the [`TrialLog`] at once.
+//! device, whose samples come from one mix; or [`DryRun`] for a dry run, which names the
+//! files [`write_dry_run`] writes and marks the log's rows), reads each answer and appends it to the [`TrialLog`] at once.
 //! `sake-glug analyze` reads that log.
 
 #[cfg(feature = "audio")]
@@ -28,12 +28,12 @@ use std::path::PathBuf;
 
 #[cfg(feature = "audio")]
 pub use alsa_out::{AlsaOutput, AlsaPlayer};
-pub use dry_run::{check_dry_run_folder, write_dry_run, TRIAL_LIST};
+pub use dry_run::{check_dry_run_folder, write_dry_run, DryRunFiles, TRIAL_LIST};
 #[cfg(feature = "audio")]
 pub use jack_out::{JackOutput, JackPlayer};
 pub use log::{header as log_header, LogRow, TrialLog};
 pub use recording::{Recording, RECORDING_RATES_HZ};
-pub use session::{Onsets, Place, Presented, Presenter, Silent, StudySession};
+pub use session::{DryRun, Onsets, Place, Presented, Presenter, Silent, StudySession};
 pub use spec::{
     level_keys, Channels, Design, Discriminate, Equalize, Source, Spec, Stimulus,
     DISCRIMINATE_DESIGNS, MAX_NOISE_DBFS, MAX_PRACTICE, MAX_TRIALS, MIN_NOISE_DBFS, STANDARD,

@@ -7,7 +7,7 @@
 //! spreadsheet would read as a formula are written as text.
 //!
 //! A log an earlier runner wrote lacks the columns added since (`practice`, `correct`, the
-//! third stimulus's): it is resumed in its own columns when the session would leave every
+//! third stimulus's, `dry_run`): it is resumed in its own columns when the session would leave every
 //! missing one blank, else refused, naming them. This module knows rows and files; whether a
 //! row is the session's is the session's to say ([`TrialLog::resume`] takes its check).
 
@@ -75,6 +75,11 @@ pub struct LogRow {
     pub third_onset_frame: Option<u64>,
     /// The third stimulus as the spec defines it.
     pub third_params: Option<String>,
+    /// 1 for a trial of a dry run (nothing was played: its answer is no data, and the analyses
+    /// refuse it unless asked to read dry runs), 0 for a trial played. A log written before the
+    /// column has none: its trials were played, or its dry run was not marked.
+    #[serde(default)]
+    pub dry_run: u8,
 }
 
 impl LogRow {
@@ -320,10 +325,10 @@ fn cells(row: &LogRow) -> Vec<String> {
     record.iter().map(str::to_owned).collect()
 }
 
-/// What a column holds in a row that leaves it blank: nothing, or for `practice` 0 (a log
-/// written before that column holds the study's trials only).
+/// What a column holds in a row that leaves it blank: nothing, or for `practice` and `dry_run`
+/// 0 (a log written before those columns holds the study's trials, played).
 fn blank(column: &str) -> &'static str {
-    if column == "practice" {
+    if ["practice", "dry_run"].contains(&column) {
         "0"
     } else {
         ""
@@ -373,7 +378,8 @@ fn columns_of(found: &[String], planned: &[LogRow]) -> Result<Vec<usize>, String
         }
         return Err(format!(
             "an earlier runner's log: it has no column {}, which this session fills (the \
-             spec's practice trials, whether each answer was right, a third stimulus); finish \
+             spec's practice trials, whether each answer was right, a third stimulus, a dry run's \
+             mark); finish \
              it with the version that began it, or start a new log (`analyze` reads this one as \
              it is)",
             filled.join(", ")
@@ -410,6 +416,7 @@ pub fn header() -> Vec<String> {
             third_gain_db: None,
             third_onset_frame: None,
             third_params: None,
+            dry_run: 0,
         })
         .expect("a Vec never fails");
     let bytes = writer.into_inner().expect("a Vec never fails");

@@ -6,6 +6,7 @@ use std::io::{BufRead, Write};
 use std::path::Path;
 use std::time::Instant;
 
+use super::dry_run::DryRunFiles;
 use super::log::{LogRow, TrialLog};
 use super::spec::{Design, Spec};
 use super::stimuli::Rendered;
@@ -40,6 +41,12 @@ pub struct Presented {
 pub trait Presenter {
     /// Plays the stimuli of `trial` (indices into the rendered stimuli).
     fn present(&mut self, trial: Trial) -> Result<Presented, StudyError>;
+
+    /// What the prompt tells the participant before the trial at `place`: to listen, where the
+    /// presenter plays it.
+    fn cue(&self, _place: Place) -> String {
+        "listen…".into()
+    }
 }
 
 /// Plays nothing: the dry run's answers count from the prompt.
@@ -52,6 +59,24 @@ impl Presenter for Silent {
             onset_frames: None,
             ended: Instant::now(),
         })
+    }
+}
+
+/// A dry run: plays nothing, and cues each trial with the files of its folder to play by hand.
+#[derive(Debug)]
+pub struct DryRun<'a>(pub &'a DryRunFiles);
+
+impl Presenter for DryRun<'_> {
+    fn present(&mut self, trial: Trial) -> Result<Presented, StudyError> {
+        Silent.present(trial)
+    }
+
+    fn cue(&self, place: Place) -> String {
+        format!(
+            "play {} (in {})…",
+            self.0.of_place(place).join(", then "),
+            printable(&self.0.folder.to_string_lossy())
+        )
     }
 }
 
@@ -68,6 +93,8 @@ pub struct StudySession<'a> {
     pub trials: &'a [Trial],
     /// The stimuli, level-matched.
     pub rendered: &'a [Rendered],
+    /// Whether it is a dry run (nothing played): every row it logs is marked so.
+    pub dry_run: bool,
 }
 
 /// A place in a session: its practice trials first, then the study's.
@@ -155,6 +182,7 @@ impl StudySession<'_> {
             third_gain_db: trial.third.map(|third| self.rendered[third].gain_db),
             third_onset_frame: None,
             third_params: third.map(|third| third.params.clone()),
+            dry_run: u8::from(self.dry_run),
         }
     }
 
@@ -200,6 +228,18 @@ impl StudySession<'_> {
                     "a practice trial (1)"
                 } else {
                     "a trial of the study (0)"
+                }
+            ));
+        }
+        if row.dry_run != u8::from(self.dry_run) {
+            return Err(format!(
+                "row {}: dry_run {}, where this session {}",
+                index + 1,
+                row.dry_run,
+                if self.dry_run {
+                    "is a dry run (1)"
+                } else {
+                    "plays its stimuli (0)"
                 }
             ));
         }
@@ -327,7 +367,7 @@ impl StudySession<'_> {
             let of = if place.practice { practice } else { study };
             say(
                 prompt,
-                format_args!("{kind} {}/{of}: listen…\n", place.number),
+                format_args!("{kind} {}/{of}: {}\n", place.number, presenter.cue(*place)),
             );
             let presented = presenter.present(place.trial)?;
             say(prompt, format_args!("{} {keys}: ", self.spec.question));

@@ -236,3 +236,104 @@ fn the_log_and_the_dry_run_make_their_folders() {
     assert_eq!(names(&dir.path().join("runs/p1/dry")).len(), 2 * 12 + 1);
     assert!(dir.path().join("logs/p1/log.csv").is_file());
 }
+
+/// A dry run looked like real data (issue 49): its prompt said "listen…" without naming the
+/// files to play, and `analyze` reported its log as a result. Each trial's prompt now names its
+/// files in the folder (the practice trials' too), each row of the log is marked `dry_run` 1,
+/// and `analyze` refuses such a log unless `--dry-run-logs` is given, and then says so.
+#[test]
+fn a_dry_run_names_its_files_and_its_log_is_no_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = SHORT_PAIRED.replace("equalize = \"peak\"", "equalize = \"peak\"\npractice = 2");
+    std::fs::write(dir.path().join("study.toml"), spec).unwrap();
+    let output = run(
+        dir.path(),
+        &[
+            "study.toml",
+            "--participant",
+            "p1",
+            "--log",
+            "log.csv",
+            "--dry-run",
+            "dry",
+        ],
+        &answers(2 + 12),
+    );
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}");
+    assert!(!stdout.contains("listen"), "{stdout}");
+    let folder = names(&dir.path().join("dry"));
+    let list = super::log_rows(&dir.path().join("dry/trials.csv"));
+    let cued = |line: &str| -> Vec<String> {
+        let files = line
+            .split_once(": play ")
+            .and_then(|(_, rest)| rest.strip_suffix(" (in dry)…"))
+            .unwrap_or_else(|| panic!("no files in `{line}`"));
+        files.split(", then ").map(str::to_owned).collect()
+    };
+    let (mut practice, mut trials) = (0, 0);
+    // A prompt follows the previous trial's question on its line.
+    for line in stdout.lines() {
+        if let Some(at) = line.find("Practice trial ") {
+            let line = &line[at..];
+            practice += 1;
+            let files = cued(line);
+            assert_eq!(files.len(), 2, "{line}");
+            assert!(files.iter().all(|file| folder.contains(file)), "{line}");
+        } else if let Some(at) = line.find("Trial ") {
+            let line = &line[at..];
+            let number: usize = line["Trial ".len()..]
+                .split('/')
+                .next()
+                .unwrap()
+                .parse()
+                .unwrap();
+            let row = &list[number - 1];
+            // The files the trial list gives the trial, in the order played.
+            assert_eq!(cued(line), [&row[3], &row[4]], "{line}");
+            trials += 1;
+        }
+    }
+    assert_eq!(trials, 12, "{stdout}");
+    assert_eq!(practice, 2, "{stdout}");
+    assert_eq!(folder.len(), 2 * 2 + 2 * 12 + 1, "{folder:?}");
+
+    let log = dir.path().join("log.csv");
+    let header = csv::Reader::from_path(&log)
+        .unwrap()
+        .headers()
+        .unwrap()
+        .clone();
+    let dry_run = header
+        .iter()
+        .position(|column| column == "dry_run")
+        .unwrap();
+    assert!(super::log_rows(&log).iter().all(|row| &row[dry_run] == "1"));
+
+    let analyze = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_sake-glug"))
+            .current_dir(dir.path())
+            .args(["analyze", "paired", "log.csv"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let refused = analyze(&[]);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("log.csv, line 4") && stderr.contains("a dry run's trial"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("--dry-run-logs"), "{stderr}");
+    let read = analyze(&["--dry-run-logs", "--json"]);
+    let stderr = String::from_utf8_lossy(&read.stderr);
+    assert!(read.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("warning: 12 of these trials were answered in a dry run"),
+        "{stderr}"
+    );
+    let json: serde_json::Value = serde_json::from_slice(&read.stdout).unwrap();
+    assert_eq!(json["dry_run_trials"], 12);
+    assert_eq!(json["trials"], 12);
+}

@@ -84,7 +84,7 @@ fn instructions_practice_and_breaks_come_as_the_spec_says() {
     // The analysis reads the 12 trials of the study, not the practice.
     let analysed = std::process::Command::new(env!("CARGO_BIN_EXE_sake-glug"))
         .current_dir(dir.path())
-        .args(["analyze", "paired", "--json", "log.csv"])
+        .args(["analyze", "paired", "--json", "--dry-run-logs", "log.csv"])
         .output()
         .unwrap();
     assert!(analysed.status.success());

@@ -260,7 +260,7 @@ fn a_recording_against_its_model_in_two_commands() {
     );
     let analysed = std::process::Command::new(env!("CARGO_BIN_EXE_sake-glug"))
         .current_dir(dir.path())
-        .args(["analyze", "discrimination", "log.csv"])
+        .args(["analyze", "discrimination", "--dry-run-logs", "log.csv"])
         .output()
         .unwrap();
     assert!(analysed.status.success());

@@ -126,7 +126,13 @@ fn a_triangle_and_an_abx_session_log_whether_the_answer_was_right() {
         assert_eq!(files, 3 * trials + 1, "three files a trial and the list");
         let analysed = std::process::Command::new(env!("CARGO_BIN_EXE_sake-glug"))
             .current_dir(dir.path())
-            .args(["analyze", "discrimination", "--json", "log.csv"])
+            .args([
+                "analyze",
+                "discrimination",
+                "--json",
+                "--dry-run-logs",
+                "log.csv",
+            ])
             .output()
             .unwrap();
         assert!(analysed.status.success());
@@ -253,7 +259,7 @@ fn an_earlier_runners_log_resumes_in_its_columns_or_is_refused_by_name() {
     assert!(records.iter().all(|record| record.len() == header.len()));
     let analysed = std::process::Command::new(env!("CARGO_BIN_EXE_sake-glug"))
         .current_dir(dir.path())
-        .args(["analyze", "paired", "old.csv"])
+        .args(["analyze", "paired", "--dry-run-logs", "old.csv"])
         .output()
         .unwrap();
     assert!(
@@ -285,6 +291,33 @@ fn an_earlier_runners_log_resumes_in_its_columns_or_is_refused_by_name() {
         &["tri.csv, line 1", "an earlier runner's log", "`correct`"],
     );
     assert_eq!(std::fs::read(dir.path().join("tri.csv")).unwrap(), before);
+
+    // A log from before the dry run's mark cannot take a dry run's marked rows.
+    std::fs::write(dir.path().join("study.toml"), SHORT_PAIRED).unwrap();
+    let output = session_output(
+        dir.path(),
+        "p1",
+        "unmarked.csv",
+        &["--dry-run", "u"],
+        &format!("\n{}", "1\n".repeat(4)),
+    );
+    assert_eq!(output.status.code(), Some(1));
+    older(&dir.path().join("unmarked.csv"), &["dry_run"]);
+    let output = session_output(
+        dir.path(),
+        "p1",
+        "unmarked.csv",
+        &["--dry-run", "u", "--resume"],
+        "\n1\n",
+    );
+    refused(
+        &output,
+        &[
+            "unmarked.csv, line 1",
+            "an earlier runner's log",
+            "`dry_run`",
+        ],
+    );
 }
 
 /// `experiment … --dry-run DIR` with stdin closed waited for answers and exited 1 (issue 40):

@@ -62,7 +62,13 @@ fn a_2afc_session_logs_whether_the_target_was_chosen_and_is_analysed() {
     }
     let analysed = std::process::Command::new(env!("CARGO_BIN_EXE_sake-glug"))
         .current_dir(dir.path())
-        .args(["analyze", "discrimination", "--json", "log.csv"])
+        .args([
+            "analyze",
+            "discrimination",
+            "--json",
+            "--dry-run-logs",
+            "log.csv",
+        ])
         .output()
         .unwrap();
     assert!(
