@@ -1,11 +1,12 @@
 //! A benchmark's report, written with the commit and the processor it measured to
-//! `<target>/bench-NAME.md`, which `cargo xtask docs` copies into the docs: one writer for every
+//! `<target>/bench-<name>.md`, which `cargo xtask docs` copies into the docs: one writer for every
 //! benchmark that reports.
 
 use std::process::Command;
 
-/// Writes `lines`, the report of `cargo bench --bench NAME`, to `<target>/bench-NAME.md` (the
-/// target directory is found from this executable's path, `<target>/release/deps/NAME-…`).
+/// Writes `lines`, the report of the benchmark `name` (`cargo bench --bench capi` reports as
+/// "capi"), to `<target>/bench-<name>.md` (the target directory is found from this executable's
+/// path, `<target>/release/deps/<name>-…`).
 pub fn save(name: &str, lines: &str) {
     let Some(target) = std::env::current_exe()
         .ok()

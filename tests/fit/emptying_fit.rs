@@ -8,7 +8,8 @@
 use std::path::Path;
 
 use sake_glug_engine::{Constant, Control};
-use sake_glug_fit::compare::{compare, Comparison};
+use sake_glug_fit::compare::Comparison;
+use sake_glug_fit::comparisons::compare;
 use sake_glug_fit::{fit_session, FitSession, SessionFit};
 
 use super::emptying::{helmholtz_hz, simulate, Params, Simulated};

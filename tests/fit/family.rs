@@ -20,7 +20,7 @@ use std::fmt::Write as _;
 use std::ops::Range;
 
 use sake_glug_engine::Constant;
-use sake_glug_fit::compare::compare;
+use sake_glug_fit::comparisons::compare;
 use sake_glug_fit::{fit_session, FitSession, SessionFit};
 use sake_glug_render::Scene;
 

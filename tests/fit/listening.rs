@@ -14,7 +14,7 @@
 
 use std::path::{Path, PathBuf};
 
-use sake_glug_fit::compare::compare_recording;
+use sake_glug_fit::comparisons::compare_recording;
 use sake_glug_fit::{fit_session, FitSession, Listened, Source};
 
 /// The clips of the development half that the first fits were tested on (the rest of it is in

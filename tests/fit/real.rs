@@ -11,7 +11,8 @@
 use std::f64::consts::TAU;
 use std::path::PathBuf;
 
-use sake_glug_fit::compare::{compare, Comparison};
+use sake_glug_fit::compare::Comparison;
+use sake_glug_fit::comparisons::compare;
 use sake_glug_fit::{
     fit_session, Audio, FitError, FitSession, SessionFit, AT_PEAK_SHARE, LOW_EXPLAINED,
 };

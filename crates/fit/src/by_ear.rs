@@ -13,8 +13,7 @@ use sake_glug_engine::{Constant, Control};
 use sake_glug_io::keys;
 
 use super::compare::{log_spectral_distance, render_table, AsRecorded, ONE_MODE_SPLIT_HZ};
-use super::estimate::Estimate;
-use super::liquid::range_of;
+use super::estimate::{range_of, Estimate};
 use super::listen::{hear, Heard};
 use super::recording::{RecordingFit, LOW_EXPLAINED};
 use super::spectrum::Spectrum;

@@ -10,7 +10,8 @@ use sake_glug_io::PendingFile;
 use sake_glug_plot::plotters::prelude::*;
 use sake_glug_plot::{Canvas, Plot, PlotError, FONT};
 
-use super::compare::{compare_recording, smoothed_db, Comparison};
+use super::compare::{smoothed_db, Comparison};
+use super::comparisons::compare_recording;
 use super::plot::{draw_units_panel, waveform_chart};
 use super::session_fit::SessionFit;
 

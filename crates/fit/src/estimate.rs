@@ -3,6 +3,8 @@
 //! fewer than [`MIN_UNITS_FOR_MODEL`] is not written into the model (its default is kept, with the
 //! reason); one that could not be made, or that lies outside the data, has no value and says why.
 
+use sake_glug_engine::{Constant, Control, Range};
+
 /// The fewest units an interval is given from.
 pub const MIN_UNITS_FOR_INTERVAL: usize = 5;
 /// The fewest units an estimate written into the model comes from.
@@ -131,6 +133,16 @@ impl Estimate {
     pub fn has_value(&self) -> bool {
         self.value.is_finite()
     }
+}
+
+/// The range of the constant or control whose scene key is `key`.
+pub(crate) fn range_of(key: &str) -> Option<Range> {
+    Constant::ALL
+        .iter()
+        .map(|c| c.quantity())
+        .chain(Control::ALL.iter().map(|c| c.quantity()))
+        .find(|q| q.scene_key == key)
+        .map(|q| q.range)
 }
 
 #[cfg(test)]

@@ -13,7 +13,8 @@
 
 use serde_json::{json, Map, Value};
 
-use super::compare::{compare, Comparison};
+use super::compare::Comparison;
+use super::comparisons::compare;
 use super::estimate::Estimate;
 use super::listen::Heard;
 use super::session_fit::SessionFit;

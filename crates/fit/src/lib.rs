@@ -37,6 +37,7 @@ mod weight;
 mod write;
 
 pub mod compare;
+pub mod comparisons;
 
 pub use audio::{Audio, FIT_BYTES_PER_SAMPLE, MIN_SAMPLE_RATE_HZ};
 pub use by_ear::{misses, Listened, ListeningFit};

@@ -4,8 +4,8 @@
 
 use super::by_ear::{fit_by_listening, ListeningFit};
 use super::curves::FittedCurves;
-use super::estimate::Estimate;
 use super::estimate::MIN_UNITS_FOR_MODEL;
+use super::estimate::{range_of, Estimate};
 use super::headspace::{fit_law, HeadspaceLaw};
 use super::model_toml::model_toml;
 use super::pour::{intervals, pockets, rate_error};
@@ -13,7 +13,7 @@ use super::recording::{FittedUnit, RecordingFit, LOW_EXPLAINED};
 use super::stats::{bootstrap, iqr, median, Line, NORMAL_IQR};
 use super::units::Modes;
 use sake_glug_engine::curves::REFERENCE_TILT_DEG;
-use sake_glug_engine::{Constant, Control, Curve, Headspace, Range};
+use sake_glug_engine::{Constant, Control, Curve, Headspace};
 
 /// The z of a two-sided 95 % normal interval (a line's rate).
 const Z_95: f64 = 1.959_963_984_540_054;
@@ -587,14 +587,4 @@ fn kept_at_default(estimates: &[Estimate], curves: &FittedCurves) -> Vec<(String
         }
     }
     kept
-}
-
-/// The range of the constant or control whose scene key is `key`.
-pub(crate) fn range_of(key: &str) -> Option<Range> {
-    Constant::ALL
-        .iter()
-        .map(|c| c.quantity())
-        .chain(Control::ALL.iter().map(|c| c.quantity()))
-        .find(|q| q.scene_key == key)
-        .map(|q| q.range)
 }

@@ -10,10 +10,10 @@
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
-use super::session::{Place, StudySession};
+use super::session::{Place, Presented, Presenter, Silent, StudySession};
 use super::trials::Trial;
 use super::StudyError;
-use sake_glug_io::text::csv_cell;
+use sake_glug_io::text::{csv_cell, printable};
 use sake_glug_io::{remove_stale_temps, temp_dir_beside};
 use sake_glug_render::human_bytes;
 
@@ -313,4 +313,22 @@ fn file_safe(name: &str) -> String {
             }
         })
         .collect()
+}
+
+/// A dry run: plays nothing, and cues each trial with the files of its folder to play by hand.
+#[derive(Debug)]
+pub struct DryRun<'a>(pub &'a DryRunFiles);
+
+impl Presenter for DryRun<'_> {
+    fn present(&mut self, trial: Trial) -> Result<Presented, StudyError> {
+        Silent.present(trial)
+    }
+
+    fn cue(&self, place: Place) -> String {
+        format!(
+            "play {} (in {})…",
+            self.0.of_place(place).join(", then "),
+            printable(&self.0.folder.to_string_lossy())
+        )
+    }
 }

@@ -28,12 +28,12 @@ use std::path::PathBuf;
 
 #[cfg(feature = "audio")]
 pub use alsa_out::{AlsaOutput, AlsaPlayer};
-pub use dry_run::{check_dry_run_folder, write_dry_run, DryRunFiles, TRIAL_LIST};
+pub use dry_run::{check_dry_run_folder, write_dry_run, DryRun, DryRunFiles, TRIAL_LIST};
 #[cfg(feature = "audio")]
 pub use jack_out::{JackOutput, JackPlayer};
 pub use log::{header as log_header, LogRow, TrialLog};
 pub use recording::{Recording, RECORDING_RATES_HZ};
-pub use session::{DryRun, Onsets, Place, Presented, Presenter, Silent, StudySession};
+pub use session::{Onsets, Place, Presented, Presenter, Silent, StudySession};
 pub use spec::{
     level_keys, Channels, Design, Discriminate, Equalize, Source, Spec, Stimulus,
     DISCRIMINATE_DESIGNS, MAX_NOISE_DBFS, MAX_PRACTICE, MAX_TRIALS, MIN_NOISE_DBFS, STANDARD,

@@ -6,7 +6,6 @@ use std::io::{BufRead, Write};
 use std::path::Path;
 use std::time::Instant;
 
-use super::dry_run::DryRunFiles;
 use super::log::{LogRow, TrialLog};
 use super::spec::{Design, Spec};
 use super::stimuli::Rendered;
@@ -59,24 +58,6 @@ impl Presenter for Silent {
             onset_frames: None,
             ended: Instant::now(),
         })
-    }
-}
-
-/// A dry run: plays nothing, and cues each trial with the files of its folder to play by hand.
-#[derive(Debug)]
-pub struct DryRun<'a>(pub &'a DryRunFiles);
-
-impl Presenter for DryRun<'_> {
-    fn present(&mut self, trial: Trial) -> Result<Presented, StudyError> {
-        Silent.present(trial)
-    }
-
-    fn cue(&self, place: Place) -> String {
-        format!(
-            "play {} (in {})…",
-            self.0.of_place(place).join(", then "),
-            printable(&self.0.folder.to_string_lossy())
-        )
     }
 }
 
