@@ -14,6 +14,10 @@
 //! ```sh
 //! SAKE_GLUG_FAMILY_TABLE=family.md cargo test --test fit family -- --ignored --nocapture
 //! ```
+//!
+//! While tuning, `SAKE_GLUG_FAMILY_SEEDS=37,43` fits only those draws of the set, and
+//! `SAKE_GLUG_FAMILY_CLIPS=folder` keeps each draw's clip there (`draw-37.wav`) to look at with
+//! `sake-glug fit`; the goal is held only over the whole set.
 
 use std::f64::consts::{PI, TAU};
 use std::fmt::Write as _;
@@ -379,6 +383,10 @@ fn fit_draw(draw: &Draw) -> Outcome {
     let folder = tempfile::tempdir().unwrap();
     let wav = folder.path().join("clip.wav");
     write_wav(&wav, &simulated.samples, draw.params.sample_rate as u32);
+    if let Some(folder) = std::env::var_os("SAKE_GLUG_FAMILY_CLIPS") {
+        let kept = std::path::Path::new(&folder).join(format!("draw-{}.wav", draw.seed));
+        std::fs::copy(&wav, kept).unwrap();
+    }
     let truth = MEASURES.map(|measure| (measure.truth)(&simulated));
     let fit = FitSession::of_clips(&[wav], Some(draw.params.capacity_ml), None)
         .and_then(|session| fit_session(&session))
@@ -496,9 +504,24 @@ fn markdown(set: &str, outcomes: &[Outcome]) -> String {
 /// Fits every draw of `seeds`, prints the table, writes it where `table_variable` names, and
 /// holds each constant to the goal.
 fn run_family(set: &str, seeds: Range<u64>, table_variable: &str) {
-    let outcomes: Vec<Outcome> = seeds.map(|seed| fit_draw(&draw(seed))).collect();
+    let only: Option<Vec<u64>> = std::env::var("SAKE_GLUG_FAMILY_SEEDS").ok().map(|list| {
+        list.split(',')
+            .map(|seed| {
+                seed.trim()
+                    .parse()
+                    .expect("SAKE_GLUG_FAMILY_SEEDS: seeds, by commas")
+            })
+            .collect()
+    });
+    let outcomes: Vec<Outcome> = seeds
+        .filter(|seed| only.as_ref().is_none_or(|only| only.contains(seed)))
+        .map(|seed| fit_draw(&draw(seed)))
+        .collect();
     let table = markdown(set, &outcomes);
     println!("{table}");
+    if only.is_some() {
+        return;
+    }
     if let Some(path) = std::env::var_os(table_variable) {
         std::fs::write(&path, &table).unwrap();
     }

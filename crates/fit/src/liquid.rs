@@ -259,12 +259,36 @@ fn unit_estimates(units: &[FittedUnit], capacity_ml: f64, pocket_ml: f64) -> Vec
         median(&b[0]),
         median(&b[1]),
         mean_over_modes(&b, &log_sigma),
-        median(&of(&|u| u.fit.viscosity())),
+        viscosity(units),
         silent_below,
         amplitude_spread,
         20.0 * full.log10(),
         r_squared,
     ]
+}
+
+/// c: the median of A1/(A1 + A2) over the units that ring both modes, where at least
+/// [`MIN_UNITS_FOR_SPREAD`] do; else over every unit. A unit ringing one mode beside units that
+/// ring both has lost the other in noise or in the last glug's ring (its short bright mode, tens
+/// of milliseconds long, is the first to go), and would pull c to 0 or 1 (MODEL.md §13).
+fn viscosity(units: &[FittedUnit]) -> f64 {
+    let both: Vec<f64> = units
+        .iter()
+        .filter(|u| u.fit.amplitude.iter().all(|&a| a > 0.0))
+        .map(|u| u.fit.viscosity())
+        .filter(|c| c.is_finite())
+        .collect();
+    if both.len() >= MIN_UNITS_FOR_SPREAD {
+        median(&both)
+    } else {
+        median(
+            &units
+                .iter()
+                .map(|u| u.fit.viscosity())
+                .filter(|c| c.is_finite())
+                .collect::<Vec<_>>(),
+        )
+    }
 }
 
 /// The line Asum = α·V + β through the units whose volume is known.

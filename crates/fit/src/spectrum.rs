@@ -151,6 +151,19 @@ pub fn own_peaks(samples: &[f64], sample_rate: f64) -> Vec<(f64, f64)> {
     Spectrum::of_span(samples, sample_rate).peaks_within(WEAKEST_OWN_PEAK)
 }
 
+/// The strongest peak `(Hz, power)` of a unit's own span at or above `lowest_hz`, if any.
+pub fn own_peak_above(samples: &[f64], sample_rate: f64, lowest_hz: f64) -> Option<(f64, f64)> {
+    let spectrum = Spectrum::of_span(samples, sample_rate);
+    let first_bin = ((lowest_hz.max(LOWEST_PEAK_HZ) / spectrum.bin_hz).ceil() as usize).max(1);
+    (first_bin..spectrum.power.len().saturating_sub(1))
+        .filter(|&bin| {
+            spectrum.power[bin] > spectrum.power[bin - 1]
+                && spectrum.power[bin] >= spectrum.power[bin + 1]
+        })
+        .max_by(|&a, &b| spectrum.power[a].total_cmp(&spectrum.power[b]))
+        .map(|bin| (spectrum.refined_hz(bin), spectrum.power[bin]))
+}
+
 impl Spectrum {
     fn refined_hz(&self, bin: usize) -> f64 {
         let log = |bin: usize| self.power[bin].max(1e-300).ln();

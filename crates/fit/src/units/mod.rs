@@ -466,6 +466,9 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
         fs,
     );
     let mut residual = samples.to_vec();
+    // Per unit kept, where a short mode was found: its place in `detected`, and the unit without
+    // and with it.
+    let mut short_modes: Vec<Option<(usize, UnitFit, UnitFit)>> = Vec::new();
     let mut units = Vec::with_capacity(onsets.len());
     let mut detected = Vec::with_capacity(onsets.len());
     let strides = Strides::for_highest(start_hz[1], fs);
@@ -488,9 +491,12 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
             continue;
         }
         let span = Span::of(&residual, first, end, onset, fs);
-        match fit_unit(&span, start_hz, strides) {
+        match fit_one_way(&span, start_hz, strides) {
             Ok(unit) => {
-                subtract(&mut residual, &unit, fs);
+                let with_short = second_mode::with_second_mode(&span, unit);
+                subtract(&mut residual, &with_short.unwrap_or(unit), fs);
+                short_modes.push(with_short.map(|both| (detected.len(), unit, both)));
+                let unit = with_short.unwrap_or(unit);
                 units.push(unit);
                 detected.push(DetectedUnit {
                     onset_s,
@@ -508,6 +514,18 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
             }
         }
     }
+    // A short mode too few units agree on is left out of every unit (MODEL.md §13).
+    let found: Vec<Option<f64>> = short_modes
+        .iter()
+        .map(|short| short.and_then(|(_, _, both)| both.components[1].map(|c| c.heard_hz)))
+        .collect();
+    let agreed = second_mode::agreed(&found, units.len());
+    for ((unit, short), agreed) in units.iter_mut().zip(&short_modes).zip(agreed) {
+        if let (Some((index, without, _)), false) = (short, agreed) {
+            *unit = *without;
+            detected[*index].fit = Some(*without);
+        }
+    }
     let energy = |signal: &[f32]| signal.iter().map(|&y| f64::from(y).powi(2)).sum::<f64>();
     let explained = 1.0 - energy(&residual) / energy(samples).max(1e-300);
     RecordingUnits {
@@ -518,15 +536,6 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
         spectrum,
         explained,
     }
-}
-
-/// The unit `span` holds: eq. 1 if it describes it, else a phased fit from its own peaks, else
-/// the same in the first part of the span; or why none does, with the best fit rejected. A unit
-/// kept with one component gets the short second mode its fit left out, where there is one (a
-/// unit rejected stays rejected: a second mode found in what a fit could not explain would make
-/// a babble of bubbles look like a glug).
-fn fit_unit(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<UnitFit, Failed> {
-    fit_one_way(span, start_hz, strides).map(|unit| second_mode::with_second_mode(span, unit))
 }
 
 /// The stronger component of `unit` must lie at the strongest peak of the samples it was fitted
@@ -556,7 +565,11 @@ fn at_peak(span: &Span, unit: UnitFit) -> Result<UnitFit, Failed> {
     }
 }
 
-/// [`fit_unit`] without the second mode.
+/// The unit `span` holds: eq. 1 if it describes it, else a phased fit from its own peaks, else
+/// the same in the first part of the span; or why none does, with the best fit rejected. (A unit
+/// kept with one component is then given the short second mode its fit left out, where there is
+/// one; a unit rejected stays rejected: a second mode found in what a fit could not explain would
+/// make a babble of bubbles look like a glug.)
 fn fit_one_way(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<UnitFit, Failed> {
     let at_peak = |unit: UnitFit| at_peak(span, unit);
     let paper = eq1::fit(span, start_hz, strides)

@@ -5,27 +5,45 @@
 //! component is looked at again: where what its fit left out of the unit's first
 //! [`EARLY_S`] peaks at least [`SEPARATE_MODES`] from its component, both are fitted together
 //! there, and the pair is kept if the new component lies above the unit's own and decays faster
-//! (the short bright mode sought) and the pair explains at least [`MIN_GAIN`] more of the span.
+//! (the short bright mode sought) and the pair explains at least [`MIN_EARLY_GAIN`] of what the
+//! one component left of those first [`EARLY_S`], without explaining less of the span. A short
+//! mode is a bottle's only where units enough ring it at one pitch ([`agreed`]); elsewhere each
+//! unit keeps its one component.
 
 use super::eq1;
 use super::modes::SEPARATE_MODES;
 use super::phased;
 use super::window::Span;
 use super::{at_peak, check, Fitted, Placed, Strides, UnitFit};
-use crate::spectrum::own_peaks;
+use crate::spectrum::own_peak_above;
 
 /// The early part of a unit where a short mode is sought (s).
 const EARLY_S: f64 = 0.04;
 /// A short mode's decay where the pencil gives none (1/s): −60 dB in 46 ms.
 const SHORT_DECAY_GUESS_PER_S: f64 = 150.0;
-/// The share of the span's energy the pair must explain beyond the one component: more than any
-/// noise 30 dB down could lend a fit.
-const MIN_GAIN: f64 = 0.05;
+/// The share of what the one component left of the unit's first [`EARLY_S`] that the pair must
+/// explain. A short mode carries little of a 150 ms span's energy (a tenth of the amplitude of a
+/// long mode, decaying ten times faster, is 0.1 % of it) but a share of what is left early;
+/// noise, which a component of four numbers fits only as its share of the hundreds of samples
+/// read (1 % at the fewest), stays below it. A room's ring and the last glug's tail leave much
+/// early that no mode explains, so the share asked is small and the units' agreement decides.
+const MIN_EARLY_GAIN: f64 = 0.05;
+/// The pair may explain this share less of the whole span than the one component (its fit is
+/// weighted to the early part, where the short mode lives).
+const SPAN_SLACK: f64 = 0.02;
 
-/// `unit`, with the short mode its fit left out where there is one.
-pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> UnitFit {
+/// A short mode is the bottle's if at least this many units ring it…
+const MIN_AGREEING_UNITS: usize = 3;
+/// …and at least this share of the units kept…
+const MIN_AGREEING_SHARE: f64 = 0.15;
+/// …within this share of their median pitch: a bubble's size, and so its pitch, varies from glug
+/// to glug (a real bottle's by 15 %), while what noise lends a fit lies anywhere above the mode.
+const AGREEING_PITCH: f64 = 0.25;
+
+/// `unit`, with the short mode its fit left out where there is one (`Some`: the unit with it).
+pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
     let (Some(main), None) = (unit.components[0], unit.components[1]) else {
-        return unit;
+        return None;
     };
     let from = (span.onset - span.first).min(span.samples.len());
     let to = (from + (EARLY_S * span.fs) as usize).min(span.samples.len());
@@ -33,11 +51,12 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> UnitFit {
         .map(|n| span.samples[n] - unit.value_at((span.first + n) as f64 / span.fs))
         .collect();
     if left.len() < 16 {
-        return unit;
+        return None;
     }
-    let apart = |hz: f64| (hz / main.heard_hz).max(main.heard_hz / hz) >= SEPARATE_MODES;
-    let Some(&(short_hz, _)) = own_peaks(&left, span.fs).iter().find(|p| apart(p.0)) else {
-        return unit;
+    // The short mode sought lies above the unit's own; below it lie hum and the skirts of the
+    // long mode's misfit.
+    let Some((short_hz, _)) = own_peak_above(&left, span.fs, main.heard_hz * SEPARATE_MODES) else {
+        return None;
     };
     let strides = Strides::for_highest(short_hz.max(main.heard_hz), span.fs);
     let poles = eq1::pencil_poles(&left, strides.pencil, span.fs);
@@ -49,7 +68,7 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> UnitFit {
         &[(main.frequency_hz, main.decay_per_s), short],
         false,
     ) else {
-        return unit;
+        return None;
     };
     let both = UnitFit::new(
         Fitted {
@@ -75,8 +94,40 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> UnitFit {
         }
         _ => false,
     };
+    let left_by = |fit: &UnitFit| -> f64 {
+        (from..to)
+            .map(|n| (span.samples[n] - fit.value_at((span.first + n) as f64 / span.fs)).powi(2))
+            .sum()
+    };
+    let left_early = left.iter().map(|y| y * y).sum::<f64>();
+    let early_gain = 1.0 - left_by(&both) / left_early.max(1e-300);
     match check(both, span.fs).and_then(|both| at_peak(span, both)) {
-        Ok(both) if two_modes && both.r_squared >= unit.r_squared + MIN_GAIN => both,
-        _ => unit,
+        Ok(both)
+            if two_modes
+                && early_gain >= MIN_EARLY_GAIN
+                && both.r_squared >= unit.r_squared - SPAN_SLACK =>
+        {
+            Some(both)
+        }
+        _ => None,
     }
+}
+
+/// Which of the short modes found (`found[i]`: the pitch of unit i's, Hz) agree, out of `kept`
+/// units: those within [`AGREEING_PITCH`] of the found ones' median, if at least
+/// [`MIN_AGREEING_UNITS`] and [`MIN_AGREEING_SHARE`] of the units kept; else none (a mode heard
+/// in a few units, or at scattered pitches, is noise or a splash, not the bottle's).
+pub(super) fn agreed(found: &[Option<f64>], kept: usize) -> Vec<bool> {
+    let pitches: Vec<f64> = found.iter().flatten().copied().collect();
+    if pitches.is_empty() {
+        return vec![false; found.len()];
+    }
+    let centre = crate::stats::median(&pitches);
+    let agrees = |hz: f64| (hz / centre - 1.0).abs() <= AGREEING_PITCH;
+    let count = pitches.iter().filter(|&&hz| agrees(hz)).count();
+    let enough = count >= MIN_AGREEING_UNITS && count as f64 >= MIN_AGREEING_SHARE * kept as f64;
+    found
+        .iter()
+        .map(|hz| enough && hz.is_some_and(agrees))
+        .collect()
 }
