@@ -55,21 +55,18 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
     }
     // The short mode sought lies above the unit's own; below it lie hum and the skirts of the
     // long mode's misfit.
-    let Some((short_hz, _)) = own_peak_above(&left, span.fs, main.heard_hz * SEPARATE_MODES) else {
-        return None;
-    };
+    let (short_hz, _) = own_peak_above(&left, span.fs, main.heard_hz * SEPARATE_MODES)?;
     let strides = Strides::for_highest(short_hz.max(main.heard_hz), span.fs);
     let poles = eq1::pencil_poles(&left, strides.pencil, span.fs);
     let short = eq1::nearest_pole(&poles, short_hz).unwrap_or((short_hz, SHORT_DECAY_GUESS_PER_S));
     let window = span.window(strides.fit);
-    let Ok(pair) = phased::fit(
+    let pair = phased::fit(
         &window,
         unit.onset_s,
         &[(main.frequency_hz, main.decay_per_s), short],
         false,
-    ) else {
-        return None;
-    };
+    )
+    .ok()?;
     let both = UnitFit::new(
         Fitted {
             onset_s: pair.onset_s,
@@ -130,4 +127,31 @@ pub(super) fn agreed(found: &[Option<f64>], kept: usize) -> Vec<bool> {
         .iter()
         .map(|hz| enough && hz.is_some_and(agrees))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::agreed;
+
+    #[test]
+    fn short_modes_are_the_bottles_only_where_units_enough_agree_on_their_pitch() {
+        // A real bottle's bubbles: three of four units, 15 % apart.
+        let bottle = [Some(1094.0), None, Some(1290.0), Some(1346.0)];
+        assert_eq!(agreed(&bottle, 4), [true, false, true, true]);
+        // One far off the others is left out of them.
+        let one_off = [Some(1300.0), Some(1320.0), Some(1280.0), Some(3900.0)];
+        assert_eq!(agreed(&one_off, 4), [true, true, true, false]);
+        // Scattered pitches (what noise lends a fit) agree on nothing.
+        let scattered = [Some(700.0), Some(1300.0), Some(2600.0), Some(4100.0)];
+        assert_eq!(agreed(&scattered, 4), [false; 4]);
+        // Three a third apart are three pitches, not one bubble's.
+        assert_eq!(
+            agreed(&[Some(900.0), Some(1300.0), Some(1800.0)], 3),
+            [false; 3]
+        );
+        // Two units, or three of forty, are too few.
+        assert_eq!(agreed(&[Some(1300.0), Some(1310.0)], 2), [false; 2]);
+        let few = [Some(1300.0), Some(1310.0), Some(1290.0)];
+        assert_eq!(agreed(&few, 40), [false; 3]);
+    }
 }
