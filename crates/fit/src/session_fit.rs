@@ -11,7 +11,7 @@ use super::pour::{complete_without_weight, pockets, tilt_rates};
 use super::recording::{fit_recording, RecordingFit};
 use super::session::FitSession;
 use super::stats::median;
-use super::units::Modes;
+use super::units::{local_split, Modes, UnitFit};
 use sake_glug_engine::Constant;
 
 /// A whole session, fitted.
@@ -126,8 +126,33 @@ fn assign_modes(recordings: &mut [RecordingFit], members: &[usize]) -> Modes {
                 fit.assign(&modes);
             }
         }
+        if matches!(modes, Modes::Split(_)) {
+            place_lone_modes(recording);
+        }
     }
     modes
+}
+
+/// Puts the component of each unit of `recording` that rings one mode in the mode its neighbours
+/// in time ring there (MODEL.md §13).
+fn place_lone_modes(recording: &mut RecordingFit) {
+    let both: Vec<(f64, [f64; 2])> = recording
+        .units
+        .iter()
+        .filter(|u| u.fit.amplitude.iter().all(|&a| a > 0.0))
+        .map(|u| (u.fit.onset_s, u.fit.frequency_hz))
+        .collect();
+    let lone = |fit: &UnitFit| fit.fitted().count() == 1;
+    for unit in &mut recording.units {
+        if let (true, Some(split)) = (lone(&unit.fit), local_split(unit.fit.onset_s, &both)) {
+            unit.fit.assign(&split);
+        }
+    }
+    for fit in recording.detected.iter_mut().filter_map(|d| d.fit.as_mut()) {
+        if let (true, Some(split)) = (lone(fit), local_split(fit.onset_s, &both)) {
+            fit.assign(&split);
+        }
+    }
 }
 
 /// The error of a liquid none of whose detected units the model describes, with the reasons.

@@ -23,7 +23,7 @@ use std::f64::consts::TAU;
 use super::listen::glug_onsets;
 use super::onsets::detect_onsets;
 use super::spectrum::{own_peaks, Spectrum};
-pub use modes::Modes;
+pub use modes::{local_split, Modes};
 use window::{Span, Window};
 
 /// The fitted span starts this long before the detected onset (s): the silence before a unit

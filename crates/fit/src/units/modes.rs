@@ -87,6 +87,29 @@ impl Modes {
     }
 }
 
+/// The units nearest in time on each side whose modes place a unit ringing one mode.
+const NEIGHBOURS: usize = 2;
+
+/// The split for a unit at `onset_s` that rings one mode, from the units nearest it in time that
+/// ring both (`both`: their onsets (s) and f1, f2, in time order): halfway, in log frequency,
+/// between their median f1 and f2. A falling cavity spreads f1 over an octave or more, so the
+/// split of a liquid's frequencies taken together can put a full bottle's lone f1 above it; its
+/// neighbours' modes place it where it rings. `None` where no unit rings both, or where its
+/// neighbours' modes are not [`SEPARATE_MODES`] apart.
+pub fn local_split(onset_s: f64, both: &[(f64, [f64; 2])]) -> Option<Modes> {
+    let after = both.partition_point(|&(t, _)| t < onset_s);
+    let near = &both[after.saturating_sub(NEIGHBOURS)..(after + NEIGHBOURS).min(both.len())];
+    if near.is_empty() {
+        return None;
+    }
+    let median_of = |k: usize| {
+        let values: Vec<f64> = near.iter().map(|(_, hz)| hz[k]).collect();
+        crate::stats::median(&values)
+    };
+    let (low, high) = (median_of(0), median_of(1));
+    (high / low >= SEPARATE_MODES).then(|| Modes::Split((low * high).sqrt()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
