@@ -15,6 +15,46 @@ use sake_glug_study::{
 #[cfg(feature = "audio")]
 use sake_glug_study::{AlsaOutput, Channels, JackOutput, Presenter};
 
+/// `experiment`'s summary and `--design`'s help, written from the designs' own lists
+/// ([`Design::ALL`], [`DISCRIMINATE_DESIGNS`]) so that a design added shows in `--help`, with
+/// the command that plans a discrimination study.
+pub fn with_designs(command: clap::Command) -> clap::Command {
+    let names = |designs: &[Design]| {
+        let names: Vec<&str> = designs.iter().map(|design| design.name()).collect();
+        names.join(", ")
+    };
+    let about = format!(
+        "Runs a listening study's session for one participant: a spec file's design ({}), or \
+         with --discriminate a recording against its fitted model ({}; plan the participants it \
+         needs with `sake-glug analyze plan discrimination`)",
+        names(&Design::ALL),
+        names(&DISCRIMINATE_DESIGNS)
+    );
+    let designs: Vec<String> = DISCRIMINATE_DESIGNS
+        .iter()
+        .map(|&design| {
+            let arrangements = design.arrangements().unwrap_or(1);
+            let repetitions = Discriminate::default_repetitions(design);
+            format!(
+                "`{}`: {} ({arrangements} arrangements; by default each {repetitions} times, {} \
+                 trials)",
+                design.name(),
+                design.task(),
+                Discriminate::default_trials(design)
+            )
+        })
+        .collect();
+    let design_help = format!(
+        "With --discriminate: the design, one of: {} [default: {}]. `sake-glug analyze plan \
+         discrimination --design DESIGN` says how many participants such a session needs",
+        designs.join("; "),
+        DISCRIMINATE_DESIGNS[0].name()
+    );
+    command
+        .about(about)
+        .mut_arg("design", |arg| arg.help(design_help))
+}
+
 /// The JACK client's name unless `--client-name` gives one.
 const CLIENT_NAME: &str = "sake-glug-experiment";
 /// The ALSA device unless `--alsa-device` names one.
@@ -38,9 +78,8 @@ pub struct ExperimentArgs {
         conflicts_with = "spec"
     )]
     discriminate: Option<Vec<PathBuf>>,
-    /// With --discriminate: the design: `triangle` (three stimuli, two alike: which one is
-    /// different? 6 arrangements), `2afc` (which one is the recording? 2 orders) or `abx` (is
-    /// the third the first or the second? 4 arrangements) [default: triangle].
+    /// With --discriminate: the design (its help is written from the designs' list:
+    /// [`with_designs`]).
     #[arg(long, requires = "discriminate", value_name = "DESIGN")]
     design: Option<String>,
     /// With --discriminate: each stimulus's length (s) [default: 2].

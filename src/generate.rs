@@ -6,7 +6,7 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Args, CommandFactory, Subcommand};
+use clap::{Args, Subcommand};
 use clap_complete::Shell;
 
 #[derive(Args)]
@@ -31,7 +31,7 @@ enum What {
 }
 
 pub fn run(args: GenerateArgs) -> ExitCode {
-    let command = crate::Cli::command();
+    let command = crate::command();
     match args.what {
         What::Man { dir } => match clap_mangen::generate_to(command, &dir) {
             Ok(()) => ExitCode::SUCCESS,

@@ -14,7 +14,7 @@ mod stability;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 use sake_glug_render::Scene;
 
@@ -45,9 +45,10 @@ enum Command {
     /// Fits a model (a scene file) to recordings of a bottle: see MODEL.md §13.
     Fit(fit::FitArgs),
     /// Analyses study logs (Thurstone scaling of paired comparisons, a psychometric fit of
-    /// constant stimuli), or plans a constant-stimuli study by simulation.
+    /// constant stimuli, discrimination), or plans a study by simulation.
     Analyze(analyze::AnalyzeArgs),
-    /// Runs a listening study's session (paired or constant stimuli) for one participant.
+    /// Runs a listening study's session for one participant (its summary is written from the
+    /// designs' list: [`experiment::with_designs`]).
     Experiment(experiment::ExperimentArgs),
     /// Measures an actuator's response on a JACK server (stepped sines out, its accelerometer
     /// in) and writes its profile: see MODEL.md §18.1.
@@ -70,8 +71,15 @@ fn sample_rate_hz(text: &str) -> Result<f64, String> {
         .map_err(|error| error.to_string())
 }
 
+/// The command line as `--help`, the man pages and the completions show it: clap's definition
+/// with the help written from the code's own lists (the study's designs).
+pub fn command() -> clap::Command {
+    Cli::command().mut_subcommand("experiment", experiment::with_designs)
+}
+
 fn main() -> ExitCode {
-    match Cli::parse().command {
+    let cli = Cli::from_arg_matches(&command().get_matches()).unwrap_or_else(|error| error.exit());
+    match cli.command {
         Command::Render(args) => render::run(*args),
         Command::Accuracy(args) => accuracy::run(args),
         Command::Stability(args) => stability::run(args),

@@ -14,6 +14,7 @@ use sake_glug_actuator::{shipped_names, ActuatorProfile};
 use sake_glug_engine::Preset;
 use sake_glug_io::text::{printable, quoted};
 use sake_glug_model_file::ModelFile;
+use sake_glug_render::beyond_fit::beyond_fit;
 use sake_glug_render::clips::HapticBand;
 use sake_glug_render::fidelity::{self, fidelity_table, Fidelity};
 use sake_glug_render::loudness::{
@@ -292,6 +293,7 @@ pub fn run(mut args: RenderArgs) -> ExitCode {
                     outside,
                     fidelity,
                     silent,
+                    beyond_fit,
                 } in takes
                 {
                     for leftover in &report.leftovers {
@@ -301,7 +303,7 @@ pub fn run(mut args: RenderArgs) -> ExitCode {
                             leftover.display()
                         ));
                     }
-                    if let Some(reason) = silent {
+                    for reason in silent.iter().chain(&beyond_fit) {
                         out.error(&format!("warning: {name}: {reason}"));
                     }
                     for clipped in &report.clipped {
@@ -654,13 +656,14 @@ fn output(argument: &str) -> Result<Output, String> {
 
 /// What one file set of a job did (a scene's, or one take's of a set): its name, its report,
 /// the files it read from outside its scene's folder, with --fidelity what every format keeps,
-/// and why it is silent, if it is.
+/// why it is silent, if it is, and why it plays a fitted model beyond its recordings, if it does.
 struct Rendered {
     name: String,
     report: RenderReport,
     outside: Vec<PathBuf>,
     fidelity: Option<Vec<Fidelity>>,
     silent: Option<String>,
+    beyond_fit: Option<String>,
 }
 
 /// What a job did: one file set, or a set of takes with its manifests.
@@ -887,12 +890,14 @@ fn render_one(
         None
     };
     let silent = why_silent(&scene, &report.summary);
+    let beyond_fit = beyond_fit(&scene, &report.summary);
     Ok(Rendered {
         name,
         report,
         outside,
         fidelity,
         silent,
+        beyond_fit,
     })
 }
 

@@ -25,6 +25,7 @@ use sake_glug_analysis::{
 };
 use sake_glug_engine::{Preset, UnitOnset, Voicing, PRESETS};
 use sake_glug_fit::{fit_json, fit_session, FitError, FitSession};
+use sake_glug_render::beyond_fit::beyond_fit;
 use sake_glug_render::loudness::{
     check_loudness, check_true_peak, LevelError, LevelStage, LevelTarget, Loudness,
 };
@@ -335,8 +336,9 @@ fn level_target(loudness: Option<f64>, true_peak: Option<f64>) -> PyResult<Level
     })
 }
 
-/// Warns that a render is silent, with the command line's reason.
-fn warn_silent(py: Python<'_>, reason: &str) -> PyResult<()> {
+/// Warns of a render (silent, or a fitted model played beyond its recordings), with the command
+/// line's sentence.
+fn warn_user(py: Python<'_>, reason: &str) -> PyResult<()> {
     let message = std::ffi::CString::new(reason.replace('\0', " ")).expect("no NUL is left");
     PyErr::warn(py, &py.get_type::<PyUserWarning>(), &message, 1)
 }
@@ -459,12 +461,12 @@ fn render<'py>(
         let mut ticks = Ticks::new(progress, total);
         let rendered = render_levelled(&scene, &level, false, &mut ticks);
         rendered
-            .map(|in_memory| (in_memory.samples, in_memory.silent))
+            .map(|in_memory| (in_memory.samples, in_memory.warnings))
             .map_err(|refused| refused.stopped_by(ticks))
     });
-    let (samples, silent) = rendered.map_err(Refused::into_py)?;
-    if let Some(reason) = silent {
-        warn_silent(py, &reason)?;
+    let (samples, warnings) = rendered.map_err(Refused::into_py)?;
+    for reason in warnings {
+        warn_user(py, &reason)?;
     }
     Ok(PyArray1::from_vec(py, samples))
 }
@@ -554,13 +556,13 @@ fn render_variations<'py>(
         take,
         InMemory {
             samples,
-            silent,
+            warnings,
             measured,
         },
     ) in rendered
     {
-        if let Some(reason) = silent {
-            warn_silent(py, &format!("take {}: {reason}", take.number))?;
+        for reason in warnings {
+            warn_user(py, &format!("take {}: {reason}", take.number))?;
         }
         let measured = measured.expect("render_levelled measures every take");
         // The manifest's row, but for the file name a set of samples has not.
@@ -600,15 +602,19 @@ fn render_levelled(
     let measured = stage.finish().filter(|_| measure).map(|level| level.after);
     Ok(InMemory {
         samples: samples.into_vec(),
-        silent: why_silent(scene, &summary),
+        warnings: why_silent(scene, &summary)
+            .into_iter()
+            .chain(beyond_fit(scene, &summary))
+            .collect(),
         measured,
     })
 }
 
-/// A render held in memory: its samples, why it is silent if it is, what they measure if asked.
+/// A render held in memory: its samples, its warnings (why it is silent if it is, a fitted model
+/// played beyond its recordings), what they measure if asked.
 struct InMemory {
     samples: Vec<f32>,
-    silent: Option<String>,
+    warnings: Vec<String>,
     measured: Option<Loudness>,
 }
 

@@ -5,6 +5,7 @@ import collections
 import itertools
 import threading
 import time
+import warnings
 import _thread
 from pathlib import Path
 
@@ -226,3 +227,14 @@ def test_what_the_progress_callback_raises_stops_the_render_and_is_raised():
 def test_a_progress_callback_must_be_callable():
     with pytest.raises(TypeError, match="progress must be callable or None, not int"):
         sake_glug.render(progress=3)
+
+
+def test_a_fitted_model_played_far_beyond_its_recordings_warns_as_the_cli_does():
+    """A model fitted from glugs at 275–295 ml (`[fit] volumes_ml`), played as a whole pour,
+    warns with the command line's sentence; played within them, it does not (issue 49)."""
+    fitted = {"tilt_deg": 135.0, "fit": {"volumes_ml": [275.0, 295.0]}}
+    with pytest.warns(UserWarning, match=r"its glugs come at .* fitted from glugs at 275–295 ml"):
+        assert sake_glug.render(fitted).size > 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert sake_glug.render({**fitted, "duration_s": 0.9}).size > 0

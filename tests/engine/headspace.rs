@@ -1,8 +1,10 @@
 //! The headspace law of MODEL.md §5.1: each unit's frequencies follow the air above the liquid
-//! as it starts, the draw of §7 on top, and with both exponents at 0 nothing changes.
+//! as it starts, the draw of §7 on top, and with both exponents at 0 nothing changes; a mode the
+//! law drives below 20 Hz is not sounded (§6).
 
-use crate::support::{pour_onsets, tilt_only};
+use crate::support::{pour_onsets, reference_render, render_in_blocks, tilt_only};
 use sake_glug_engine::{Constant, ModelConfig};
+use sake_glug_render::Scene;
 
 fn with_law(exponents: [f64; 2], headspace_ml: f64) -> ModelConfig {
     let mut config = ModelConfig::default();
@@ -77,4 +79,55 @@ fn exponents_of_0_leave_every_unit_as_the_paper_has_it_whatever_the_headspace() 
         5.0,
     );
     assert_eq!(default, still);
+}
+
+/// A law that carries f1 from 80 Hz to 12 Hz as the bottle empties (a law fitted near full,
+/// played to empty), with only f1 sounding (c = 1): from the first unit whose f1 lies below
+/// 20 Hz nothing sounds, on the default path and in the reference, once the last glug above it
+/// has decayed.
+#[test]
+fn a_mode_the_law_drives_below_20_hz_is_not_sounded() {
+    let scene = Scene::parse(
+        r#"
+        deterministic = true
+        duration_s = 6.0
+        tilt_deg = 135.0
+        viscosity_c = 1.0
+        [bottle]
+        headspace_ml = 2.0
+        [glug]
+        f1_headspace_exponent = 0.5
+        "#,
+    )
+    .unwrap();
+    let fs = scene.sample_rate as f64;
+    let (onsets, _) = pour_onsets(fs, scene.config, |_| tilt_only(135.0), 6.0);
+    let below = onsets
+        .iter()
+        // MODEL.md §6's floor, as the model states it.
+        .position(|onset| onset.shape.frequency_hz[0] < 20.0)
+        .expect("the law takes f1 below 20 Hz");
+    assert!(
+        below > 10 && onsets.len() - below > 10,
+        "{below} units above 20 Hz, {} below",
+        onsets.len() - below
+    );
+    // −120 dB of B1 = 45/s takes 0.31 s.
+    let last_above = &onsets[below - 1];
+    let quiet_from = last_above.sample as usize + (0.35 * fs) as usize;
+    let len = (6.0 * fs) as usize;
+    assert!(quiet_from < len - fs as usize);
+    let fast = render_in_blocks(&scene, len, &[512]);
+    let reference = reference_render(&scene, len);
+    assert!(fast[..quiet_from].iter().any(|&y| y != 0.0));
+    let loudest_fast = fast[quiet_from..]
+        .iter()
+        .fold(0.0f32, |m, y| m.max(y.abs()));
+    let loudest_reference = reference[quiet_from..]
+        .iter()
+        .fold(0.0f64, |m, y| m.max(y.abs()));
+    assert!(
+        loudest_fast < 1e-6 && loudest_reference < 1e-6,
+        "units below 20 Hz sound: default path {loudest_fast:e}, reference {loudest_reference:e}"
+    );
 }

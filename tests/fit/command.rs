@@ -313,6 +313,51 @@ fn a_clip_alone_is_fitted_with_every_output() {
     assert!(report.contains("| clip.wav |"), "{report}");
 }
 
+/// A model fitted from the first four glugs of a pour (300 → 280 ml) records the volumes it saw;
+/// played as a whole pour it warns that it goes far beyond them, and played within them it does
+/// not (issue 49).
+#[test]
+fn a_model_of_a_few_glugs_warns_when_played_far_beyond_their_volumes() {
+    let folder = tempfile::tempdir().unwrap();
+    let dir = folder.path();
+    let rendered = render("sample_rate = 25000\ntilt_deg = 135.0\nduration_s = 0.42\n");
+    write_wav(&dir.join("clip.wav"), &rendered.samples, 25_000);
+    let output = sake_glug(dir, &["fit", "clip.wav", "-o", "model.toml"]);
+    assert_refused(&output, 0, &["model.toml"]);
+    let model = sake_glug_model_file::ModelFile::load(&dir.join("model.toml")).unwrap();
+    let fitted = model
+        .fitted_volumes()
+        .expect("the model records its volumes");
+    assert!(
+        (270.0..=285.0).contains(&fitted.lowest_ml) && fitted.highest_ml <= 300.0,
+        "{fitted:?}"
+    );
+    let output = sake_glug(dir, &["render", "model.toml", "-o", "full.wav"]);
+    assert_refused(
+        &output,
+        0,
+        &["warning: model: its glugs come at", "`fit.volumes_ml`"],
+    );
+    // Half a second from full: glugs down to about 270 ml, within the margin.
+    std::fs::write(dir.join("short.toml"), "duration_s = 0.5\n").unwrap();
+    let output = sake_glug(
+        dir,
+        &[
+            "render",
+            "--model",
+            "model.toml",
+            "short.toml",
+            "-o",
+            "short.wav",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        output.status.success() && !stderr.contains("warning"),
+        "{stderr}"
+    );
+}
+
 /// Clips and a session do not mix; the clips' bottle is not a session's.
 #[test]
 fn clip_options_with_a_session_and_mixed_inputs_exit_2() {

@@ -237,6 +237,32 @@ fn bad_arguments_are_errors_not_panics() {
     assert!(files_in(directory.path()).is_empty());
 }
 
+/// `sake-glug --help` and `experiment --help` name every design of the study's own list, each
+/// discrimination design with its task, and the command that plans one (issue 49): a design
+/// added to the list and left out of the help turns this red.
+#[test]
+fn the_help_names_every_design_and_the_plan() {
+    use sake_glug_study::{Design, DISCRIMINATE_DESIGNS};
+    let directory = tempfile::tempdir().unwrap();
+    let help = |args: &[&str]| {
+        let output = sake_glug(directory.path(), args);
+        assert!(output.status.success(), "{args:?}");
+        String::from_utf8(output.stdout).unwrap()
+    };
+    let root = help(&["--help"]);
+    let experiment = help(&["experiment", "--help"]);
+    for text in [&root, &experiment] {
+        for design in Design::ALL {
+            assert!(text.contains(design.name()), "{}: {text}", design.name());
+        }
+        assert!(text.contains("analyze plan discrimination"), "{text}");
+    }
+    for design in DISCRIMINATE_DESIGNS {
+        let named = format!("`{}`: {}", design.name(), design.task());
+        assert!(experiment.contains(&named), "{named}: {experiment}");
+    }
+}
+
 #[test]
 fn the_accuracy_lengths_are_taken_as_the_help_shows_them() {
     let directory = tempfile::tempdir().unwrap();

@@ -110,6 +110,39 @@ fn the_python_install_line_names_what_pip_fetches() {
     }
 }
 
+/// The guide is written for someone who installed a package: no user page shows a command or a
+/// path of a source build (`cargo run`, `target/release`); those are the developer page's. The
+/// README says the tarball unpacks into a folder and that `~/.local/bin` must be on PATH.
+#[test]
+fn the_user_pages_of_the_guide_name_no_source_build() {
+    const SOURCE_BUILD: [&str; 2] = ["cargo run", "target/release"];
+    let pages: Vec<PathBuf> = files_under("docs/guide", "md")
+        .into_iter()
+        .filter(|page| page.file_name() != Some("developer.md".as_ref()))
+        .collect();
+    assert!(pages.len() > 3, "no guide pages found: {pages:?}");
+    let mut found = Vec::new();
+    for page in &pages {
+        for (number, line) in read(page).lines().enumerate() {
+            for source_build in SOURCE_BUILD.iter().filter(|s| line.contains(*s)) {
+                found.push(format!("{}:{}: {source_build}", page.display(), number + 1));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "user pages of the guide name a source build (move it to developer.md):\n{}",
+        found.join("\n")
+    );
+    let readme = read(Path::new("README.md"));
+    for said in ["unpacks into the folder", "~/.local/bin", "PATH"] {
+        assert!(
+            readme.contains(said),
+            "README's install says nothing of {said}"
+        );
+    }
+}
+
 /// A link to a heading (`page.md#anchor`, or `#anchor` within a page) finds it: every heading of
 /// README.md and docs/ is an anchor as GitHub makes it (lower case, spaces to hyphens, other
 /// punctuation left out), and the pages link to one another by those.

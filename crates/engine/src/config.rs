@@ -13,6 +13,10 @@ use super::quantity::{Knob, Quantity, Range, ValueError};
 
 /// Sample rate fs of a render (Hz).
 pub const SAMPLE_RATE_HZ: Range = Range::new(1_000.0, 768_000.0, 48_000.0);
+/// The lowest frequency a component sounds at (Hz, MODEL.md §6): below it a mode is no glug but
+/// a rumble under hearing (a fitted headspace law carried far beyond its recordings can drive f1
+/// there), so it is omitted as one at or above Nyquist is.
+pub const LOWEST_SOUNDING_HZ: f64 = 20.0;
 /// Hard output ceiling (linear amplitude): every output sample stays within ±ceiling.
 pub const CEILING: Range = Range::new(0.001, 1.0, 1.0);
 /// The seed of the random generator of §7 (the plugin's Seed parameter spans it). A scene may
@@ -104,7 +108,7 @@ declare_constants! {
             unit: " Hz",
             scene_key: "glug.f1_hz",
             param_id: "f1",
-            note: "the pocket bouncing in the neck; omitted at or above Nyquist",
+            note: "the pocket bouncing in the neck; omitted below 20 Hz or at or above Nyquist",
             range: Range::new(0.0, 400_000.0, 80.0),
             // Narrower than the engine's range (which only guards against nonsense) but wide
             // enough to reach past Nyquist at 44.1 kHz.
@@ -120,7 +124,7 @@ declare_constants! {
             unit: " Hz",
             scene_key: "glug.f2_hz",
             param_id: "f2",
-            note: "the free pocket's ring; omitted at or above Nyquist",
+            note: "the free pocket's ring; omitted below 20 Hz or at or above Nyquist",
             range: Range::new(0.0, 400_000.0, 300.0),
             knob: Knob::full(1).within(10.0, 24_000.0).skewed(-2.0),
         },

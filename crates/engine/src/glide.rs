@@ -2,6 +2,8 @@
 //! it exponentially, as a real glug sweeps down into the cavity's resonance as the bubble forms,
 //! or up as it rises and shrinks. With both ratios at 1 nothing of it is computed.
 
+use super::config::LOWEST_SOUNDING_HZ;
+
 /// How each component's frequency glides into its own from the unit's onset.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Glide {
@@ -28,6 +30,15 @@ impl Glide {
         } else {
             frequency_hz
         }
+    }
+
+    /// Whether component `index` of a unit whose own frequency is `frequency_hz` sounds at
+    /// `sample_rate` (MODEL.md §6): its own frequency at or above [`LOWEST_SOUNDING_HZ`] and the
+    /// highest it reaches below Nyquist.
+    #[inline]
+    pub fn sounds(&self, index: usize, frequency_hz: f64, sample_rate: f64) -> bool {
+        frequency_hz >= LOWEST_SOUNDING_HZ
+            && self.highest_hz(index, frequency_hz) < 0.5 * sample_rate
     }
 }
 

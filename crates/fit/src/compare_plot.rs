@@ -12,14 +12,32 @@ use sake_glug_plot::{Canvas, Plot, PlotError, FONT};
 
 use super::compare::{smoothed_db, Comparison};
 use super::comparisons::compare_recording;
-use super::plot::{draw_units_panel, waveform_chart};
+use super::listen::Heard;
+use super::plot::{caption_px, draw_units_panel, waveform_chart, CHART_MARGIN_PX};
 use super::session_fit::SessionFit;
 
 const COMPARE_PLOT: Plot = Plot::new("comparison picture", (1600, 1500));
-/// The waveforms' span (s), at most.
-const WAVE_S: f64 = 3.0;
-/// The units overlaid in (d).
+/// The shortest span of the waveforms (s).
+const SHORTEST_WAVE_S: f64 = 0.05;
+/// The units overlaid in (e).
 const UNITS_SHOWN: usize = 4;
+
+/// The waveforms' span (s): the whole clip (the excerpt the fit keeps), so that the time axis
+/// reaches its end.
+fn wave_span_s(samples: usize, sample_rate: f64) -> f64 {
+    (samples as f64 / sample_rate).max(SHORTEST_WAVE_S)
+}
+
+/// Panel (e)'s caption: the units it shows are the first the fit used (rejected ones are left
+/// out), so it says so.
+fn units_caption(shown: usize, used: usize, detected: usize) -> String {
+    let which = if shown < used {
+        format!("the first {shown} of its {used} units used")
+    } else {
+        format!("its {used} units used")
+    };
+    format!("(e) {which} (of {detected} detected), with their fits")
+}
 
 /// Draws the comparison of `fit`'s first recording into `file` (a PNG).
 pub fn draw_compare_plot(fit: &SessionFit, file: &PendingFile) -> Result<(), PlotError> {
@@ -45,7 +63,7 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
     root.fill(&WHITE).map_err(|x| e(&x))?;
     let panels = root.split_evenly((3, 2));
 
-    let span_s = WAVE_S.min(recording.excerpt.len() as f64 / rate).max(0.05);
+    let span_s = wave_span_s(recording.excerpt.len(), rate);
     for (panel, samples, caption) in [
         (
             &panels[0],
@@ -89,11 +107,12 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
         })
         .collect();
     let (low_hz, high_hz) = super::compare::COMPARED_BAND_HZ;
+    const SPECTRA_CAPTION: &str = "(c) spectra, smoothed (dB below each one's peak)";
     let mut chart = ChartBuilder::on(&panels[2])
-        .margin(12)
+        .margin(CHART_MARGIN_PX)
         .caption(
-            "(c) spectra, smoothed (dB below each one's peak)",
-            (FONT, 22),
+            SPECTRA_CAPTION,
+            (FONT, caption_px(&panels[2], SPECTRA_CAPTION)),
         )
         .x_label_area_size(35)
         .y_label_area_size(70)
@@ -131,7 +150,7 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
         let to_s = (last.fit.window.1 as f64 / rate).max(from_s + 0.02);
         draw_units_panel(
             &panels[4],
-            &format!("(e) its first {} units and their fits", units.len()),
+            &units_caption(units.len(), recording.units.len(), recording.detected.len()),
             recording,
             &units,
             from_s..to_s,
@@ -139,6 +158,19 @@ fn draw(fit: &SessionFit, root: &Canvas<'_>) -> Result<(), String> {
     }
     draw_measures_panel(&panels[5], comparison)?;
     Ok(())
+}
+
+/// The points of (d)'s pitch track of one pour: each voiced glug's onset and low pitch (a glug
+/// too quiet or too short to read a pitch is left out, not drawn as a dip).
+fn pitch_track(heard: &Heard) -> Vec<(f64, f64)> {
+    heard
+        .onsets_s
+        .iter()
+        .zip(&heard.pitch_hz)
+        .zip(&heard.voiced)
+        .filter(|&((_, hz), &voiced)| voiced && hz.is_finite())
+        .map(|((&s, &hz), _)| (s, hz))
+        .collect()
 }
 
 /// (d) Each glug's low pitch against time, heard in the recording, the model and the default
@@ -155,31 +187,17 @@ fn draw_pitch_panel(
         .map(|u| (u.fit.onset_s, u.fit.frequency_hz[0]))
         .filter(|(_, hz)| hz.is_finite())
         .collect();
-    let tracks: Vec<Vec<(f64, f64)>> = comparison
-        .heard
-        .iter()
-        .map(|heard| {
-            heard
-                .onsets_s
-                .iter()
-                .copied()
-                .zip(heard.pitch_hz.iter().copied())
-                .filter(|(_, hz)| hz.is_finite())
-                .collect()
-        })
-        .collect();
+    let tracks: Vec<Vec<(f64, f64)>> = comparison.heard.iter().map(pitch_track).collect();
     let every = tracks.iter().flatten().chain(&units);
     let end_s = every.clone().map(|p| p.0).fold(0.1, f64::max) * 1.05;
     let top_hz = every.map(|p| p.1).fold(50.0, f64::max) * 1.15;
+    let caption = format!(
+        "(d) each glug's pitch below {:.0} Hz against time",
+        comparison.split_hz
+    );
     let mut chart = ChartBuilder::on(panel)
-        .margin(12)
-        .caption(
-            format!(
-                "(d) each glug's pitch below {:.0} Hz against time",
-                comparison.split_hz
-            ),
-            (FONT, 22),
-        )
+        .margin(CHART_MARGIN_PX)
+        .caption(&caption, (FONT, caption_px(panel, &caption)))
         .x_label_area_size(35)
         .y_label_area_size(70)
         .build_cartesian_2d(0.0..end_s, 0.0..top_hz)
@@ -279,4 +297,74 @@ fn draw_measures_panel(panel: &Canvas<'_>, comparison: &Comparison) -> Result<()
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sake_glug_plot::plotters::style::IntoTextStyle;
+
+    /// The caption of (b) as a recording at 44.1 kHz gives it: too wide for its panel at the
+    /// full size, it is set smaller until it fits within the margins.
+    #[test]
+    fn a_long_caption_fits_its_panel() {
+        let caption = "(b) the model of `liquid`, rendered as recorded: held at 135°, from 100 % \
+                       full, for 3.13 s at 44100 Hz";
+        let png = COMPARE_PLOT.png(std::path::Path::new("test.png"), |root| {
+            let panels = root.split_evenly((3, 2));
+            let panel = &panels[1];
+            let room = panel.dim_in_pixel().0 - 2 * CHART_MARGIN_PX;
+            let width = |px: u32| {
+                panel
+                    .estimate_text_size(caption, &(FONT, px).into_text_style(panel))
+                    .unwrap()
+                    .0
+            };
+            let px = caption_px(panel, caption);
+            if width(super::super::plot::CAPTION_PX) <= room {
+                return Err("the caption fits at full size: the test shows nothing".to_string());
+            }
+            if width(px) > room {
+                return Err(format!(
+                    "{} px wide at {px} px, {room} px of room",
+                    width(px)
+                ));
+            }
+            Ok(())
+        });
+        png.unwrap();
+    }
+
+    #[test]
+    fn the_waveforms_reach_the_clips_end() {
+        let rate = 44_100.0;
+        let samples = (3.13 * rate) as usize;
+        assert!(wave_span_s(samples, rate) >= samples as f64 / rate);
+    }
+
+    #[test]
+    fn the_units_caption_says_they_are_the_ones_used() {
+        let caption = units_caption(4, 4, 5);
+        assert!(
+            caption.contains("its 4 units used (of 5 detected)"),
+            "{caption}"
+        );
+        let caption = units_caption(4, 9, 12);
+        assert!(
+            caption.contains("the first 4 of its 9 units used"),
+            "{caption}"
+        );
+    }
+
+    #[test]
+    fn the_pitch_track_leaves_out_glugs_not_voiced() {
+        let heard = Heard {
+            onsets_s: vec![0.1, 0.2, 0.3, 0.4],
+            rate_per_s: 10.0,
+            pitch_hz: vec![200.0, 31.0, 190.0, f64::NAN],
+            voiced: vec![true, false, true, true],
+            high_share: 0.1,
+        };
+        assert_eq!(pitch_track(&heard), [(0.1, 200.0), (0.3, 190.0)]);
+    }
 }

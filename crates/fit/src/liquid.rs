@@ -14,6 +14,7 @@ use super::stats::{bootstrap, iqr, median, Line, NORMAL_IQR};
 use super::units::Modes;
 use sake_glug_engine::curves::REFERENCE_TILT_DEG;
 use sake_glug_engine::{Constant, Control, Curve, Headspace};
+use sake_glug_model_file::FittedVolumes;
 
 /// The z of a two-sided 95 % normal interval (a line's rate).
 const Z_95: f64 = 1.959_963_984_540_054;
@@ -387,7 +388,18 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
         }))
         .collect();
     let mut kept_default = kept_default;
-    let mut model = model_toml(liquid, &estimates, inputs.curves, &kept_default, &cautions);
+    let volumes = fitted_volumes(&units);
+    let model_toml = |estimates: &[Estimate], kept_default: &[(String, String)]| {
+        model_toml(
+            liquid,
+            estimates,
+            inputs.curves,
+            volumes,
+            kept_default,
+            &cautions,
+        )
+    };
+    let mut model = model_toml(&estimates, &kept_default);
     let listening = if !units.is_empty() {
         fit_by_listening(&model, &mut estimates, recordings, capacity_ml)
     } else {
@@ -400,7 +412,7 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
             listening.set.join(", ")
         ));
         kept_default = kept_at_default(&estimates, inputs.curves);
-        model = model_toml(liquid, &estimates, inputs.curves, &kept_default, &cautions);
+        model = model_toml(&estimates, &kept_default);
     }
     LiquidFit {
         listening,
@@ -413,6 +425,27 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
         model_toml: model,
         amplitude_law: law,
     }
+}
+
+/// The lowest and highest V_i of the units the model was fitted from, if any has a volume: what
+/// the model file records, so that a render far beyond them warns (MODEL.md §13).
+fn fitted_volumes(units: &[FittedUnit]) -> Option<FittedVolumes> {
+    let volumes = units.iter().map(|u| u.volume_ml).filter(|v| v.is_finite());
+    volumes.fold(None, |range, v| {
+        Some(range.map_or(
+            FittedVolumes {
+                lowest_ml: v,
+                highest_ml: v,
+            },
+            |FittedVolumes {
+                 lowest_ml,
+                 highest_ml,
+             }| FittedVolumes {
+                lowest_ml: lowest_ml.min(v),
+                highest_ml: highest_ml.max(v),
+            },
+        ))
+    })
 }
 
 /// An exponent is written only where its mode follows the headspace measurably, and H only where

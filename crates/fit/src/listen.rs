@@ -36,6 +36,12 @@ const ATTACK_FRAMES: usize = 4;
 const PITCH_SPAN_S: f64 = 0.06;
 /// The lowest pitch read (Hz).
 const LOWEST_PITCH_HZ: f64 = 30.0;
+/// A glug's pitch is voiced (drawn in the comparison's pitch track) where its span's energy is at
+/// least this share of the loudest glug's (−30 dB: a glug, not the bubbles between glugs)…
+const VOICED_ENERGY: f64 = 1e-3;
+/// …and the span holds this many periods of the pitch read (a span cut short by the next onset
+/// or the clip's end reads no pitch).
+const VOICED_PERIODS: f64 = 2.0;
 
 /// What a listener hears of one pour.
 #[derive(Debug, Clone, PartialEq)]
@@ -46,6 +52,9 @@ pub struct Heard {
     pub rate_per_s: f64,
     /// Each glug's low pitch, below the split (Hz; NaN where none is heard).
     pub pitch_hz: Vec<f64>,
+    /// Whether each glug's pitch is voiced: its span loud enough and long enough to read it
+    /// ([`VOICED_ENERGY`], [`VOICED_PERIODS`]); what the comparison's pitch track draws.
+    pub voiced: Vec<bool>,
     /// The share of the energy above the split.
     pub high_share: f64,
 }
@@ -73,7 +82,7 @@ pub fn hear(samples: &[f32], sample_rate: f64, split_hz: f64) -> Heard {
         _ => f64::NAN,
     };
     let span = (PITCH_SPAN_S * sample_rate) as usize;
-    let pitch_hz = onsets
+    let spans: Vec<&[f32]> = onsets
         .iter()
         .enumerate()
         .map(|(i, &from)| {
@@ -83,13 +92,30 @@ pub fn hear(samples: &[f32], sample_rate: f64, split_hz: f64) -> Heard {
                 .unwrap_or(samples.len())
                 .min(from + span)
                 .min(samples.len());
-            low_pitch(&samples[from..to], sample_rate, split_hz)
+            &samples[from..to]
+        })
+        .collect();
+    let pitch_hz: Vec<f64> = spans
+        .iter()
+        .map(|span| low_pitch(span, sample_rate, split_hz))
+        .collect();
+    let energy = |span: &[f32]| {
+        span.iter().map(|&y| f64::from(y).powi(2)).sum::<f64>() / span.len().max(1) as f64
+    };
+    let loudest = spans.iter().map(|span| energy(span)).fold(0.0, f64::max);
+    let voiced = spans
+        .iter()
+        .zip(&pitch_hz)
+        .map(|(span, &hz)| {
+            let periods = hz * span.len() as f64 / sample_rate;
+            energy(span) >= VOICED_ENERGY * loudest && periods >= VOICED_PERIODS
         })
         .collect();
     Heard {
         onsets_s,
         rate_per_s,
         pitch_hz,
+        voiced,
         high_share: high_share(samples, sample_rate, split_hz),
     }
 }
@@ -251,6 +277,27 @@ mod tests {
         );
         let dull = hear(&glugs(9.0, 8, 1.0, fs), fs, 600.0);
         assert!((dull.fall_over(8) - 1.0).abs() < 0.05);
+    }
+
+    /// A clip cut 7 ms into its last glug reads a nonsense pitch there (a few periods of 30 Hz
+    /// do not fit): that glug is not voiced, every whole one is.
+    #[test]
+    fn a_glug_cut_short_is_not_voiced() {
+        let fs = 44_100.0;
+        let whole = glugs(9.0, 4, 1.0, fs);
+        let last_onset = ((0.05 + 3.0 / 9.0) * fs) as usize;
+        let cut = &whole[..last_onset + (0.007 * fs) as usize];
+        let heard = hear(cut, fs, 600.0);
+        assert_eq!(heard.onsets_s.len(), 4, "{:?}", heard.onsets_s);
+        assert_eq!(
+            heard.voiced,
+            [true, true, true, false],
+            "{:?}",
+            heard.pitch_hz
+        );
+        assert!(heard.pitch_hz[..3]
+            .iter()
+            .all(|hz| (hz / 200.0 - 1.0).abs() < 0.05));
     }
 
     #[test]

@@ -265,6 +265,26 @@ pub(crate) fn draw_units_panel(
     Ok(())
 }
 
+/// The margin of a chart in its panel (px).
+pub(crate) const CHART_MARGIN_PX: u32 = 12;
+/// A caption's size (px), unless it must shrink to fit its panel…
+pub(crate) const CAPTION_PX: u32 = 22;
+/// …down to this at the least.
+const SMALLEST_CAPTION_PX: u32 = 12;
+
+/// The largest caption size, from [`CAPTION_PX`] down, at which `caption` fits across `area`
+/// within its margins, so that no caption is cut at the panel's edge.
+pub(crate) fn caption_px(area: &Canvas<'_>, caption: &str) -> u32 {
+    let room = area.dim_in_pixel().0.saturating_sub(2 * CHART_MARGIN_PX);
+    (SMALLEST_CAPTION_PX..=CAPTION_PX)
+        .rev()
+        .find(|&px| {
+            area.estimate_text_size(caption, &(FONT, px).into_text_style(area))
+                .is_ok_and(|(width, _)| width <= room)
+        })
+        .unwrap_or(SMALLEST_CAPTION_PX)
+}
+
 /// A waveform panel's chart on `area`: time (s) over `time_s`, and ±1.1 × the peak of `samples`
 /// (the samples it will show), captioned and meshed as every waveform panel is.
 pub(crate) fn waveform_chart<'a, 'b>(
@@ -280,8 +300,8 @@ pub(crate) fn waveform_chart<'a, 'b>(
         .fold(1e-9f64, |p, &y| p.max(f64::from(y).abs()))
         * 1.1;
     let mut chart = ChartBuilder::on(area)
-        .margin(12)
-        .caption(caption, (FONT, 22))
+        .margin(CHART_MARGIN_PX)
+        .caption(caption, (FONT, caption_px(area, caption)))
         .x_label_area_size(35)
         .y_label_area_size(70)
         .build_cartesian_2d(time_s, -peak..peak)

@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use super::fitted::{FittedVolumes, FITTED_VOLUMES_KEY};
 use sake_glug_engine::{Constant, Control, Curve, ModelConfig, PerControl, Quantity, ValueError};
 use sake_glug_io::keys;
 use sake_glug_io::read::{self, InputKind, ReadError};
@@ -56,6 +57,7 @@ pub struct ModelFile {
     keys: Vec<(String, toml::Value)>,
     config: ModelConfig,
     controls: PerControl<Option<f64>>,
+    fitted_volumes: Option<FittedVolumes>,
 }
 
 impl ModelFile {
@@ -75,8 +77,13 @@ impl ModelFile {
         let keys = flatten(&table);
         let mut config = ModelConfig::default();
         let mut controls = PerControl::from_fn(|_| None);
+        let mut fitted_volumes = None;
         for (key, value) in &keys {
             match model_key(key) {
+                Some(ModelKey::FittedVolumes) => {
+                    fitted_volumes =
+                        Some(FittedVolumes::from_value(value).map_err(|e| syntax(&e))?);
+                }
                 Some(ModelKey::Control(control)) => {
                     let quantity = control.quantity();
                     let value = as_number(value).ok_or_else(|| ModelFileError::NotAModelKey {
@@ -128,6 +135,7 @@ impl ModelFile {
             keys,
             config,
             controls,
+            fitted_volumes,
         })
     }
 
@@ -155,6 +163,11 @@ impl ModelFile {
     pub fn controls(&self) -> &PerControl<Option<f64>> {
         &self.controls
     }
+
+    /// The volumes its fit saw glugs at, if a fit wrote them (MODEL.md §13).
+    pub fn fitted_volumes(&self) -> Option<FittedVolumes> {
+        self.fitted_volumes
+    }
 }
 
 /// What a model key sets.
@@ -162,6 +175,8 @@ enum ModelKey {
     Control(Control),
     Constant(Constant),
     Curve(Curve),
+    /// What the fit saw ([`FITTED_VOLUMES_KEY`]): plays nothing, read by the renderer's warning.
+    FittedVolumes,
 }
 
 /// The model key `key` (`section.name` inside a table), if it is one.
@@ -182,7 +197,8 @@ fn model_key(key: &str) -> Option<ModelKey> {
             .find(|curve| curve.scene_key() == key)
             .map(|&curve| ModelKey::Curve(curve))
     };
-    controls.or_else(constants).or_else(curves)
+    let fitted = || (key == FITTED_VOLUMES_KEY).then_some(ModelKey::FittedVolumes);
+    controls.or_else(constants).or_else(curves).or_else(fitted)
 }
 
 /// The section and name of the model key that `key` names in another of the model's sections or

@@ -5,5 +5,7 @@
 //! everywhere.
 
 mod file;
+mod fitted;
 
 pub use file::{curve_points, ModelFile, ModelFileError, MAX_MODEL_BYTES};
+pub use fitted::{FittedVolumes, FITTED_VOLUMES_KEY, FITTED_VOLUMES_MARGIN};

@@ -5,6 +5,7 @@
 //! refused up front if it cannot fit in memory; [`render_tables`] gives the tables in memory.
 
 mod automation;
+pub mod beyond_fit;
 pub mod clips;
 pub mod fidelity;
 pub mod loudness;

@@ -55,6 +55,8 @@ pub struct RenderSummary {
     pub units: u64,
     /// Largest |sample|.
     pub peak: f32,
+    /// The lowest and highest V_i of the units started (ml), `None` without a unit.
+    pub unit_volumes_ml: Option<(f64, f64)>,
     /// Wall-clock time the render took.
     pub elapsed: Duration,
 }
@@ -141,6 +143,7 @@ pub fn render_scene<E: From<RenderError>>(
     let mut take = TakePlayer::new(scene);
     // Trailing zeros are held back until something follows them or the end is known.
     let (mut written, mut held_zeros, mut peak) = (0u64, 0u64, 0.0f32);
+    let mut unit_volumes_ml: Option<(f64, f64)> = None;
 
     loop {
         let position = engine.position();
@@ -163,6 +166,7 @@ pub fn render_scene<E: From<RenderError>>(
         take.override_lanes(&mut controls);
         let block = &mut block[..len];
         engine.process_observed(&controls, block, &mut |onset, voicing| {
+            widen(&mut unit_volumes_ml, onset.volume_ml);
             observer.unit_started(onset, voicing)
         });
         // The output stage after synthesis: a trimmed render's fade (crate::trim).
@@ -202,7 +206,10 @@ pub fn render_scene<E: From<RenderError>>(
             }
         }
     }
-    engine.report_deferred_units(&mut |onset, voicing| observer.unit_started(onset, voicing));
+    engine.report_deferred_units(&mut |onset, voicing| {
+        widen(&mut unit_volumes_ml, onset.volume_ml);
+        observer.unit_started(onset, voicing)
+    });
     let end = total.unwrap_or_else(|| engine.active_until().max(written));
     write_zeros(&mut sink, end - written)?;
     Ok(RenderSummary {
@@ -210,8 +217,16 @@ pub fn render_scene<E: From<RenderError>>(
         sample_rate: scene.sample_rate,
         units: engine.stats().units_started,
         peak,
+        unit_volumes_ml,
         elapsed: started.elapsed(),
     })
+}
+
+/// `range` widened to hold `volume_ml`.
+fn widen(range: &mut Option<(f64, f64)>, volume_ml: f64) {
+    *range = Some(range.map_or((volume_ml, volume_ml), |(low, high)| {
+        (low.min(volume_ml), high.max(volume_ml))
+    }));
 }
 
 /// A scene's MIDI take played into the engine: every message acts at its sample, before that

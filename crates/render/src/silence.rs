@@ -72,8 +72,8 @@ fn reason(scene: &Scene, summary: &RenderSummary) -> Option<String> {
     }
     Some(format!(
         "its {} glugs are all silent: each came below `{}` (the amplitude law is 0 there, \
-         MODEL.md §12), at an output gain too low, or with both components at or above \
-         Nyquist ({} Hz)",
+         MODEL.md §12), at an output gain too low, or with both components below 20 Hz or at \
+         or above Nyquist ({} Hz)",
         summary.units,
         Constant::SilentBelow.quantity().scene_key,
         scene.sample_rate as f64 / 2.0

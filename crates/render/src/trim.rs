@@ -36,7 +36,7 @@ pub fn check_trim_db(level_db: f64) -> Result<f64, TrimLevelError> {
 /// When a unit of the units table has decayed below `threshold` (in output units) for good:
 /// its onset plus the time its two components' sum A1·e^(−B1·τ) + A2·e^(−B2·τ) takes to fall to
 /// the threshold; a component the engine omits (reaching Nyquist, its `glide`'s start included,
-/// or at 0 Hz) counts for nothing. `None` for a unit that starts at or below the threshold (it
+/// or below 20 Hz: [`Glide::sounds`]) counts for nothing. `None` for a unit that starts at or below the threshold (it
 /// keeps nothing audible); infinity for one that never falls below it (a decay rate of 0).
 pub fn unit_decayed_s(
     unit: &UnitRow,
@@ -45,9 +45,7 @@ pub fn unit_decayed_s(
     glide: &Glide,
 ) -> Option<f64> {
     let sounds = |index: usize, frequency_hz: f64| {
-        unit.audible
-            && frequency_hz > 0.0
-            && glide.highest_hz(index, frequency_hz) < sample_rate / 2.0
+        unit.audible && glide.sounds(index, frequency_hz, sample_rate)
     };
     let components: Vec<(f64, f64)> = [
         (unit.f1_hz, unit.a1.abs(), unit.b1_per_s),

@@ -90,6 +90,30 @@ impl Design {
     pub fn discriminates(self) -> bool {
         self.discrimination().is_some()
     }
+
+    /// What a session of it presents, as `--help` says it.
+    pub fn task(self) -> &'static str {
+        match self {
+            Design::Paired => "every ordered pair of named stimuli (the paper's §3)",
+            Design::Constant => {
+                "a standard against comparison levels of one control or constant (the paper's §4.4)"
+            }
+            Design::TwoAfc => "two stimuli: which one is the target (the recording)?",
+            Design::Triangle => "three stimuli, two alike: which one is different?",
+            Design::Abx => "A, B, then X: is X A or B?",
+        }
+    }
+
+    /// The arrangements of two stimuli one repetition of a discrimination design presents
+    /// (its orders, or which stimulus is the odd one where); `None` for the paper's two.
+    pub fn arrangements(self) -> Option<u32> {
+        match self {
+            Design::Paired | Design::Constant => None,
+            Design::TwoAfc => Some(2),
+            Design::Triangle => Some(6),
+            Design::Abx => Some(4),
+        }
+    }
 }
 
 impl TryFrom<String> for Design {
@@ -665,12 +689,10 @@ pub const MAX_PRACTICE: u32 = 100;
 /// `repetitions` times: every ordered pair, or every comparison.
 fn trial_count(design: Design, stimuli: usize, repetitions: u32) -> u64 {
     let stimuli = stimuli as u64;
-    let per_repetition = match design {
-        Design::Paired => stimuli * stimuli.saturating_sub(1),
-        Design::Constant => stimuli.saturating_sub(1),
-        Design::TwoAfc => 2,
-        Design::Triangle => 6,
-        Design::Abx => 4,
+    let per_repetition = match design.arrangements() {
+        Some(arrangements) => u64::from(arrangements),
+        None if design == Design::Paired => stimuli * stimuli.saturating_sub(1),
+        None => stimuli.saturating_sub(1),
     };
     per_repetition.saturating_mul(u64::from(repetitions))
 }
@@ -685,8 +707,9 @@ fn check_trials(design: Design, stimuli: usize, repetitions: u32) -> Result<(), 
         Design::Paired => format!("{} ordered pairs", trials / u64::from(repetitions)),
         Design::Constant => format!("{} comparisons", trials / u64::from(repetitions)),
         Design::TwoAfc => "2 orders".into(),
-        Design::Triangle => "6 arrangements".into(),
-        Design::Abx => "4 arrangements".into(),
+        Design::Triangle | Design::Abx => {
+            format!("{} arrangements", trials / u64::from(repetitions))
+        }
     };
     Err(format!(
         "{what} × `repetitions` = {repetitions} make {trials} trials a session: at most \

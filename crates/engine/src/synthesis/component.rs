@@ -47,16 +47,14 @@ impl ComponentGlide {
 
 impl Component {
     /// Component `index` (0: f1/B1, 1: f2/B2) of `onset`, or `None` if it is never computed:
-    /// zero amplitude, a frequency of 0 or one that reaches Nyquist (its glide's start
-    /// included, MODEL.md §5.2), or already below −120 dB.
+    /// zero amplitude, a frequency below 20 Hz or one that reaches Nyquist (its glide's start
+    /// included, MODEL.md §5.2, §6), or already below −120 dB.
     pub fn of(onset: &UnitOnset, index: usize, sample_rate: f64) -> Option<Self> {
         let amplitude = onset.component_amplitudes()[index];
         let frequency_hz = onset.shape.frequency_hz[index];
         let glide = &onset.shape.glide;
         let audible_amplitude = amplitude >= NEGLIGIBLE_AMPLITUDE;
-        let below_nyquist =
-            frequency_hz > 0.0 && glide.highest_hz(index, frequency_hz) < 0.5 * sample_rate;
-        if !audible_amplitude || !below_nyquist {
+        if !audible_amplitude || !glide.sounds(index, frequency_hz, sample_rate) {
             return None;
         }
         let radians_per_sample = std::f64::consts::TAU * frequency_hz / sample_rate;

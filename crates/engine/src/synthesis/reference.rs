@@ -16,6 +16,7 @@
 
 use std::ops::Range;
 
+use crate::config::LOWEST_SOUNDING_HZ;
 use crate::{ControlSource, ControlValues, DrainMode, ModelConfig, Pour, SilentBelow, UnitOnset};
 
 /// MODEL.md §5: Asum = 0.0027·V − 0.2277, V in ml of the paper's 300 ml bottle, normalised by
@@ -424,15 +425,16 @@ fn unit_frequencies(
 }
 
 /// q_i(τ) of MODEL.md §5 (without G), added at every sample of `window` with τ ≥ 0. A component
-/// at or above fs/2 (a glide's start frequency included, §5.2), at 0 Hz or of zero amplitude is
-/// omitted (§6). A gliding component's phase is §5.2's closed form,
+/// at or above fs/2 (a glide's start frequency included, §5.2), below 20 Hz or of zero amplitude
+/// is omitted (§6). A gliding component's phase is §5.2's closed form,
 /// 2π·f·[τ + (ρ − 1)·τ_k·(1 − e^(−τ/τ_k))].
 fn add_unit(unit: &Unit, sample_rate: f64, window: &Range<u64>, out: &mut [f64]) {
     for k in 0..2 {
         let (amplitude, frequency_hz) = (unit.amplitudes[k], unit.frequency_hz[k]);
         let (ratio, glide_s) = (unit.glide_ratio[k], unit.glide_s[k]);
         let highest_hz = frequency_hz * ratio.max(1.0);
-        if amplitude == 0.0 || frequency_hz <= 0.0 || highest_hz >= 0.5 * sample_rate {
+        if amplitude == 0.0 || frequency_hz < LOWEST_SOUNDING_HZ || highest_hz >= 0.5 * sample_rate
+        {
             continue;
         }
         let first = window.start.max(unit.first_sample);

@@ -25,7 +25,7 @@ use sake_glug_engine::{
 };
 use sake_glug_io::keys;
 use sake_glug_io::read::{self, InputKind};
-use sake_glug_model_file::ModelFile;
+use sake_glug_model_file::{FittedVolumes, ModelFile};
 
 pub use duration::MAX_DURATION_S;
 pub use error::SceneError;
@@ -70,6 +70,9 @@ pub struct Scene {
     /// The scene's `[variations]` table (MODEL.md §10.2), if it has one: what a set of takes of
     /// it draws.
     pub variations: Option<VariationSpec>,
+    /// The volumes the model's glugs were recorded at (`[fit] volumes_ml`, MODEL.md §13), if a
+    /// fitted model gives them: they play nothing; the renderer warns of a pour far beyond them.
+    pub fitted_volumes: Option<FittedVolumes>,
 }
 
 /// A scene file's text, read as a regular file within [`MAX_SCENE_BYTES`], in UTF-8.

@@ -14,7 +14,7 @@ use sake_glug_engine::{
     Constant, Control, Curve, DrainMode, ModelConfig, PerControl, Quantity, Range, ValueError,
 };
 use sake_glug_io::keys::{self, KeyedTable};
-use sake_glug_model_file::{curve_points, ModelFile};
+use sake_glug_model_file::{curve_points, FittedVolumes, ModelFile, FITTED_VOLUMES_KEY};
 
 /// The keys a scene has besides the controls' and the constants' (theirs come from their tables).
 const SAMPLE_RATE: &str = "sample_rate";
@@ -151,6 +151,10 @@ impl SceneFile {
             Some(table) => Some(VariationSpec::from_table(table)?),
             None => None,
         };
+        let fitted_volumes = self
+            .take::<toml::Value>(FITTED_VOLUMES_KEY)?
+            .map(|value| FittedVolumes::from_value(&value).map_err(|e| syntax(&e)))
+            .transpose()?;
         self.refuse_unknown()?;
         Ok(Scene {
             sample_rate,
@@ -163,6 +167,7 @@ impl SceneFile {
             actuator: None,
             fade_out: None,
             variations,
+            fitted_volumes,
         })
     }
 }
