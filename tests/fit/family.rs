@@ -724,3 +724,19 @@ fn one_draw_runs_through_the_harness() {
         "{table}"
     );
 }
+
+/// Development draws whose weak, short bright mode the fit once missed: beside a long cavity, in
+/// a room, with hum that an eq. 1 fit took for the second mode (draws 4 and 44), and in a
+/// cavity falling from 590 Hz, whose full bottle's f1 the liquid's split put in f2's mode (draw
+/// 43). Their f2 and c come within tolerance (MODEL.md §13, "A short bright mode").
+#[test]
+fn weak_short_bright_modes_of_the_development_set_are_found() {
+    let f2_and_c = [1, 4];
+    let missed: Vec<String> = [4, 43, 44]
+        .into_iter()
+        .map(|seed| fit_draw(&draw(seed)))
+        .filter(|outcome| !f2_and_c.iter().all(|&measure| outcome.passes(measure)))
+        .map(|outcome| markdown("development", std::slice::from_ref(&outcome)))
+        .collect();
+    assert!(missed.is_empty(), "{}", missed.join("\n"));
+}

@@ -130,4 +130,27 @@ mod tests {
         assert_eq!(two.mode_of(81.0, 0, 1), 0);
         assert_eq!(two.mode_of(305.0, 0, 1), 1);
     }
+
+    #[test]
+    fn a_lone_mode_is_placed_by_its_neighbours_in_time() {
+        // A cavity falling from 700 to 220 Hz beside a bubble at 1330 Hz: taken together, the
+        // units' f1 put the split near 540 Hz, below a full bottle's lone f1 at 760 Hz.
+        let both = [
+            (0.2, [700.0, 1330.0]),
+            (0.4, [690.0, 1328.0]),
+            (3.0, [221.0, 1336.0]),
+            (3.2, [220.0, 1331.0]),
+            (3.4, [219.0, 1333.0]),
+        ];
+        let early = local_split(0.1, &both).expect("neighbours ring both modes");
+        assert_eq!(early.mode_of(760.0, 0, 1), 0, "{early:?}");
+        assert_eq!(early.mode_of(1300.0, 0, 1), 1, "{early:?}");
+        // Late in the pour its neighbours are the late units.
+        let late = local_split(3.3, &both).expect("neighbours ring both modes");
+        assert_eq!(late.mode_of(230.0, 0, 1), 0, "{late:?}");
+        assert_eq!(late.mode_of(900.0, 0, 1), 1, "{late:?}");
+        // No unit rings both, or they ring one pitch: no split of their own.
+        assert_eq!(local_split(0.5, &[]), None);
+        assert_eq!(local_split(0.5, &[(1.0, [300.0, 330.0])]), None);
+    }
 }

@@ -1,14 +1,14 @@
 //! A unit's second, short mode (MODEL.md §13): a real glug often carries a bright mode (the
 //! pocket ringing as a bubble) that dies within a few tens of milliseconds beside a long low one
 //! (the headspace's cavity). Over a span of up to 150 ms its spectral peak stands far below the
-//! long mode's, so a fit from the span's own peaks finds one mode only. So a unit kept with one
-//! component is looked at again: where what its fit left out of the unit's first
-//! [`EARLY_S`] peaks at least [`SEPARATE_MODES`] from its component, both are fitted together
-//! there, and the pair is kept if the new component lies above the unit's own and decays faster
-//! (the short bright mode sought) and the pair explains at least [`MIN_EARLY_GAIN`] of what the
-//! one component left of those first [`EARLY_S`], without explaining less of the span. A short
-//! mode is a bottle's only where units enough ring it at one pitch ([`agreed`]); elsewhere each
-//! unit keeps its one component.
+//! long mode's, so a fit from the span's own peaks finds one mode only. So a unit kept with
+//! nothing fitted above its stronger component is looked at again: where what its fit left out of
+//! the unit's first [`EARLY_S`] peaks at least [`SEPARATE_MODES`] above that component, both are
+//! fitted together there, and the pair is a candidate if the new component decays faster (the
+//! short bright mode sought) and the pair explains at least [`MIN_EARLY_GAIN`] of what the unit's
+//! fit left of those first [`EARLY_S`], without explaining less of the span. A short mode is a
+//! bottle's only where units enough ring it at one pitch ([`agreed`]); elsewhere each unit keeps
+//! its own fit.
 
 use super::eq1;
 use super::modes::SEPARATE_MODES;
@@ -21,7 +21,7 @@ use crate::spectrum::own_peak_above;
 const EARLY_S: f64 = 0.04;
 /// A short mode's decay where the pencil gives none (1/s): −60 dB in 46 ms.
 const SHORT_DECAY_GUESS_PER_S: f64 = 150.0;
-/// The share of what the one component left of the unit's first [`EARLY_S`] that the pair must
+/// The share of what the unit's fit left of the unit's first [`EARLY_S`] that the pair must
 /// explain. A short mode carries little of a 150 ms span's energy (a tenth of the amplitude of a
 /// long mode, decaying ten times faster, is 0.1 % of it) but a share of what is left early;
 /// noise, which a component of four numbers fits only as its share of the hundreds of samples
@@ -42,9 +42,12 @@ const AGREEING_PITCH: f64 = 0.25;
 
 /// `unit`, with the short mode its fit left out where there is one (`Some`: the unit with it).
 pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
-    let (Some(main), None) = (unit.components[0], unit.components[1]) else {
+    // The unit's stronger component, if nothing it fitted lies above it (a weaker one below is
+    // replaced: a low blob an eq. 1 started at hum or the room gives, not the bright mode).
+    let main = *unit.stronger()?;
+    if unit.fitted().any(|c| c.heard_hz > main.heard_hz) {
         return None;
-    };
+    }
     let from = (span.onset - span.first).min(span.samples.len());
     let to = (from + (EARLY_S * span.fs) as usize).min(span.samples.len());
     let left: Vec<f64> = (from..to)
