@@ -3,15 +3,17 @@ them: the Debian package installed with dpkg (and purged at the end, even when a
 the tarball's install.sh into a throw-away HOME (and --uninstall), the wheel into a fresh venv
 with no cargo on PATH. From each install: `sake-glug render` from PATH, the VST3 in pedalboard
 and the C example built through pkg-config give the build's CLI's samples bit for bit; every man
-page renders; bash completes `sake-glug ren` to `render`; removing it leaves no file. lintian
+page renders; bash completes `sake-glug ren` to `render`; the installed CLI runs the installed
+study spec (shortened) on a JACK server of its own; removing it leaves no file. lintian
 finds no error in the .deb, auditwheel accepts the wheel as manylinux, and every product reports
 the workspace's version.
 
 Needs `cargo xtask dist` (run by `cargo xtask test` before these tests), root for dpkg, Debian's
-lintian, pkg-config, man-db and bash-completion (.ci/run installs them), and auditwheel
+lintian, pkg-config, man-db, bash-completion and jackd2 (.ci/run installs them), and auditwheel
 (tests/host/requirements.txt).
 """
 
+import csv
 import os
 import re
 import shutil
@@ -252,6 +254,39 @@ def subcommands():
     listed = help_text.split("Commands:")[1].split("Options:")[0]
     names = [line.split()[0] for line in listed.splitlines() if line.startswith("  ") and line.split()]
     return [name for name in names if name != "help"]
+
+
+@pytest.fixture(scope="module")
+def release_jack_server():
+    from test_standalone import own_jack_server
+
+    yield from own_jack_server("sakeglug-release", (CLI, "cargo xtask dist"))
+
+
+def test_installed_cli_runs_the_installed_study_on_jack(install, release_jack_server, tmp_path):
+    """A real study from the installed CLI, on the installed spec (shortened: its trials 0.2 s
+    long, one repetition), played on a JACK server: a log row for each trial, with its frames."""
+    installed = install.doc_dir / "experiments" / "paired-waves.toml"
+    assert installed.is_file(), f"{install}: {installed} is not installed"
+    spec = tomllib.loads(installed.read_text())
+    lines = installed.read_text().splitlines()
+    shortened = ["duration_s = 0.2" if l.startswith("duration_s") else
+                 "gap_s = 0.1" if l.startswith("gap_s") else
+                 "repetitions = 1" if l.startswith("repetitions") else l for l in lines]
+    (tmp_path / "study.toml").write_text("\n".join(shortened) + "\n")
+    trials = len(spec["stimuli"]) * (len(spec["stimuli"]) - 1)
+    env = dict(install.env, JACK_DEFAULT_SERVER=release_jack_server)
+    done = subprocess.run(
+        ["sake-glug", "experiment", "study.toml", "--participant", "p1", "--log", "log.csv"],
+        cwd=tmp_path, env=env, input="\n" + "1\n" * trials, capture_output=True, text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, f"{install}'s sake-glug experiment:\n{done.stdout}\n{done.stderr}"
+    rows = list(csv.DictReader(open(tmp_path / "log.csv")))
+    assert len(rows) == trials, f"{len(rows)} rows for {trials} trials"
+    frames = [int(row["first_onset_frame"]) for row in rows]
+    assert frames == sorted(frames) and frames[0] >= 0, frames
+    assert all(row.get("dry_run", "0") in ("0", "") for row in rows), rows[0]
 
 
 def test_every_man_page_renders(install):
