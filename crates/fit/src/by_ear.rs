@@ -398,10 +398,15 @@ fn targets_of(recordings: &[&RecordingFit], capacity_ml: f64) -> Option<Vec<Targ
             let fs = f64::from(made.sample_rate);
             let length = ((made.duration_s * fs) as usize).min(recording.excerpt.len());
             let samples = &recording.excerpt[..length];
-            let spectrum = Spectrum::of(samples, fs);
+            // The glugs are heard without the recording's noise, which no model plays: a noisy
+            // clip's hiss would otherwise be matched by a brighter, shorter bottle.
+            let spectrum = Spectrum::of(samples, fs).less(&Spectrum::noise_of(samples, fs));
             let heard = hear(samples, fs, ONE_MODE_SPLIT_HZ);
             let glugs = heard.onsets_s.len();
-            let listened = Listened::from_heard(&heard, glugs, 0.0);
+            let listened = Listened {
+                bright: spectrum.share_above(ONE_MODE_SPLIT_HZ),
+                ..Listened::from_heard(&heard, glugs, 0.0)
+            };
             let default_render = render_as_recorded(&default, &made)?;
             let default_distance_db =
                 log_spectral_distance(&spectrum, &Spectrum::of(&default_render, fs), fs);

@@ -220,17 +220,7 @@ fn low_pitch(samples: &[f32], sample_rate: f64, split_hz: f64) -> f64 {
 
 /// The share of the energy of `samples` above `split_hz` (Welch's spectrum).
 pub fn high_share(samples: &[f32], sample_rate: f64, split_hz: f64) -> f64 {
-    let spectrum = Spectrum::of(samples, sample_rate);
-    let total: f64 = spectrum.power.iter().sum();
-    let high: f64 = (0..spectrum.power.len())
-        .filter(|&bin| spectrum.hz(bin) >= split_hz)
-        .map(|bin| spectrum.power[bin])
-        .sum();
-    if total > 0.0 {
-        high / total
-    } else {
-        f64::NAN
-    }
+    Spectrum::of(samples, sample_rate).share_above(split_hz)
 }
 
 #[cfg(test)]

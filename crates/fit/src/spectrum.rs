@@ -9,6 +9,18 @@ use rustfft::FftPlanner;
 /// decaying component's peak is B/π wide, about 14 Hz at 45 /s).
 const SEGMENT_S: f64 = 0.16;
 
+/// The quantile of a bin's powers over a recording's segments that its noise is read from: the
+/// glugs fill most segments, the quietest fifth holds little but noise.
+const NOISE_QUANTILE: f64 = 0.2;
+
+/// A bin's noise is the median of the quiet powers of the bins within this ratio of its
+/// frequency (half an octave either side).
+const NOISE_NEIGHBOURHOOD: f64 = std::f64::consts::SQRT_2;
+
+/// A bin less its noise keeps at least this share of itself (a bin of noise alone has no
+/// power of its own to keep, but a log-spectral distance needs some).
+const KEPT_UNDER_NOISE: f64 = 0.03;
+
 /// Lowest frequency searched for a peak (Hz): below it lie drift and handling noise.
 const LOWEST_PEAK_HZ: f64 = 20.0;
 
@@ -39,6 +51,38 @@ pub(crate) fn forward(len: usize) -> std::sync::Arc<dyn rustfft::Fft<f64>> {
     PLANNER.with(|planner| planner.borrow_mut().plan_fft_forward(len))
 }
 
+/// Welch's segments of `samples` (Hann windows, half overlapping, a power of two long, the
+/// last zero-padded): each one's power per bin, from 0 Hz to Nyquist, to `each`; the bins'
+/// spacing (Hz).
+fn segment_powers(samples: &[f32], sample_rate: f64, mut each: impl FnMut(&[f64])) -> f64 {
+    let len = ((SEGMENT_S * sample_rate) as usize)
+        .next_power_of_two()
+        .min(samples.len().next_power_of_two().max(16));
+    let fft = forward(len);
+    let window: Vec<f64> = (0..len)
+        .map(|n| 0.5 - 0.5 * (std::f64::consts::TAU * n as f64 / len as f64).cos())
+        .collect();
+    let mut power = vec![0.0; len / 2 + 1];
+    let mut buffer = vec![Complex::new(0.0, 0.0); len];
+    let mut start = 0;
+    loop {
+        for (n, slot) in buffer.iter_mut().enumerate() {
+            let sample = samples.get(start + n).map_or(0.0, |&y| f64::from(y));
+            *slot = Complex::new(sample * window[n], 0.0);
+        }
+        fft.process(&mut buffer);
+        for (bin, slot) in power.iter_mut().enumerate() {
+            *slot = buffer[bin].norm_sqr();
+        }
+        each(&power);
+        start += len / 2;
+        if start + len > samples.len() {
+            break;
+        }
+    }
+    sample_rate / len as f64
+}
+
 /// The averaged power spectrum of a recording.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Spectrum {
@@ -52,33 +96,75 @@ impl Spectrum {
     /// Welch's estimate of the power spectrum of `samples` at `sample_rate` (Hann windows, half
     /// overlapping, a power of two long).
     pub fn of(samples: &[f32], sample_rate: f64) -> Self {
-        let len = ((SEGMENT_S * sample_rate) as usize)
-            .next_power_of_two()
-            .min(samples.len().next_power_of_two().max(16));
-        let fft = forward(len);
-        let window: Vec<f64> = (0..len)
-            .map(|n| 0.5 - 0.5 * (std::f64::consts::TAU * n as f64 / len as f64).cos())
+        let mut power: Vec<f64> = Vec::new();
+        let bin_hz = segment_powers(samples, sample_rate, |segment| {
+            power.resize(segment.len(), 0.0);
+            power.iter_mut().zip(segment).for_each(|(sum, p)| *sum += p);
+        });
+        Self { bin_hz, power }
+    }
+
+    /// The recording's noise in the same units as [`Spectrum::of`]'s: in each bin, the
+    /// [`NOISE_QUANTILE`] of its segments' powers (the quiet ones, between and after the glugs)
+    /// over that quantile of noise's own spread, times the segments; then the median of that over
+    /// its neighbourhood ([`NOISE_NEIGHBOURHOOD`]).
+    pub fn noise_of(samples: &[f32], sample_rate: f64) -> Self {
+        let mut segments: Vec<Vec<f64>> = Vec::new();
+        let bin_hz = segment_powers(samples, sample_rate, |segment| {
+            segments.push(segment.to_vec())
+        });
+        let bins = segments.first().map_or(0, Vec::len);
+        let count = segments.len() as f64;
+        let quiet: Vec<f64> = (0..bins)
+            .map(|bin| {
+                let mut powers: Vec<f64> = segments.iter().map(|s| s[bin]).collect();
+                powers.sort_by(f64::total_cmp);
+                let at = ((NOISE_QUANTILE * powers.len() as f64) as usize).min(powers.len() - 1);
+                // A noise periodogram's bin is exponential: its q-quantile is −ln(1 − q) times
+                // its mean.
+                powers[at] / -(1.0 - NOISE_QUANTILE).ln() * count
+            })
             .collect();
-        let mut power = vec![0.0; len / 2 + 1];
-        let mut buffer = vec![Complex::new(0.0, 0.0); len];
-        let mut start = 0;
-        loop {
-            for (n, slot) in buffer.iter_mut().enumerate() {
-                let sample = samples.get(start + n).map_or(0.0, |&y| f64::from(y));
-                *slot = Complex::new(sample * window[n], 0.0);
-            }
-            fft.process(&mut buffer);
-            for (bin, slot) in power.iter_mut().enumerate() {
-                *slot += buffer[bin].norm_sqr();
-            }
-            start += len / 2;
-            if start + len > samples.len() {
-                break;
-            }
-        }
+        // A mode that rings in every segment (glugs faster than it decays) is no quieter in
+        // the quiet ones: a bin's noise is the median over its neighbourhood, where such a peak
+        // is a few bins of many (and noise is smooth, but for hum's few lines).
+        let power = (0..bins)
+            .map(|bin| {
+                let from = ((bin as f64 / NOISE_NEIGHBOURHOOD) as usize).max(1);
+                let to = ((bin as f64 * NOISE_NEIGHBOURHOOD).ceil() as usize + 1).min(bins);
+                let mut near: Vec<f64> = quiet[from.min(bin)..to.max(bin + 1)].to_vec();
+                near.sort_by(f64::total_cmp);
+                near[near.len() / 2]
+            })
+            .collect();
+        Self { bin_hz, power }
+    }
+
+    /// This spectrum less `noise` (of the same recording), each bin kept at least
+    /// [`KEPT_UNDER_NOISE`] of itself.
+    pub fn less(&self, noise: &Spectrum) -> Self {
         Self {
-            bin_hz: sample_rate / len as f64,
-            power,
+            bin_hz: self.bin_hz,
+            power: self
+                .power
+                .iter()
+                .zip(&noise.power)
+                .map(|(&p, &n)| (p - n).max(KEPT_UNDER_NOISE * p))
+                .collect(),
+        }
+    }
+
+    /// The share of the power at or above `split_hz`.
+    pub fn share_above(&self, split_hz: f64) -> f64 {
+        let total: f64 = self.power.iter().sum();
+        let high: f64 = (0..self.power.len())
+            .filter(|&bin| self.hz(bin) >= split_hz)
+            .map(|bin| self.power[bin])
+            .sum();
+        if total > 0.0 {
+            high / total
+        } else {
+            f64::NAN
         }
     }
 
@@ -175,5 +261,64 @@ impl Spectrum {
             0.0
         };
         (bin as f64 + offset) * self.bin_hz
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    /// Glugs (a 200 Hz mode, decaying at 30 /s, 6 a second) with white noise 10 dB below their
+    /// RMS, at 16 kHz: the noise read from the quiet segments, and the glugs' bright share once
+    /// it is taken away.
+    #[test]
+    fn a_recordings_noise_is_read_and_taken_away() {
+        let fs = 16_000.0;
+        let glugs: Vec<f32> = (0..(3.0 * fs) as usize)
+            .map(|n| {
+                let tau = (n as f64 / fs) % (1.0 / 6.0);
+                ((-30.0 * tau).exp() * (std::f64::consts::TAU * 200.0 * tau).sin()) as f32
+            })
+            .collect();
+        let rms =
+            (glugs.iter().map(|y| f64::from(*y).powi(2)).sum::<f64>() / glugs.len() as f64).sqrt();
+        // Uniform noise of this half-width has the RMS sought.
+        let half_width = 10f64.powf(-0.5) * rms * 3f64.sqrt();
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+        let noise: Vec<f32> = glugs
+            .iter()
+            .map(|_| (half_width * (2.0 * rng.random::<f64>() - 1.0)) as f32)
+            .collect();
+        let noisy: Vec<f32> = glugs.iter().zip(&noise).map(|(g, n)| g + n).collect();
+        let floor = Spectrum::noise_of(&noisy, fs);
+        let truth = Spectrum::of(&noise, fs);
+        // Above the glugs' band, the floor is the noise's own level, within 25 %.
+        let band = |s: &Spectrum| -> f64 {
+            (0..s.power.len())
+                .filter(|&bin| s.hz(bin) >= 2000.0)
+                .map(|bin| s.power[bin])
+                .sum()
+        };
+        let ratio = band(&floor) / band(&truth);
+        assert!(
+            (0.75..1.25).contains(&ratio),
+            "noise read at {ratio} of its level"
+        );
+        // The noise lends the recording a bright share the glugs do not have; less it, the share
+        // comes most of the way back to the glugs' (a bin of noise alone keeps a little).
+        let glugs_share = Spectrum::of(&glugs, fs).share_above(700.0);
+        let noisy_spectrum = Spectrum::of(&noisy, fs);
+        let less_share = noisy_spectrum.less(&floor).share_above(700.0);
+        let noisy_share = noisy_spectrum.share_above(700.0);
+        assert!(
+            noisy_share > glugs_share + 0.05,
+            "{noisy_share}, the glugs' {glugs_share}"
+        );
+        assert!(
+            (less_share - glugs_share).abs() < 0.2 * (noisy_share - glugs_share),
+            "{less_share} less the noise, {noisy_share} with it, {glugs_share} the glugs alone"
+        );
     }
 }
