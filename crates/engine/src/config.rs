@@ -13,10 +13,6 @@ use super::quantity::{Knob, Quantity, Range, ValueError};
 
 /// Sample rate fs of a render (Hz).
 pub const SAMPLE_RATE_HZ: Range = Range::new(1_000.0, 768_000.0, 48_000.0);
-/// The lowest frequency a component sounds at (Hz, MODEL.md §6): below it a mode is no glug but
-/// a rumble under hearing (a fitted headspace law carried far beyond its recordings can drive f1
-/// there), so it is omitted as one at or above Nyquist is.
-pub const LOWEST_SOUNDING_HZ: f64 = 20.0;
 /// Hard output ceiling (linear amplitude): every output sample stays within ±ceiling.
 pub const CEILING: Range = Range::new(0.001, 1.0, 1.0);
 /// The seed of the random generator of §7 (the plugin's Seed parameter spans it). A scene may

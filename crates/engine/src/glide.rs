@@ -2,7 +2,10 @@
 //! it exponentially, as a real glug sweeps down into the cavity's resonance as the bubble forms,
 //! or up as it rises and shrinks. With both ratios at 1 nothing of it is computed.
 
-use super::config::LOWEST_SOUNDING_HZ;
+/// The lowest frequency a component sounds at (Hz, MODEL.md §6): below it a mode is no glug but
+/// a rumble under hearing (a fitted headspace law carried far beyond its recordings can drive f1
+/// there), so it is omitted as one at or above Nyquist is.
+pub const LOWEST_SOUNDING_HZ: f64 = 20.0;
 
 /// How each component's frequency glides into its own from the unit's onset.
 #[derive(Debug, Clone, Copy, PartialEq)]

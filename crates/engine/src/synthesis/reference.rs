@@ -16,7 +16,7 @@
 
 use std::ops::Range;
 
-use crate::config::LOWEST_SOUNDING_HZ;
+use crate::glide::LOWEST_SOUNDING_HZ;
 use crate::{ControlSource, ControlValues, DrainMode, ModelConfig, Pour, SilentBelow, UnitOnset};
 
 /// MODEL.md §5: Asum = 0.0027·V − 0.2277, V in ml of the paper's 300 ml bottle, normalised by
