@@ -100,6 +100,15 @@ impl Glide {
     fn extra_phase(&self, hz: f64, tau: f64) -> f64 {
         TAU * hz * (self.ratio - 1.0) * self.time_s * (1.0 - (-tau / self.time_s).exp())
     }
+
+    /// Its frequency over the mode's own τ after the onset.
+    pub fn factor(&self, tau: f64) -> f64 {
+        if self.ratio == 1.0 {
+            1.0
+        } else {
+            1.0 + (self.ratio - 1.0) * (-tau / self.time_s).exp()
+        }
+    }
 }
 
 /// A bottle emptying as this simulator sees it.
@@ -287,6 +296,10 @@ pub struct Simulated {
     pub bubble_energy: Vec<f64>,
     /// The cavity's decay (1/s).
     pub cavity_decay: f64,
+    /// The cavity's glide in every glug.
+    pub cavity_glide: Glide,
+    /// The bubble mode's glide in every glug.
+    pub bubble_glide: Glide,
     /// The exponent γ of f ∝ V_air^(−γ) for the cavity: 1/2 (0 for a fixed low mode).
     pub cavity_exponent: f64,
     /// The full bottle's headspace H (ml).
@@ -554,6 +567,8 @@ pub fn simulate(params: &Params) -> Simulated {
         cavity_energy,
         bubble_energy,
         cavity_decay: params.cavity_decay,
+        cavity_glide: params.cavity_glide,
+        bubble_glide: params.bubble_glide,
         cavity_exponent: if params.fixed_cavity_hz.is_some() {
             0.0
         } else {

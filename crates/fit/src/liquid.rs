@@ -16,6 +16,8 @@ use sake_glug_engine::curves::REFERENCE_TILT_DEG;
 use sake_glug_engine::{Constant, Control, Curve, Headspace};
 use sake_glug_model_file::FittedVolumes;
 
+/// A mode's glide is written only where its median ρ lies this far from 1 (MODEL.md §13).
+const GLIDE_HEARD: f64 = 0.05;
 /// The z of a two-sided 95 % normal interval (a line's rate).
 const Z_95: f64 = 1.959_963_984_540_054;
 /// A fitted V0 further below the lowest unit's volume than this share of the volumes' span lies
@@ -95,13 +97,17 @@ pub(crate) struct LiquidInputs<'a> {
 }
 
 /// The unit estimates, in this order: each one's model key (or name), and whether it is one.
-fn unit_keys() -> [(String, bool); 14] {
+fn unit_keys() -> [(String, bool); 18] {
     let key = |constant: Constant| (constant.quantity().scene_key.to_owned(), true);
     [
         key(Constant::F1),
         key(Constant::F2),
         key(Constant::F1Exponent),
         key(Constant::F2Exponent),
+        key(Constant::F1GlideRatio),
+        key(Constant::F2GlideRatio),
+        key(Constant::F1GlideTime),
+        key(Constant::F2GlideTime),
         key(Constant::Headspace),
         key(Constant::FreqJitter),
         key(Constant::B1),
@@ -116,7 +122,7 @@ fn unit_keys() -> [(String, bool); 14] {
 }
 
 /// The units each of [`unit_keys`]' estimates comes from.
-fn unit_counts(units: &[FittedUnit]) -> [usize; 14] {
+fn unit_counts(units: &[FittedUnit]) -> [usize; 18] {
     let in_mode = |mode: usize| {
         units
             .iter()
@@ -136,11 +142,16 @@ fn unit_counts(units: &[FittedUnit]) -> [usize; 14] {
         .max()
         .unwrap_or(low.max(high));
     let with_volume = units.iter().filter(|u| u.volume_ml.is_finite()).count();
+    let gliding = |mode: usize| units.iter().filter(|u| u.fit.glide[mode].is_some()).count();
     [
         low,
         high,
         in_mode_with_volume(0),
         in_mode_with_volume(1),
+        low,
+        high,
+        gliding(0),
+        gliding(1),
         in_mode_with_volume(0).max(in_mode_with_volume(1)),
         spread,
         low,
@@ -249,11 +260,16 @@ fn unit_estimates(units: &[FittedUnit], capacity_ml: f64, pocket_ml: f64) -> Vec
         Some(line) if line.slope > 0.0 => line.at(capacity_ml),
         _ => median(&of(&|u| u.fit.amplitude_sum())),
     };
+    let glide = glides(units);
     vec![
         quoted_hz[0],
         quoted_hz[1],
         exponent[0],
         exponent[1],
+        glide[0].0,
+        glide[1].0,
+        glide[0].1,
+        glide[1].1,
         law.headspace_ml,
         // j_f: f(1 + j·u), u uniform in [−1, 1], has its quartiles at f(1 ± j/2).
         mean_over_modes(&f, &relative),
@@ -266,6 +282,58 @@ fn unit_estimates(units: &[FittedUnit], capacity_ml: f64, pocket_ml: f64) -> Vec
         20.0 * full.log10(),
         r_squared,
     ]
+}
+
+/// Each mode's glide (MODEL.md §5.2, §13): ρ the median over the units ringing it (1 for a unit
+/// whose component does not glide, so that a glide a few units show is no bottle's), τ_g (ms) the
+/// median over those that glide.
+fn glides(units: &[FittedUnit]) -> [(f64, f64); 2] {
+    [0, 1].map(|k| {
+        let ringing = units.iter().filter(|u| u.fit.frequency_hz[k].is_finite());
+        let ratios: Vec<f64> = ringing
+            .clone()
+            .map(|u| u.fit.glide[k].map_or(1.0, |g| g.ratio))
+            .collect();
+        let times_ms: Vec<f64> = ringing
+            .filter_map(|u| u.fit.glide[k].map(|g| 1e3 * g.time_s))
+            .collect();
+        (median(&ratios), median(&times_ms))
+    })
+}
+
+/// A glide is written only where its mode's median ρ lies at least [`GLIDE_HEARD`] from 1 (a
+/// smaller one moves the pitch less than the units' own scatter); else ρ and τ_g keep their
+/// defaults, with the reason.
+fn check_glides(estimates: &mut [Estimate]) {
+    let modes = [
+        (Constant::F1GlideRatio, Constant::F1GlideTime),
+        (Constant::F2GlideRatio, Constant::F2GlideTime),
+    ];
+    for (k, (ratio, time)) in modes.into_iter().enumerate() {
+        let find = |estimates: &[Estimate], c: Constant| {
+            estimates
+                .iter()
+                .position(|e| e.key == c.quantity().scene_key)
+        };
+        let (Some(r), Some(t)) = (find(estimates, ratio), find(estimates, time)) else {
+            continue;
+        };
+        let value = estimates[r].value;
+        if estimates[r].in_model && (value - 1.0).abs() >= GLIDE_HEARD {
+            continue;
+        }
+        for (index, what) in [(r, "ρ"), (t, "τ_g")] {
+            let estimate = &mut estimates[index];
+            if estimate.in_model || estimate.has_value() {
+                estimate.in_model = false;
+                estimate.note = Some(format!(
+                    "f{} does not glide measurably (median ρ = {value:.3} over its units): {what} \
+                     kept at its default",
+                    k + 1
+                ));
+            }
+        }
+    }
 }
 
 /// c: the median of A1/(A1 + A2) over the units that ring both modes, where at least
@@ -345,6 +413,7 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
         }
     }
     check_silent_below(&mut estimates, &units, capacity_ml);
+    check_glides(&mut estimates);
     check_headspace(
         &mut estimates,
         &headspace_law(&units, capacity_ml, pocket_ml),

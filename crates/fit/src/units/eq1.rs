@@ -86,7 +86,7 @@ pub(super) fn fit(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<U
     }
     let components = [0, 1].map(|k| Component {
         frequency_hz: p[3 + k],
-        glide_hz_per_s: 0.0,
+        glide: None,
         heard_hz: p[3 + k],
         in_span: 0.0,
         decay_per_s: p[5 + k],
@@ -137,6 +137,10 @@ pub(super) fn nearest_pole(poles: &[(f64, f64)], hz: f64) -> Option<(f64, f64)> 
 pub(super) fn pencil_poles(segment: &[f64], step: usize, fs: f64) -> Vec<(f64, f64)> {
     const ORDER: usize = 4;
     let decimated: Vec<f64> = segment.iter().step_by(step).copied().collect();
+    // An SVD of a matrix holding a NaN never converges.
+    if !decimated.iter().all(|v| v.is_finite()) {
+        return Vec::new();
+    }
     let len = decimated.len();
     let pencil = (len / 3).min(PENCIL_MAX_COLUMNS);
     if pencil < ORDER + 1 || len < pencil + ORDER + 2 {

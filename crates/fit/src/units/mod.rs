@@ -5,8 +5,9 @@
 //! dominate, a component may start at another phase, the pitch may glide. So a unit eq. 1 does
 //! not describe, or describes with its stronger component away from the unit's own spectral
 //! peak, is fitted again ([`phased`]) with one or two components started at the peaks of its own
-//! spectrum, each with a phase of its own, and, if that explains too little of it, in the
-//! first part of its span only (where a gliding pitch has not moved far). A unit is kept if its
+//! spectrum, each with a phase of its own, then gliding, then in the first part of its span
+//! only (where a gliding pitch has not moved far). A unit kept steady is fitted again gliding,
+//! and keeps the glide where it explains much more. A unit is kept if its
 //! fit explains at least half of the samples fitted and its stronger component lies at its own
 //! spectral peak; otherwise it is rejected with the reason. Units are fitted in time order, each
 //! kept unit subtracted from the recording before the next is fitted, so that a unit starting
@@ -19,6 +20,8 @@ mod second_mode;
 mod window;
 
 use std::f64::consts::TAU;
+
+use sake_glug_engine::Constant;
 
 use super::listen::glug_onsets;
 use super::onsets::detect_onsets;
@@ -54,21 +57,29 @@ pub(crate) const LOWEST_HZ: f64 = 20.0;
 pub const AT_PEAK_SHARE: f64 = 0.1;
 /// A fitted unit is subtracted until it has decayed by this factor (−80 dB).
 const SUBTRACT_UNTIL: f64 = 1e-4;
+/// A glide's time constant may be at most this many times its ring's 1/B: by the time the ring
+/// has fallen by e² (17 dB) the pitch is at least 1/e of the way to its own frequency, which is
+/// then heard; a slower glide's end is a guess (MODEL.md §13).
+const GLIDE_REACHED: f64 = 2.0;
+/// A glide is kept where it leaves at most this share of what a steady fit left of a unit.
+const GLIDE_LEAVES: f64 = 0.75;
 /// A gliding unit is fitted again in the first this share of its span…
 const GLIDE_SHARE: f64 = 0.4;
 /// …but never fewer than this many periods of its lowest start.
 const GLIDE_PERIODS: f64 = 4.0;
 
-/// One resonance of a unit: A·e^(−Bτ)·sin(2π(fτ + gτ²/2) + φ), τ the time since the unit's
-/// onset (g = 0 and φ = 0 in the paper's eq. 1).
+/// One resonance of a unit: A·e^(−Bτ)·sin(2π·cycles(τ) + φ), τ the time since the unit's onset,
+/// cycles(τ) = fτ for a steady component (φ = 0 in the paper's eq. 1) and, for one that glides
+/// from ρ·f into f (MODEL.md §5.2), fτ + (ρ − 1)·f·τ_g·(1 − e^(−τ/τ_g)).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Component {
-    /// f at the onset (Hz).
+    /// f, its own frequency: the one a glide approaches (Hz).
     pub frequency_hz: f64,
-    /// g, how fast its frequency rises (Hz/s; 0 but for a gliding unit).
-    pub glide_hz_per_s: f64,
-    /// The frequency it is heard at (Hz): f, or for a glide f at the centre of its energy in the
-    /// span fitted. Eq. 1's view of the unit, and its mode, take this one.
+    /// Its glide into f, if it glides.
+    pub glide: Option<UnitGlide>,
+    /// The frequency it is heard at (Hz): f, or for a glide its frequency at the centre of its
+    /// energy in the span fitted. Which mode it rings, and whether it is at the span's spectral
+    /// peak, take this one.
     pub heard_hz: f64,
     /// B (1/s).
     pub decay_per_s: f64,
@@ -82,11 +93,47 @@ pub struct Component {
     pub in_span: f64,
 }
 
+/// A component's glide as MODEL.md §5.2 has it: from ρ·f, approaching f exponentially.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UnitGlide {
+    /// ρ, the start frequency over f.
+    pub ratio: f64,
+    /// τ_g, the approach's time constant (s).
+    pub time_s: f64,
+}
+
+impl UnitGlide {
+    /// The cycles the glide adds to fτ by τ, for a component of own frequency `hz`.
+    pub fn cycles(&self, hz: f64, tau: f64) -> f64 {
+        (self.ratio - 1.0) * hz * self.time_s * (1.0 - (-tau / self.time_s).exp())
+    }
+
+    /// Its frequency over f at τ.
+    pub fn factor(&self, tau: f64) -> f64 {
+        1.0 + (self.ratio - 1.0) * (-tau / self.time_s).exp()
+    }
+}
+
 impl Component {
+    /// The cycles its phase has turned through τ seconds after the onset (φ aside).
+    pub fn cycles(&self, tau: f64) -> f64 {
+        self.frequency_hz * tau + self.glide.map_or(0.0, |g| g.cycles(self.frequency_hz, tau))
+    }
+
     /// Its value τ seconds after the onset.
     pub fn value(&self, tau: f64) -> f64 {
-        let cycles = (self.frequency_hz + 0.5 * self.glide_hz_per_s * tau) * tau;
-        self.amplitude * (-self.decay_per_s * tau).exp() * (TAU * cycles + self.phase).sin()
+        self.amplitude
+            * (-self.decay_per_s * tau).exp()
+            * (TAU * self.cycles(tau) + self.phase).sin()
+    }
+
+    /// Why its glide is not heard, if it glides more slowly than it rings ([`GLIDE_REACHED`]).
+    fn unheard_glide(&self) -> Option<Rejection> {
+        let glide = self.glide?;
+        (glide.time_s * self.decay_per_s > GLIDE_REACHED).then(|| Rejection::GlideUnheard {
+            glide_ms: 1e3 * glide.time_s,
+            ring_ms: 1e3 / self.decay_per_s,
+        })
     }
 
     /// Why it is no resonance of a recording at `fs`, if it is not one.
@@ -96,10 +143,22 @@ impl Component {
             decay_per_s: decay,
             ..
         } = *self;
-        if !(hz.is_finite() && decay.is_finite() && self.amplitude.is_finite()) {
+        let glide_finite = self
+            .glide
+            .is_none_or(|g| g.ratio.is_finite() && g.time_s.is_finite() && g.time_s > 0.0);
+        let numbers = [hz, decay, self.amplitude, self.frequency_hz, self.phase];
+        // A glide starts at ρ·f, which must lie in the model's range of ρ and be heard.
+        let start_hz = self.glide.map_or(hz, |g| g.ratio * self.frequency_hz);
+        let ratio_range = Constant::F1GlideRatio.range();
+        if !(numbers.iter().all(|v| v.is_finite()) && glide_finite) {
             Err(Rejection::NotFinite)
         } else if !(LOWEST_HZ..fs / 2.0).contains(&hz) {
             Err(Rejection::Frequency { hz })
+        } else if !(LOWEST_HZ..fs / 2.0).contains(&start_hz)
+            || !(LOWEST_HZ..fs / 2.0).contains(&self.frequency_hz)
+            || self.glide.is_some_and(|g| !ratio_range.contains(g.ratio))
+        {
+            Err(Rejection::Frequency { hz: start_hz })
         } else if decay <= 0.0 {
             Err(Rejection::NoDecay)
         } else if decay >= MAX_DECAY_PER_S {
@@ -117,8 +176,8 @@ pub enum UnitMethod {
     Eq1,
     /// One or two components, each with its phase, from the unit's own spectral peaks.
     Phased,
-    /// As [`UnitMethod::Phased`] with a glide of each frequency, in the first part of the span
-    /// (a bubble's pitch rises as it rises).
+    /// As [`UnitMethod::Phased`] with each component gliding into its own frequency (MODEL.md
+    /// §5.2): a unit a steady fit left a sweep of, or one no steady fit described.
     Glide,
 }
 
@@ -131,8 +190,11 @@ pub struct UnitFit {
     pub components: [Option<Component>; 2],
     /// A1, A2: its amplitude in the bottle's low and high mode (0 where it does not ring one).
     pub amplitude: [f64; 2],
-    /// f1, f2 (Hz; NaN where it does not ring that mode).
+    /// f1, f2 (Hz; NaN where it does not ring that mode): each component's own frequency, the
+    /// one a glide approaches.
     pub frequency_hz: [f64; 2],
+    /// Each mode's glide, where its component glides.
+    pub glide: [Option<UnitGlide>; 2],
     /// B1, B2 (1/s; NaN where it does not ring that mode).
     pub decay_per_s: [f64; 2],
     /// The share of the samples fitted that the fit explains.
@@ -161,6 +223,7 @@ impl UnitFit {
             components: [sorted.first().copied(), sorted.get(1).copied()],
             amplitude: [0.0; 2],
             frequency_hz: [f64::NAN; 2],
+            glide: [None; 2],
             decay_per_s: [f64::NAN; 2],
             r_squared: fitted.explained,
             window: placed.window,
@@ -177,7 +240,8 @@ impl UnitFit {
         self.components.iter().flatten()
     }
 
-    /// Puts each component in the mode `modes` gives it (the stronger, where two fall in one).
+    /// Puts each component in the mode `modes` gives the frequency it is heard at (the stronger,
+    /// where two fall in one).
     pub fn assign(&mut self, modes: &Modes) {
         let mut best: [Option<Component>; 2] = [None, None];
         let count = self.fitted().count();
@@ -189,7 +253,8 @@ impl UnitFit {
         }
         for (mode, component) in best.into_iter().enumerate() {
             self.amplitude[mode] = component.map_or(0.0, |c| c.amplitude);
-            self.frequency_hz[mode] = component.map_or(f64::NAN, |c| c.heard_hz);
+            self.frequency_hz[mode] = component.map_or(f64::NAN, |c| c.frequency_hz);
+            self.glide[mode] = component.and_then(|c| c.glide);
             self.decay_per_s[mode] = component.map_or(f64::NAN, |c| c.decay_per_s);
         }
     }
@@ -281,6 +346,14 @@ pub enum Rejection {
     },
     /// A component that does not decay.
     NoDecay,
+    /// A component gliding so slowly that its ring dies before it reaches its own frequency:
+    /// that frequency is not heard, so no fit can tell it.
+    GlideUnheard {
+        /// τ_g (ms).
+        glide_ms: f64,
+        /// 1/B (ms).
+        ring_ms: f64,
+    },
     /// A component decaying faster than a resonance does.
     Click {
         /// Its decay rate (1/s).
@@ -316,6 +389,7 @@ impl Rejection {
             Rejection::Frequency { .. } => "a frequency out of range",
             Rejection::NoDecay => "no decay",
             Rejection::Click { .. } => "a click",
+            Rejection::GlideUnheard { .. } => "a glide slower than its ring",
             Rejection::Unexplained { .. } => "the fit explains too little",
             Rejection::OffPeak { .. } => "not at its spectral peak",
             Rejection::OnsetMoved { .. } => "the onset moved",
@@ -340,6 +414,11 @@ impl std::fmt::Display for Rejection {
                 "a component at {hz:.1} Hz, outside {LOWEST_HZ} Hz … half the sample rate"
             ),
             Rejection::NoDecay => write!(f, "a component does not decay"),
+            Rejection::GlideUnheard { glide_ms, ring_ms } => write!(
+                f,
+                "a component glides with τ_g = {glide_ms:.1} ms but rings for 1/B = \
+                 {ring_ms:.1} ms: its own frequency is never heard"
+            ),
             Rejection::Click { decay } => write!(
                 f,
                 "a component decays at {decay:.0} /s: a click, not a resonance"
@@ -576,7 +655,7 @@ fn fit_one_way(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<Unit
         .map_err(|rejection| Box::new((rejection, None)))
         .and_then(at_peak);
     let Err(first_reason) = paper else {
-        return paper;
+        return paper.map(|unit| with_glide(span, unit));
     };
     let peaks = own_peaks(&span.samples, span.fs);
     if peaks.is_empty() {
@@ -635,11 +714,53 @@ fn fit_one_way(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<Unit
         .and_then(|unit| check(unit, span.fs))
         .and_then(at_peak);
         match attempt {
+            Ok(unit) if method == UnitMethod::Phased => return Ok(with_glide(span, unit)),
             Ok(unit) => return Ok(unit),
             Err(reason) => best = better(best, reason),
         }
     }
     Err(best)
+}
+
+/// `unit`, fitted with steady components, fitted again with each gliding (MODEL.md §5.2) over the
+/// same samples; the glide is kept where it leaves at most [`GLIDE_LEAVES`] of what the steady
+/// fit left, and passes the same checks. A glide has two numbers more per component, so on a
+/// steady unit it explains next to nothing more; on a gliding one a steady fit leaves the sweep.
+pub(super) fn with_glide(span: &Span, unit: UnitFit) -> UnitFit {
+    let starts: Vec<(f64, f64)> = unit.fitted().map(|c| (c.heard_hz, c.decay_per_s)).collect();
+    let window = span.window_until(unit.stride, unit.window.1);
+    let Ok(fitted) = phased::fit(&window, span.onset_s(), &starts, true) else {
+        return unit;
+    };
+    let glided = UnitFit::new(
+        Fitted {
+            onset_s: fitted.onset_s,
+            components: &fitted.components,
+            explained: fitted.explained,
+        },
+        Placed {
+            window: unit.window,
+            stride: unit.stride,
+            fs: span.fs,
+        },
+        None,
+        UnitMethod::Glide,
+    );
+    match check_glide(glided, span.fs).and_then(|glided| at_peak(span, glided)) {
+        Ok(glided) if 1.0 - glided.r_squared <= GLIDE_LEAVES * (1.0 - unit.r_squared) => glided,
+        _ => unit,
+    }
+}
+
+/// A glide fitted to a unit a steady fit described, checked as [`check`] does and heard: every
+/// component reaches its own frequency while it rings (else the steady fit stands).
+fn check_glide(unit: UnitFit, fs: f64) -> Result<UnitFit, Failed> {
+    let unit = check(unit, fs)?;
+    let unheard = unit.fitted().find_map(Component::unheard_glide);
+    match unheard {
+        Some(rejection) => Err(Box::new((rejection, Some(unit)))),
+        None => Ok(unit),
+    }
 }
 
 /// A phased fit checked: finite, resonant and explaining enough.
@@ -685,7 +806,7 @@ fn subtract(signal: &mut [f32], unit: &UnitFit, fs: f64) {
         fs,
     };
     for component in unit.fitted() {
-        if component.glide_hz_per_s != 0.0 {
+        if component.glide.is_some() {
             for (n, sample) in signal[first..end].iter_mut().enumerate() {
                 let tau = (first + n) as f64 / fs - unit.onset_s;
                 *sample -= component.value(tau) as f32;

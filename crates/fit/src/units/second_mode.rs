@@ -14,7 +14,7 @@ use super::eq1;
 use super::modes::SEPARATE_MODES;
 use super::phased;
 use super::window::Span;
-use super::{at_peak, check, Fitted, Placed, Strides, UnitFit};
+use super::{at_peak, check, check_glide, Fitted, Placed, Strides, UnitFit};
 use crate::spectrum::own_peak_above;
 
 /// The early part of a unit where a short mode is sought (s).
@@ -63,53 +63,67 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
     let poles = eq1::pencil_poles(&left, strides.pencil, span.fs);
     let short = eq1::nearest_pole(&poles, short_hz).unwrap_or((short_hz, SHORT_DECAY_GUESS_PER_S));
     let window = span.window(strides.fit);
-    let pair = phased::fit(
-        &window,
-        unit.onset_s,
-        &[(main.frequency_hz, main.decay_per_s), short],
-        false,
-    )
-    .ok()?;
-    let both = UnitFit::new(
-        Fitted {
-            onset_s: pair.onset_s,
-            components: &pair.components,
-            explained: pair.explained,
-        },
-        Placed {
-            window: (span.first, span.end),
-            stride: strides.fit,
-            fs: span.fs,
-        },
-        None,
-        unit.method,
-    );
-    // The pair must still be two modes, neither drawn onto the other's frequency, and the new
-    // one the short bright mode sought: above the unit's own and decaying faster.
-    let two_modes = match both.components {
-        [Some(low), Some(high)] => {
-            high.heard_hz / low.heard_hz >= SEPARATE_MODES
-                && (low.heard_hz - main.heard_hz).abs() < (high.heard_hz - main.heard_hz).abs()
-                && high.decay_per_s > low.decay_per_s
-        }
-        _ => false,
-    };
+    let left_early = left.iter().map(|y| y * y).sum::<f64>();
     let left_by = |fit: &UnitFit| -> f64 {
         (from..to)
             .map(|n| (span.samples[n] - fit.value_at((span.first + n) as f64 / span.fs)).powi(2))
             .sum()
     };
-    let left_early = left.iter().map(|y| y * y).sum::<f64>();
-    let early_gain = 1.0 - left_by(&both) / left_early.max(1e-300);
-    match check(both, span.fs).and_then(|both| at_peak(span, both)) {
-        Ok(both)
-            if two_modes
-                && early_gain >= MIN_EARLY_GAIN
-                && both.r_squared >= unit.r_squared - SPAN_SLACK =>
-        {
-            Some(both)
+    let pair = |glide: bool| -> Option<UnitFit> {
+        let pair = phased::fit(
+            &window,
+            unit.onset_s,
+            &[(main.heard_hz, main.decay_per_s), short],
+            glide,
+        )
+        .ok()?;
+        let both = UnitFit::new(
+            Fitted {
+                onset_s: pair.onset_s,
+                components: &pair.components,
+                explained: pair.explained,
+            },
+            Placed {
+                window: (span.first, span.end),
+                stride: strides.fit,
+                fs: span.fs,
+            },
+            None,
+            unit.method,
+        );
+        // The pair must still be two modes, neither drawn onto the other's frequency, and the
+        // new one the short bright mode sought: above the unit's own and decaying faster.
+        let two_modes = match both.components {
+            [Some(low), Some(high)] => {
+                high.heard_hz / low.heard_hz >= SEPARATE_MODES
+                    && (low.heard_hz - main.heard_hz).abs() < (high.heard_hz - main.heard_hz).abs()
+                    && high.decay_per_s > low.decay_per_s
+            }
+            _ => false,
+        };
+        let early_gain = 1.0 - left_by(&both) / left_early.max(1e-300);
+        let checked = if glide {
+            check_glide(both, span.fs)
+        } else {
+            check(both, span.fs)
+        };
+        match checked.and_then(|both| at_peak(span, both)) {
+            Ok(both)
+                if two_modes
+                    && early_gain >= MIN_EARLY_GAIN
+                    && both.r_squared >= unit.r_squared - SPAN_SLACK =>
+            {
+                Some(both)
+            }
+            _ => None,
         }
-        _ => None,
+    };
+    // A gliding unit's pair glides too (the bright mode sweeps as the bubble forms), else, where
+    // that fails (the short mode's glide slower than its ring), the two steady.
+    if main.glide.is_some() {
+        pair(true).or_else(|| pair(false))
+    } else {
+        pair(false)
     }
 }
 
