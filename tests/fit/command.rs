@@ -262,7 +262,7 @@ fn a_clip_alone_is_fitted_with_every_output() {
     let mut lines = units.lines();
     assert_eq!(
         lines.next(),
-        Some("recording,onset_s,f1_hz,f2_hz,b1_per_s,b2_per_s,a1,a2,used,reason,volume_ml,f1_model_hz,f2_model_hz")
+        Some("recording,onset_s,f1_hz,f2_hz,b1_per_s,b2_per_s,a1,a2,used,reason,volume_ml,f1_model_hz,f2_model_hz,f1_glide_ratio,f1_glide_ms,f2_glide_ratio,f2_glide_ms")
     );
     let rows: Vec<&str> = lines.collect();
     assert!(rows.len() >= 20, "{units}");

@@ -35,6 +35,8 @@ pub const NEAR_DISTANCE_DB: f64 = 4.0;
 /// many times the default bottle's (or [`NEAR_DISTANCE_DB`]): a recording of a bottle near the
 /// default, under noise, is as far from either, and that is no reason to fit again.
 const NO_FARTHER: f64 = 1.05;
+/// Each search is run this many times in turn, each from where the last ended.
+const SEARCH_ROUNDS: usize = 2;
 /// The fewest glugs a recording's pitch fall is listened for over.
 const MIN_GLUGS_FOR_FALL: usize = 4;
 /// What a measure the recording has and a candidate lacks costs: as far as twice its tolerance.
@@ -355,7 +357,7 @@ pub(crate) fn fit_by_listening(
         targets: &targets,
     };
     let units_cost = search.cost_of(&base)?;
-    if sounds_like_every_recording(&base, &targets) {
+    if sounds_like_every_recording(&base, &targets, NO_FARTHER) {
         return None;
     }
     let starts = starting_points(&knobs, &bounds, &targets, &units_value);
@@ -464,8 +466,8 @@ fn search_bounds(knobs: &[Knob], targets: &[Target]) -> Vec<(f64, f64)> {
 
 /// Whether `model`, rendered as each recording was made, passes on the four measures a listener
 /// is asked about (the fall is the headspace law's, which the units give and the search leaves
-/// alone).
-fn sounds_like_every_recording(model: &toml::Table, targets: &[Target]) -> bool {
+/// alone), its distance at most `farther` times the default bottle's (or [`NEAR_DISTANCE_DB`]).
+fn sounds_like_every_recording(model: &toml::Table, targets: &[Target], farther: f64) -> bool {
     targets.iter().all(|target| {
         let Some(samples) = render_as_recorded(model, &target.made) else {
             return false;
@@ -478,45 +480,58 @@ fn sounds_like_every_recording(model: &toml::Table, targets: &[Target]) -> bool 
         );
         let [rate, pitch, _, bright, distance] =
             misses(&target.listened, &listened, target.default_distance_db);
-        [rate, pitch, bright].iter().all(|&m| m < 1.0) && distance < NO_FARTHER * NO_FARTHER
+        [rate, pitch, bright].iter().all(|&m| m < 1.0) && distance < farther * farther
     })
 }
 
-/// The best of the searches from `starts`: (its pour time, its point, its cost).
+/// The best of the searches from `starts`: (its pour time, its point, its cost). An end a
+/// listener would take for nearer than the default bottle on every measure beats one that is
+/// not, whatever their costs (the cost weighs the measures against each other; a listener asks
+/// each in turn).
 fn best_of_searches(
     search: &Search,
     starts: Vec<Vec<f64>>,
     units_pour_s: f64,
 ) -> Option<(f64, Vec<f64>, f64)> {
     let pour_key = Control::PourTime.quantity().scene_key;
-    let mut best: Option<(f64, Vec<f64>, f64)> = None;
-    for mut start in starts {
-        // Each start glugs at the recordings' rate before the search, and its end again after:
-        // the rate is the pour time's alone, and a search that set both would wander off where
-        // too few glugs are heard to tell.
-        balance(search, &mut start, search.targets);
-        let pour_s = matched_pour_time(&search.model(&start), units_pour_s, search.targets);
-        let mut start_base = search.base.clone();
-        keys::insert(&mut start_base, pour_key, toml::Value::Float(pour_s));
-        let here = Search {
-            base: &start_base,
-            ..*search
-        };
-        let Some((mut x, _)) = minimise(&here, start) else {
-            continue;
-        };
-        balance(&here, &mut x, search.targets);
-        let pour_s = matched_pour_time(&here.model(&x), pour_s, search.targets);
-        let mut end = here.model(&x);
-        keys::insert(&mut end, pour_key, toml::Value::Float(pour_s));
-        let Some(cost) = search.cost_of(&end) else {
-            continue;
-        };
-        if best.as_ref().is_none_or(|(_, _, c)| cost < *c) {
-            best = Some((pour_s, x, cost));
+    let mut best: Option<(bool, f64, Vec<f64>, f64)> = None;
+    for start in starts {
+        let (mut x, mut pour_s) = (start, units_pour_s);
+        // Each round ends where the next starts, with a fresh simplex (Nelder–Mead's shrunken
+        // simplex stalls in a valley; a restart walks on).
+        for _ in 0..SEARCH_ROUNDS {
+            // Each start glugs at the recordings' rate before the search, and its end again
+            // after: the rate is the pour time's alone, and a search that set both would wander
+            // off where too few glugs are heard to tell.
+            balance(search, &mut x, search.targets);
+            pour_s = matched_pour_time(&search.model(&x), pour_s, search.targets);
+            let mut start_base = search.base.clone();
+            keys::insert(&mut start_base, pour_key, toml::Value::Float(pour_s));
+            let here = Search {
+                base: &start_base,
+                ..*search
+            };
+            let Some((end_x, _)) = minimise(&here, x.clone()) else {
+                break;
+            };
+            x = end_x;
+            balance(&here, &mut x, search.targets);
+            pour_s = matched_pour_time(&here.model(&x), pour_s, search.targets);
+            let mut end = here.model(&x);
+            keys::insert(&mut end, pour_key, toml::Value::Float(pour_s));
+            let Some(cost) = search.cost_of(&end) else {
+                break;
+            };
+            let nearer = sounds_like_every_recording(&end, search.targets, 1.0);
+            if best
+                .as_ref()
+                .is_none_or(|&(was_nearer, _, _, c)| (nearer, -cost) > (was_nearer, -c))
+            {
+                best = Some((nearer, pour_s, x.clone(), cost));
+            }
         }
     }
-    best
+    best.map(|(_, pour_s, x, cost)| (pour_s, x, cost))
 }
 
 /// Marks the estimate of `key` as fitted by listening, at `value` (added if the units gave none).

@@ -1,12 +1,12 @@
 //! The units table (`sake-glug fit --units FILE.csv`): a row per detected unit, used or not,
 //! with its fit in eq. 1's terms and why it was not used, and for a used unit its volume and the
 //! frequencies its liquid's model plays there (the headspace law of MODEL.md §5.1 beside the
-//! unit's own).
+//! unit's own), and each mode's glide where it glides (MODEL.md §5.2).
 
 use super::session_fit::SessionFit;
 
 /// The table's columns, in order.
-pub const UNIT_COLUMNS: [&str; 13] = [
+pub const UNIT_COLUMNS: [&str; 17] = [
     "recording",
     "onset_s",
     "f1_hz",
@@ -20,6 +20,10 @@ pub const UNIT_COLUMNS: [&str; 13] = [
     "volume_ml",
     "f1_model_hz",
     "f2_model_hz",
+    "f1_glide_ratio",
+    "f1_glide_ms",
+    "f2_glide_ratio",
+    "f2_glide_ms",
 ];
 
 /// The units table of `fit` as CSV text (the csv crate quotes a field that needs it).
@@ -61,6 +65,13 @@ pub fn units_csv(fit: &SessionFit) -> String {
                 Some(fit) => (fit.frequency_hz, fit.decay_per_s, fit.amplitude),
                 None => ([f64::NAN; 2], [f64::NAN; 2], [f64::NAN; 2]),
             };
+            // A mode's glide: ρ and τ_g (ms), empty where it does not glide.
+            let glide = |mode: usize| {
+                unit.fit
+                    .and_then(|fit| fit.glide[mode])
+                    .map_or([f64::NAN; 2], |g| [g.ratio, 1e3 * g.time_s])
+            };
+            let (glide1, glide2) = (glide(0), glide(1));
             let onset_s = unit.fit.map_or(unit.onset_s, |fit| fit.onset_s);
             let _ = writer.write_record([
                 name.clone(),
@@ -76,6 +87,10 @@ pub fn units_csv(fit: &SessionFit) -> String {
                 number(volume_ml),
                 number(model_hz[0]),
                 number(model_hz[1]),
+                number(glide1[0]),
+                number(glide1[1]),
+                number(glide2[0]),
+                number(glide2[1]),
             ]);
         }
     }

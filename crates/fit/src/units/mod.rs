@@ -149,14 +149,24 @@ impl Component {
         let numbers = [hz, decay, self.amplitude, self.frequency_hz, self.phase];
         // A glide starts at ρ·f, which must lie in the model's range of ρ and be heard.
         let start_hz = self.glide.map_or(hz, |g| g.ratio * self.frequency_hz);
-        let ratio_range = Constant::F1GlideRatio.range();
+        let (ratios, times_ms) = (
+            Constant::F1GlideRatio.range(),
+            Constant::F1GlideTime.range(),
+        );
+        let out_of_range = self
+            .glide
+            .filter(|g| !(ratios.contains(g.ratio) && times_ms.contains(1e3 * g.time_s)));
         if !(numbers.iter().all(|v| v.is_finite()) && glide_finite) {
             Err(Rejection::NotFinite)
         } else if !(LOWEST_HZ..fs / 2.0).contains(&hz) {
             Err(Rejection::Frequency { hz })
+        } else if let Some(glide) = out_of_range {
+            Err(Rejection::GlideRange {
+                ratio: glide.ratio,
+                glide_ms: 1e3 * glide.time_s,
+            })
         } else if !(LOWEST_HZ..fs / 2.0).contains(&start_hz)
             || !(LOWEST_HZ..fs / 2.0).contains(&self.frequency_hz)
-            || self.glide.is_some_and(|g| !ratio_range.contains(g.ratio))
         {
             Err(Rejection::Frequency { hz: start_hz })
         } else if decay <= 0.0 {
@@ -252,9 +262,15 @@ impl UnitFit {
             }
         }
         for (mode, component) in best.into_iter().enumerate() {
+            // A glide slower than its ring never reaches its own f: the mode is the pitch heard.
+            let heard = component.filter(|c| c.unheard_glide().is_some());
             self.amplitude[mode] = component.map_or(0.0, |c| c.amplitude);
-            self.frequency_hz[mode] = component.map_or(f64::NAN, |c| c.frequency_hz);
-            self.glide[mode] = component.and_then(|c| c.glide);
+            self.frequency_hz[mode] = match (component, heard) {
+                (_, Some(c)) => c.heard_hz,
+                (Some(c), None) => c.frequency_hz,
+                (None, None) => f64::NAN,
+            };
+            self.glide[mode] = component.and_then(|c| c.glide).filter(|_| heard.is_none());
             self.decay_per_s[mode] = component.map_or(f64::NAN, |c| c.decay_per_s);
         }
     }
@@ -346,6 +362,14 @@ pub enum Rejection {
     },
     /// A component that does not decay.
     NoDecay,
+    /// A component whose glide lies outside the model's ranges of ρ and τ_g (a fit's free phase,
+    /// not a sweep).
+    GlideRange {
+        /// ρ.
+        ratio: f64,
+        /// τ_g (ms).
+        glide_ms: f64,
+    },
     /// A component gliding so slowly that its ring dies before it reaches its own frequency:
     /// that frequency is not heard, so no fit can tell it.
     GlideUnheard {
@@ -388,6 +412,7 @@ impl Rejection {
             Rejection::OutOfPhase => "a negative amplitude",
             Rejection::Frequency { .. } => "a frequency out of range",
             Rejection::NoDecay => "no decay",
+            Rejection::GlideRange { .. } => "a glide out of range",
             Rejection::Click { .. } => "a click",
             Rejection::GlideUnheard { .. } => "a glide slower than its ring",
             Rejection::Unexplained { .. } => "the fit explains too little",
@@ -414,6 +439,18 @@ impl std::fmt::Display for Rejection {
                 "a component at {hz:.1} Hz, outside {LOWEST_HZ} Hz … half the sample rate"
             ),
             Rejection::NoDecay => write!(f, "a component does not decay"),
+            Rejection::GlideRange { ratio, glide_ms } => {
+                let (ratios, times_ms) = (
+                    Constant::F1GlideRatio.range(),
+                    Constant::F1GlideTime.range(),
+                );
+                write!(
+                    f,
+                    "a component glides from ρ = {ratio:.2} over τ_g = {glide_ms:.1} ms, outside \
+                     the model's {} … {} and {} … {} ms",
+                    ratios.min, ratios.max, times_ms.min, times_ms.max
+                )
+            }
             Rejection::GlideUnheard { glide_ms, ring_ms } => write!(
                 f,
                 "a component glides with τ_g = {glide_ms:.1} ms but rings for 1/B = \
@@ -692,7 +729,7 @@ fn fit_one_way(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<Unit
             &window,
             span.onset_s(),
             &starts[..count],
-            method == UnitMethod::Glide,
+            &[method == UnitMethod::Glide; 2],
         )
         .map_err(|rejection| Box::new((rejection, None)))
         .map(|fitted| {
@@ -729,7 +766,7 @@ fn fit_one_way(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<Unit
 pub(super) fn with_glide(span: &Span, unit: UnitFit) -> UnitFit {
     let starts: Vec<(f64, f64)> = unit.fitted().map(|c| (c.heard_hz, c.decay_per_s)).collect();
     let window = span.window_until(unit.stride, unit.window.1);
-    let Ok(fitted) = phased::fit(&window, span.onset_s(), &starts, true) else {
+    let Ok(fitted) = phased::fit(&window, span.onset_s(), &starts, &[true; 2]) else {
         return unit;
     };
     let glided = UnitFit::new(

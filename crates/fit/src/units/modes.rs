@@ -15,6 +15,12 @@ pub const SEPARATE_MODES: f64 = super::super::spectrum::PEAK_SEPARATION;
 /// tenth of their distance more than 14.
 pub const MIN_ASHMAN_D: f64 = 4.0;
 
+/// A mode is rung by at least this many components…
+pub const MIN_MODE_COMPONENTS: usize = 3;
+/// …and this share of them: a pitch one unit or two show (hum a fit took in, a splash) is no
+/// mode of the bottle's, as a short mode is the bottle's only where units enough ring it.
+pub const MIN_MODE_SHARE: f64 = 0.05;
+
 /// How components are put in modes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Modes {
@@ -49,9 +55,13 @@ impl Modes {
         let total_squares: f64 = logs.iter().map(|x| x * x).sum();
         let (mut best, mut best_cost) = (None, f64::INFINITY);
         let (mut sum, mut squares) = (0.0, 0.0);
+        let fewest = MIN_MODE_COMPONENTS.max((MIN_MODE_SHARE * logs.len() as f64).ceil() as usize);
         for split in 1..logs.len() {
             sum += logs[split - 1];
             squares += logs[split - 1] * logs[split - 1];
+            if split < fewest || logs.len() - split < fewest {
+                continue;
+            }
             let (n_low, n_high) = (split as f64, (logs.len() - split) as f64);
             let cost = (squares - sum * sum / n_low)
                 + (total_squares - squares - (total - sum).powi(2) / n_high);
@@ -129,6 +139,18 @@ mod tests {
         assert_eq!(Modes::of(&spread), Modes::One);
         assert_eq!(two.mode_of(81.0, 0, 1), 0);
         assert_eq!(two.mode_of(305.0, 0, 1), 1);
+        // One unit's hum beside twenty units' one mode is no mode of the bottle's.
+        let mut hum = vec![515.0; 20];
+        hum.push(52.0);
+        assert_eq!(Modes::of(&hum), Modes::One);
+        // Nor is a pitch in two units of a hundred.
+        let mut splash = vec![515.0; 98];
+        splash.extend([2000.0, 2010.0]);
+        assert_eq!(Modes::of(&splash), Modes::One);
+        // Three units of twenty ring a bright mode: two modes.
+        let mut bright = vec![515.0; 20];
+        bright.extend([1400.0, 1420.0, 1380.0]);
+        assert!(matches!(Modes::of(&bright), Modes::Split(_)));
     }
 
     #[test]

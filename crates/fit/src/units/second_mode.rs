@@ -69,12 +69,12 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
             .map(|n| (span.samples[n] - fit.value_at((span.first + n) as f64 / span.fs)).powi(2))
             .sum()
     };
-    let pair = |glide: bool| -> Option<UnitFit> {
+    let pair = |gliding: [bool; 2]| -> Option<UnitFit> {
         let pair = phased::fit(
             &window,
             unit.onset_s,
             &[(main.heard_hz, main.decay_per_s), short],
-            glide,
+            &gliding,
         )
         .ok()?;
         let both = UnitFit::new(
@@ -102,11 +102,16 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
             _ => false,
         };
         let early_gain = 1.0 - left_by(&both) / left_early.max(1e-300);
-        let checked = if glide {
-            check_glide(both, span.fs)
-        } else {
-            check(both, span.fs)
-        };
+        // The unit's own mode must still be heard as it was; the short one may glide more
+        // slowly than it rings, and is then the pitch it is heard at (`UnitFit::assign`).
+        let low_heard = both.components[0].is_none_or(|low| low.unheard_glide().is_none());
+        let checked = check(both, span.fs).and_then(|both| {
+            if low_heard {
+                Ok(both)
+            } else {
+                check_glide(both, span.fs)
+            }
+        });
         match checked.and_then(|both| at_peak(span, both)) {
             Ok(both)
                 if two_modes
@@ -118,12 +123,15 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
             _ => None,
         }
     };
-    // A gliding unit's pair glides too (the bright mode sweeps as the bubble forms), else, where
-    // that fails (the short mode's glide slower than its ring), the two steady.
+    // A gliding unit's pair glides too (the bright mode sweeps as the bubble forms); where that
+    // fails (most often the short mode's glide is slower than its ring, and only the pitch it is
+    // heard at is known), the main mode glides and the short one is steady; else the two steady.
     if main.glide.is_some() {
-        pair(true).or_else(|| pair(false))
+        pair([true, true])
+            .or_else(|| pair([true, false]))
+            .or_else(|| pair([false, false]))
     } else {
-        pair(false)
+        pair([false, false])
     }
 }
 
