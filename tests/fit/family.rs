@@ -757,14 +757,7 @@ fn one_draw_runs_through_the_harness() {
 /// 43). Their f2 and c come within tolerance (MODEL.md §13, "A short bright mode").
 #[test]
 fn weak_short_bright_modes_of_the_development_set_are_found() {
-    let f2_and_c = [1, 4];
-    let missed: Vec<String> = [4, 43, 44]
-        .into_iter()
-        .map(|seed| fit_draw(&draw(seed)))
-        .filter(|outcome| !f2_and_c.iter().all(|&measure| outcome.passes(measure)))
-        .map(|outcome| markdown("development", std::slice::from_ref(&outcome)))
-        .collect();
-    assert!(missed.is_empty(), "{}", missed.join("\n"));
+    assert_draws_pass(&[4, 43, 44], &[1, 4]);
 }
 
 /// Development draws whose modes glide (MODEL.md §13, "A glug that glides"): a cavity sweeping
@@ -774,18 +767,7 @@ fn weak_short_bright_modes_of_the_development_set_are_found() {
 /// for 204, f2 1328 Hz for 1491).
 #[test]
 fn gliding_draws_of_the_development_set_are_heard() {
-    let pitch_and_glide = [0, 1, 8];
-    let missed: Vec<String> = [38, 56, 60]
-        .into_iter()
-        .map(|seed| fit_draw(&draw(seed)))
-        .filter(|outcome| {
-            !pitch_and_glide
-                .iter()
-                .all(|&measure| outcome.passes(measure))
-        })
-        .map(|outcome| markdown("development", std::slice::from_ref(&outcome)))
-        .collect();
-    assert!(missed.is_empty(), "{}", missed.join("\n"));
+    assert_draws_pass(&[38, 56, 60], &[0, 1, 8]);
 }
 
 /// Draws 31 and 41 of the development set: a cavity gliding down into 466 and 324 Hz beside a
@@ -794,11 +776,16 @@ fn gliding_draws_of_the_development_set_are_heard() {
 /// at the pitch it is heard at (before, the bubble mode was lost: f2 kept at 300 Hz, c = 1).
 #[test]
 fn a_bright_mode_beside_a_gliding_cavity_is_heard() {
-    let bright_mode = [1, 3, 4];
-    let missed: Vec<String> = [31, 41]
-        .into_iter()
-        .map(|seed| fit_draw(&draw(seed)))
-        .filter(|outcome| !bright_mode.iter().all(|&measure| outcome.passes(measure)))
+    assert_draws_pass(&[31, 41], &[1, 3, 4]);
+}
+
+/// Fits each development draw of `seeds` and fails with the rows of those that miss any of
+/// `measures` (indices into [`MEASURES`]).
+fn assert_draws_pass(seeds: &[u64], measures: &[usize]) {
+    let missed: Vec<String> = seeds
+        .iter()
+        .map(|&seed| fit_draw(&draw(seed)))
+        .filter(|outcome| !measures.iter().all(|&measure| outcome.passes(measure)))
         .map(|outcome| markdown("development", std::slice::from_ref(&outcome)))
         .collect();
     assert!(missed.is_empty(), "{}", missed.join("\n"));

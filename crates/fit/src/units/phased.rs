@@ -488,6 +488,32 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for PhasedProblem<'_> {
 mod tests {
     use super::*;
 
+    /// `components` from `onset_s` on, `read` samples at `fs`, every `stride`-th.
+    fn window_of(
+        components: &[Component],
+        onset_s: f64,
+        read: usize,
+        fs: f64,
+        stride: usize,
+    ) -> Window {
+        let data = (0..read)
+            .map(|n| {
+                let tau = (stride * n) as f64 / fs - onset_s;
+                if tau < 0.0 {
+                    0.0
+                } else {
+                    components.iter().map(|c| c.value(tau)).sum()
+                }
+            })
+            .collect();
+        Window {
+            data,
+            first: 0,
+            stride,
+            fs,
+        }
+    }
+
     /// A component out of phase and a second, fitted from starts 5 % off, come back exactly.
     #[test]
     fn two_components_with_phases_of_their_own_come_back() {
@@ -513,22 +539,7 @@ mod tests {
             },
         ];
         let onset_s = 0.004;
-        let data: Vec<f64> = (0..2000)
-            .map(|n| {
-                let tau = n as f64 / fs - onset_s;
-                if tau < 0.0 {
-                    0.0
-                } else {
-                    truth.iter().map(|c| c.value(tau)).sum()
-                }
-            })
-            .collect();
-        let window = Window {
-            data,
-            first: 0,
-            stride: 1,
-            fs,
-        };
+        let window = window_of(&truth, onset_s, 2000, fs, 1);
         let fitted = fit(
             &window,
             onset_s + 0.001,
@@ -593,22 +604,7 @@ mod tests {
         };
         let onset_s = 0.004;
         let stride = 2;
-        let data: Vec<f64> = (0..(0.08 * fs) as usize / stride)
-            .map(|n| {
-                let tau = (stride * n) as f64 / fs - onset_s;
-                if tau < 0.0 {
-                    0.0
-                } else {
-                    truth.value(tau)
-                }
-            })
-            .collect();
-        let window = Window {
-            data,
-            first: 0,
-            stride,
-            fs,
-        };
+        let window = window_of(&[truth], onset_s, (0.08 * fs) as usize / stride, fs, stride);
         let fitted =
             fit(&window, onset_s, &[(530.0, 40.0)], &[true]).unwrap_or_else(|_| panic!("no fit"));
         let got = fitted.components[0];
@@ -685,22 +681,7 @@ mod tests {
             ..cavity
         };
         let onset_s = 0.004;
-        let data: Vec<f64> = (0..(0.1 * fs) as usize)
-            .map(|n| {
-                let tau = n as f64 / fs - onset_s;
-                if tau < 0.0 {
-                    0.0
-                } else {
-                    cavity.value(tau) + bubble.value(tau)
-                }
-            })
-            .collect();
-        let window = Window {
-            data,
-            first: 0,
-            stride: 1,
-            fs,
-        };
+        let window = window_of(&[cavity, bubble], onset_s, (0.1 * fs) as usize, fs, 1);
         let fitted = fit(
             &window,
             onset_s,

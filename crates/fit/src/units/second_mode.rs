@@ -14,7 +14,7 @@ use super::eq1;
 use super::modes::SEPARATE_MODES;
 use super::phased;
 use super::window::Span;
-use super::{at_peak, check, check_glide, Fitted, Placed, Strides, UnitFit};
+use super::{at_peak, check, Fitted, Placed, Strides, UnitFit};
 use crate::spectrum::own_peak_above;
 
 /// The early part of a unit where a short mode is sought (s).
@@ -102,19 +102,14 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
             _ => false,
         };
         let early_gain = 1.0 - left_by(&both) / left_early.max(1e-300);
-        // The unit's own mode must still be heard as it was; the short one may glide more
-        // slowly than it rings, and is then the pitch it is heard at (`UnitFit::assign`).
+        // The unit's own mode must still reach its own f while it rings; the short one may
+        // glide more slowly than it rings, and is then the pitch it is heard at
+        // (`UnitFit::assign`).
         let low_heard = both.components[0].is_none_or(|low| low.unheard_glide().is_none());
-        let checked = check(both, span.fs).and_then(|both| {
-            if low_heard {
-                Ok(both)
-            } else {
-                check_glide(both, span.fs)
-            }
-        });
-        match checked.and_then(|both| at_peak(span, both)) {
+        match check(both, span.fs).and_then(|both| at_peak(span, both)) {
             Ok(both)
-                if two_modes
+                if low_heard
+                    && two_modes
                     && early_gain >= MIN_EARLY_GAIN
                     && both.r_squared >= unit.r_squared - SPAN_SLACK =>
             {
@@ -124,8 +119,8 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
         }
     };
     // A gliding unit's pair glides too (the bright mode sweeps as the bubble forms); where that
-    // fails (most often the short mode's glide is slower than its ring, and only the pitch it is
-    // heard at is known), the main mode glides and the short one is steady; else the two steady.
+    // fails (a glide out of range, or the unit's own mode no longer reaching its f), the main
+    // mode glides and the short one is steady; else the two steady.
     if main.glide.is_some() {
         pair([true, true])
             .or_else(|| pair([true, false]))
