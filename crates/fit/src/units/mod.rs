@@ -245,6 +245,20 @@ impl UnitFit {
         unit
     }
 
+    /// The unit a phased fit gives, placed at `placed`.
+    fn of_phased(fitted: &phased::PhasedFit, placed: Placed, method: UnitMethod) -> Self {
+        Self::new(
+            Fitted {
+                onset_s: fitted.onset_s,
+                components: &fitted.components,
+                explained: fitted.explained,
+            },
+            placed,
+            None,
+            method,
+        )
+    }
+
     /// Its components, as fitted.
     pub fn fitted(&self) -> impl Iterator<Item = &Component> {
         self.components.iter().flatten()
@@ -733,18 +747,13 @@ fn fit_one_way(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<Unit
         )
         .map_err(|rejection| Box::new((rejection, None)))
         .map(|fitted| {
-            UnitFit::new(
-                Fitted {
-                    onset_s: fitted.onset_s,
-                    components: &fitted.components,
-                    explained: fitted.explained,
-                },
+            UnitFit::of_phased(
+                &fitted,
                 Placed {
                     window: (span.first, end),
                     stride: own_strides.fit,
                     fs: span.fs,
                 },
-                None,
                 method,
             )
         })
@@ -769,18 +778,13 @@ pub(super) fn with_glide(span: &Span, unit: UnitFit) -> UnitFit {
     let Ok(fitted) = phased::fit(&window, span.onset_s(), &starts, &[true; 2]) else {
         return unit;
     };
-    let glided = UnitFit::new(
-        Fitted {
-            onset_s: fitted.onset_s,
-            components: &fitted.components,
-            explained: fitted.explained,
-        },
+    let glided = UnitFit::of_phased(
+        &fitted,
         Placed {
             window: unit.window,
             stride: unit.stride,
             fs: span.fs,
         },
-        None,
         UnitMethod::Glide,
     );
     match check_glide(glided, span.fs).and_then(|glided| at_peak(span, glided)) {

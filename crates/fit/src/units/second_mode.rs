@@ -14,7 +14,7 @@ use super::eq1;
 use super::modes::SEPARATE_MODES;
 use super::phased;
 use super::window::Span;
-use super::{at_peak, check, Fitted, Placed, Strides, UnitFit};
+use super::{at_peak, check, Placed, Strides, UnitFit};
 use crate::spectrum::own_peak_above;
 
 /// The early part of a unit where a short mode is sought (s).
@@ -77,18 +77,13 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
             &gliding,
         )
         .ok()?;
-        let both = UnitFit::new(
-            Fitted {
-                onset_s: pair.onset_s,
-                components: &pair.components,
-                explained: pair.explained,
-            },
+        let both = UnitFit::of_phased(
+            &pair,
             Placed {
                 window: (span.first, span.end),
                 stride: strides.fit,
                 fs: span.fs,
             },
-            None,
             unit.method,
         );
         // The pair must still be two modes, neither drawn onto the other's frequency, and the
