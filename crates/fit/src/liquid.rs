@@ -25,6 +25,9 @@ const Z_95: f64 = 1.959_963_984_540_054;
 const V0_BEYOND_DATA: f64 = 0.25;
 /// A mode's spread is estimated from at least this many units of it.
 const MIN_UNITS_FOR_SPREAD: usize = 3;
+/// A mode's decay is taken from the units that fitted it gliding where at least this many did
+/// (as few as a short mode's agreement asks for).
+const MIN_SWEPT_UNITS: usize = 3;
 
 /// One liquid's model.
 #[derive(Debug, Clone)]
@@ -225,7 +228,22 @@ fn unit_estimates(units: &[FittedUnit], capacity_ml: f64, pocket_ml: f64) -> Vec
         _ => median(&of(&|u| u.fit.frequency_hz[k])),
     });
     let exponent = law.modes.map(|mode| mode.map_or(f64::NAN, |m| m.exponent));
-    let b = [0, 1].map(|k| of(&|u| u.fit.decay_per_s[k]));
+    // A mode rising into its pitch, fitted steady, decays up to three times as fast as it rings;
+    // where enough units fitted the mode gliding, its decay is theirs (MODEL.md §13).
+    let b = [0, 1].map(|k| {
+        let swept = of(&|u| {
+            if u.fit.swept[k] {
+                u.fit.decay_per_s[k]
+            } else {
+                f64::NAN
+            }
+        });
+        if swept.len() >= MIN_SWEPT_UNITS {
+            swept
+        } else {
+            of(&|u| u.fit.decay_per_s[k])
+        }
+    });
     // A spread over the modes with enough units to show one.
     let mean_over_modes = |values: &[Vec<f64>; 2], spread: &dyn Fn(&[f64]) -> f64| {
         let spreads: Vec<f64> = values

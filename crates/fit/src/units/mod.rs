@@ -61,8 +61,14 @@ const SUBTRACT_UNTIL: f64 = 1e-4;
 /// has fallen by e² (17 dB) the pitch is at least 1/e of the way to its own frequency, which is
 /// then heard; a slower glide's end is a guess (MODEL.md §13).
 const GLIDE_REACHED: f64 = 2.0;
-/// A glide is kept where it leaves at most this share of what a steady fit left of a unit.
-const GLIDE_LEAVES: f64 = 0.75;
+/// A glide is kept where it leaves at most this share of what a steady fit left of a unit (or of
+/// a short mode's first samples).
+pub(super) const GLIDE_LEAVES: f64 = 0.75;
+/// A glide refit may ring its unit's stronger mode at most this many times as long as the steady
+/// fit did: fitted steady, a sweep decays up to about twice as fast as it rings (MODEL.md §13), so
+/// a glide ringing longer still has traded its sweep for a ring the window cannot check, and
+/// subtracted, that ring would lie in every later unit's residual for a second.
+const GLIDE_RINGS_LONGER: f64 = 2.0;
 /// A gliding unit is fitted again in the first this share of its span…
 const GLIDE_SHARE: f64 = 0.4;
 /// …but never fewer than this many periods of its lowest start.
@@ -207,6 +213,9 @@ pub struct UnitFit {
     pub glide: [Option<UnitGlide>; 2],
     /// B1, B2 (1/s; NaN where it does not ring that mode).
     pub decay_per_s: [f64; 2],
+    /// Whether each mode's component was fitted gliding, its glide heard or not: a mode rising
+    /// into its pitch, fitted steady, decays too fast (MODEL.md §13).
+    pub swept: [bool; 2],
     /// The share of the samples fitted that the fit explains.
     pub r_squared: f64,
     /// The span fitted, `[first, end)`…
@@ -235,6 +244,7 @@ impl UnitFit {
             frequency_hz: [f64::NAN; 2],
             glide: [None; 2],
             decay_per_s: [f64::NAN; 2],
+            swept: [false; 2],
             r_squared: fitted.explained,
             window: placed.window,
             stride: placed.stride,
@@ -286,6 +296,7 @@ impl UnitFit {
             };
             self.glide[mode] = component.and_then(|c| c.glide).filter(|_| heard.is_none());
             self.decay_per_s[mode] = component.map_or(f64::NAN, |c| c.decay_per_s);
+            self.swept[mode] = component.is_some_and(|c| c.glide.is_some());
         }
     }
 
@@ -744,6 +755,7 @@ fn fit_one_way(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<Unit
             span.onset_s(),
             &starts[..count],
             &[method == UnitMethod::Glide; 2],
+            0,
         )
         .map_err(|rejection| Box::new((rejection, None)))
         .map(|fitted| {
@@ -772,32 +784,71 @@ fn fit_one_way(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<Unit
 /// same samples; the glide is kept where it leaves at most [`GLIDE_LEAVES`] of what the steady
 /// fit left, and passes the same checks. A glide has two numbers more per component, so on a
 /// steady unit it explains next to nothing more; on a gliding one a steady fit leaves the sweep.
+/// Where every component gliding fails the checks, the stronger glides and the other is steady,
+/// then the stronger glides alone: a weak component a steady fit spent on the sweep's residue
+/// has no glide of its own to find, and one out of range must not cost the mode its glide.
 pub(super) fn with_glide(span: &Span, unit: UnitFit) -> UnitFit {
     let starts: Vec<(f64, f64)> = unit.fitted().map(|c| (c.heard_hz, c.decay_per_s)).collect();
-    let window = span.window_until(unit.stride, unit.window.1);
-    let Ok(fitted) = phased::fit(&window, span.onset_s(), &starts, &[true; 2]) else {
-        return unit;
-    };
-    let glided = UnitFit::of_phased(
-        &fitted,
-        Placed {
-            window: unit.window,
-            stride: unit.stride,
-            fs: span.fs,
-        },
-        UnitMethod::Glide,
-    );
-    match check_glide(glided, span.fs).and_then(|glided| at_peak(span, glided)) {
-        Ok(glided) if 1.0 - glided.r_squared <= GLIDE_LEAVES * (1.0 - unit.r_squared) => glided,
-        _ => unit,
+    let stronger = unit
+        .fitted()
+        .position(|c| Some(c) == unit.stronger())
+        .unwrap_or(0);
+    let mut attempts = vec![(starts.clone(), [true; 2])];
+    if starts.len() > 1 {
+        let mut stronger_only = [false; 2];
+        stronger_only[stronger] = true;
+        attempts.push((starts.clone(), stronger_only));
+        attempts.push((vec![starts[stronger]], [true, false]));
     }
+    let window = span.window_until(unit.stride, unit.window.1);
+    for (starts, gliding) in attempts {
+        let Ok(fitted) = phased::fit(
+            &window,
+            span.onset_s(),
+            &starts,
+            &gliding,
+            phased::GLIDE_RESTARTS,
+        ) else {
+            continue;
+        };
+        let glided = UnitFit::of_phased(
+            &fitted,
+            Placed {
+                window: unit.window,
+                stride: unit.stride,
+                fs: span.fs,
+            },
+            UnitMethod::Glide,
+        );
+        let ring = |unit: &UnitFit| unit.stronger().map_or(f64::NAN, |c| 1.0 / c.decay_per_s);
+        // A steady component beside the glide stands for what is left of the sweep, below it; one
+        // drawn up to a bright mode would ring it steady, and a mode rising into its pitch,
+        // fitted steady, decays too fast: that mode is left to the short mode's pair, which fits
+        // it gliding first.
+        let steady_below = glided.components.iter().flatten().all(|c| {
+            c.glide.is_some() || glided.stronger().is_none_or(|s| c.heard_hz < s.heard_hz)
+        });
+        match check_glide(glided, span.fs).and_then(|glided| at_peak(span, glided)) {
+            Ok(glided)
+                if 1.0 - glided.r_squared <= GLIDE_LEAVES * (1.0 - unit.r_squared)
+                    && ring(&glided) <= GLIDE_RINGS_LONGER * ring(&unit)
+                    && steady_below =>
+            {
+                return glided
+            }
+            _ => {}
+        }
+    }
+    unit
 }
 
-/// A glide fitted to a unit a steady fit described, checked as [`check`] does and heard: every
-/// component reaches its own frequency while it rings (else the steady fit stands).
+/// A glide fitted to a unit a steady fit described, checked as [`check`] does and heard: its
+/// stronger component reaches its own frequency while it rings (else the steady fit stands). A
+/// weaker one may glide more slowly than it rings, as a short mode in a pair may; its mode is
+/// then the pitch it is heard at (`UnitFit::assign`).
 fn check_glide(unit: UnitFit, fs: f64) -> Result<UnitFit, Failed> {
     let unit = check(unit, fs)?;
-    let unheard = unit.fitted().find_map(Component::unheard_glide);
+    let unheard = unit.stronger().and_then(Component::unheard_glide);
     match unheard {
         Some(rejection) => Err(Box::new((rejection, Some(unit)))),
         None => Ok(unit),
