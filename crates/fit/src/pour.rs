@@ -40,8 +40,9 @@ pub fn pockets(recordings: &[&RecordingFit]) -> Vec<f64> {
 }
 
 /// A recording without a weight log drains at pocket / median interval from its start volume,
-/// pouring from a pocket's time before its first unit. Units that count past an empty bottle
-/// (the recording is not the pour its session says) are given no volume, and that is warned.
+/// pouring from a pocket's time before its first unit detected, kept or not. Units that count
+/// past an empty bottle (the recording is not the pour its session says) are given no volume, and
+/// that is warned.
 pub fn complete_without_weight(
     recording: &mut RecordingFit,
     pocket_ml: f64,
@@ -57,7 +58,13 @@ pub fn complete_without_weight(
     if !(rate.is_finite() && rate > 0.0) {
         return;
     }
-    let poured_from = recording.units[0].fit.onset_s - pocket_ml / rate;
+    // The first glug detected poured its pocket whether or not a fit described it.
+    let first_onset_s = recording
+        .detected
+        .iter()
+        .map(|unit| unit.onset_s)
+        .fold(recording.units[0].fit.onset_s, f64::min);
+    let poured_from = first_onset_s - pocket_ml / rate;
     let line = Line {
         slope: -rate,
         intercept: start_ml + rate * poured_from,

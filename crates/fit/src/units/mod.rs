@@ -21,7 +21,7 @@ mod window;
 
 use std::f64::consts::TAU;
 
-use sake_glug_engine::Constant;
+use sake_glug_engine::{Constant, Range};
 
 use super::listen::glug_onsets;
 use super::onsets::detect_onsets;
@@ -73,6 +73,15 @@ const GLIDE_RINGS_LONGER: f64 = 2.0;
 const GLIDE_SHARE: f64 = 0.4;
 /// …but never fewer than this many periods of its lowest start.
 const GLIDE_PERIODS: f64 = 4.0;
+
+/// The model's ranges of a glide's ρ and τ_g (ms), which every mode shares (MODEL.md §12): a
+/// component is fitted before it is put in a mode.
+pub(super) fn glide_ranges() -> (Range, Range) {
+    (
+        Constant::F1GlideRatio.range(),
+        Constant::F1GlideTime.range(),
+    )
+}
 
 /// One resonance of a unit: A·e^(−Bτ)·sin(2π·cycles(τ) + φ), τ the time since the unit's onset,
 /// cycles(τ) = fτ for a steady component (φ = 0 in the paper's eq. 1) and, for one that glides
@@ -155,10 +164,7 @@ impl Component {
         let numbers = [hz, decay, self.amplitude, self.frequency_hz, self.phase];
         // A glide starts at ρ·f, which must lie in the model's range of ρ and be heard.
         let start_hz = self.glide.map_or(hz, |g| g.ratio * self.frequency_hz);
-        let (ratios, times_ms) = (
-            Constant::F1GlideRatio.range(),
-            Constant::F1GlideTime.range(),
-        );
+        let (ratios, times_ms) = glide_ranges();
         let out_of_range = self
             .glide
             .filter(|g| !(ratios.contains(g.ratio) && times_ms.contains(1e3 * g.time_s)));
@@ -465,10 +471,7 @@ impl std::fmt::Display for Rejection {
             ),
             Rejection::NoDecay => write!(f, "a component does not decay"),
             Rejection::GlideRange { ratio, glide_ms } => {
-                let (ratios, times_ms) = (
-                    Constant::F1GlideRatio.range(),
-                    Constant::F1GlideTime.range(),
-                );
+                let (ratios, times_ms) = glide_ranges();
                 write!(
                     f,
                     "a component glides from ρ = {ratio:.2} over τ_g = {glide_ms:.1} ms, outside \
@@ -635,9 +638,9 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
         match fit_one_way(&span, start_hz, strides) {
             Ok(unit) => {
                 let with_short = second_mode::with_second_mode(&span, unit);
-                subtract(&mut residual, &with_short.unwrap_or(unit), fs);
                 short_modes.push(with_short.map(|both| (detected.len(), unit, both)));
                 let unit = with_short.unwrap_or(unit);
+                subtract(&mut residual, &unit, fs);
                 units.push(unit);
                 detected.push(DetectedUnit {
                     onset_s,
@@ -914,6 +917,24 @@ fn subtract(signal: &mut [f32], unit: &UnitFit, fs: f64) {
             component.frequency_hz,
             component.decay_per_s,
             |n, z, _| signal[first + n] -= (sine * z.im + cosine * z.re) as f32,
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `glide_ranges` reads f1's ranges for every component: that holds only while f2's are the
+    /// same.
+    #[test]
+    fn every_mode_shares_the_glide_ranges() {
+        assert_eq!(
+            glide_ranges(),
+            (
+                Constant::F2GlideRatio.range(),
+                Constant::F2GlideTime.range()
+            )
         );
     }
 }

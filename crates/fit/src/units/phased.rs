@@ -15,10 +15,8 @@ use std::f64::consts::TAU;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
 
-use sake_glug_engine::Constant;
-
 use super::window::Window;
-use super::{Component, Rejection, UnitGlide};
+use super::{glide_ranges, Component, Rejection, UnitGlide};
 
 /// The onset grid: this range around the detected onset (s), in steps.
 const ONSET_GRID_S: (f64, f64, f64) = (-0.004, 0.002, 0.00025);
@@ -190,10 +188,7 @@ impl Refined {
     /// For each component, whether Levenberg-Marquardt left its glide outside the model's range
     /// (held at its bound): no sweep, and the unit's checks reject it.
     fn held_glides(&self, gliding: &[bool]) -> Vec<bool> {
-        let (ratios, times_ms) = (
-            Constant::F1GlideRatio.range(),
-            Constant::F1GlideTime.range(),
-        );
+        let (ratios, times_ms) = glide_ranges();
         self.numbers
             .iter()
             .zip(gliding)
@@ -454,10 +449,7 @@ impl PhasedProblem<'_> {
         if !self.gliding[k] {
             return (Numbers::steady(p[2], p[3]), [true; 2]);
         }
-        let (ratios, times_ms) = (
-            Constant::F1GlideRatio.range(),
-            Constant::F1GlideTime.range(),
-        );
+        let (ratios, times_ms) = glide_ranges();
         let glide_s = p[5].exp().clamp(
             1e-3 * times_ms.min / GLIDE_BOUND_SLACK,
             1e-3 * times_ms.max * GLIDE_BOUND_SLACK,
@@ -714,10 +706,7 @@ mod tests {
             gliding: &[true, false],
         };
         let (held, which) = problem.held_numbers(0);
-        let (ratios, times_ms) = (
-            Constant::F1GlideRatio.range(),
-            Constant::F1GlideTime.range(),
-        );
+        let (ratios, times_ms) = glide_ranges();
         let ratio = 1.0 + held.glide_cycles / (held.hz * held.glide_s);
         assert_eq!(which, [true, true]);
         assert!((1e3 * held.glide_s / times_ms.min * GLIDE_BOUND_SLACK - 1.0).abs() < 1e-9);
