@@ -63,42 +63,86 @@ pub fn require_tools(command: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Where cargo leaves the Windows builds.
-fn release_dir() -> PathBuf {
-    crate::target_dir().join(TARGET).join("release")
+/// The cargo profile the shipped Windows release is built with.
+pub const RELEASE_PROFILE: &str = "release";
+/// The profile of the Windows build `cargo xtask test` runs under Wine: the release's code, built
+/// faster (Cargo.toml says how).
+pub const TEST_PROFILE: &str = "windows-test";
+
+/// Where cargo leaves the Windows builds of `profile`.
+fn profile_dir(profile: &str) -> PathBuf {
+    crate::target_dir().join(TARGET).join(profile)
 }
 
-/// Where the Windows bundles are laid out (the Linux ones are in target/bundled).
-fn bundled_dir() -> PathBuf {
-    crate::target_dir().join(TARGET).join("bundled")
+/// Where the Windows bundles of `profile` are laid out (the Linux ones are in target/bundled).
+fn bundled_dir(profile: &str) -> PathBuf {
+    profile_dir(profile).join("bundled")
 }
 
-fn cargo_build(package: &str, what: &[&str]) -> anyhow::Result<()> {
-    let mut args = vec![
-        "build",
-        "--release",
-        "--target",
-        TARGET,
-        "--package",
-        package,
-    ];
+/// Where the installer and zip of `profile` are written: target/dist for the release (beside the
+/// Linux release), a folder of their own for any other profile, so that no test build is taken
+/// for the release.
+pub fn dist_dir(profile: &str) -> PathBuf {
+    if profile == RELEASE_PROFILE {
+        crate::target_dir().join("dist")
+    } else {
+        crate::target_dir().join(format!("dist-{profile}"))
+    }
+}
+
+fn cargo_build(profile: &str, what: &[&str]) -> anyhow::Result<()> {
+    let mut args = vec!["build", "--profile", profile, "--target", TARGET];
     args.extend(what);
     crate::cargo(&args)
 }
 
-/// Builds every Windows product: the plugin with its editor (laid out as its CLAP and VST3
-/// bundles at once, before the app's build of the same library with other features replaces
-/// the DLL), the standalone app, the command line with `ogg` and the C library.
-pub fn build() -> anyhow::Result<()> {
+/// The packages of the Windows products, each run of their build names them all: cargo unifies
+/// the features of their shared crates over the packages a run names, so both runs build those
+/// crates alike and the second compiles again only what `standalone` changes.
+const PACKAGES: [&str; 6] = [
+    "--package",
+    "sake-glug-plugin",
+    "--package",
+    "sake-glug",
+    "--package",
+    "sake-glug-c",
+];
+
+/// Builds every Windows product with `profile`, in two cargo runs. The first makes the plugin
+/// with its editor, the command line with `ogg` and the C library; the plugin's DLL is laid out
+/// as its CLAP and VST3 bundles at once. The second makes the standalone app, with the plugin's
+/// `standalone` feature, and replaces the DLL: cargo unifies a package's features within a run,
+/// so one run would give the plugin nice-plug's tracing-subscriber, which installs a global
+/// logger and panic hook in every host that loads it.
+pub fn build(profile: &str) -> anyhow::Result<()> {
     require_tools("the Windows build")?;
-    cargo_build("sake-glug-plugin", &["--lib"])?;
-    bundle_plugin(&release_dir().join("sake_glug_plugin.dll"), &bundled_dir())?;
+    let started = std::time::Instant::now();
     cargo_build(
-        "sake-glug-plugin",
-        &["--bin", "sake-glug-standalone", "--features", "standalone"],
+        profile,
+        &[&PACKAGES[..], &["--lib", "--bin", "sake-glug"]].concat(),
     )?;
-    cargo_build("sake-glug", &["--bin", "sake-glug", "--features", "ogg"])?;
-    cargo_build("sake-glug-c", &[])
+    bundle_plugin(
+        &profile_dir(profile).join("sake_glug_plugin.dll"),
+        &bundled_dir(profile),
+    )?;
+    cargo_build(
+        profile,
+        &[
+            &PACKAGES[..],
+            &[
+                "--bin",
+                "sake-glug-standalone",
+                "--features",
+                "sake-glug-plugin/standalone",
+            ],
+        ]
+        .concat(),
+    )?;
+    println!(
+        "windows: built with the {profile} profile in {:.0} s",
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 /// The plugin's DLL as Windows hosts want it: `Sake Glug.clap` (CLAP has no bundle on Windows)
@@ -127,9 +171,9 @@ pub struct Built {
 }
 
 impl Built {
-    pub fn here() -> anyhow::Result<Self> {
-        let release = release_dir();
-        let bundled = bundled_dir();
+    pub fn here(profile: &str) -> anyhow::Result<Self> {
+        let release = profile_dir(profile);
+        let bundled = bundled_dir(profile);
         let built = Self {
             cli: release.join("sake-glug.exe"),
             standalone: release.join("sake-glug-standalone.exe"),
