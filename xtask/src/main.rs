@@ -33,8 +33,8 @@
 //!   test` makes (built first if they are not; see dist.rs).
 //! - `cargo xtask dist windows [--profile windows-test]`: the Windows installer and zip in
 //!   target/dist/, cross-built with MinGW-w64 (windows.rs); with the `windows-test` profile
-//!   (built without link-time optimisation, as `cargo xtask test` builds it for its Wine tests),
-//!   in target/dist-windows-test/.
+//!   (built without link-time optimisation and without the standalone app, as `cargo xtask
+//!   test` builds it for its Wine tests), in target/dist-windows-test/.
 //!
 //! Each product is built with only its features: the bundles with `editor` (which brings
 //! `plugin`), the command line with `cli`, the standalone app with `standalone`, so none compiles
@@ -203,16 +203,18 @@ fn xtask() -> nice_plug_xtask::Result<()> {
 
 /// The Windows installer and zip of `profile`, built and packed (windows.rs).
 fn windows_dist(profile: &str) -> nice_plug_xtask::Result<()> {
-    windows::build(profile)?;
+    let app = windows::App::of(profile);
+    windows::build(profile, app)?;
     let out = windows::dist_dir(profile);
-    for artefact in windows::dist(&windows::Built::here(profile)?, &out)? {
+    for artefact in windows::dist(&windows::Built::here(profile, app)?, &out)? {
         println!("dist: {}", artefact.display());
     }
     Ok(())
 }
 
 /// The Windows release that tests/host/test_windows.py runs under Wine, in the faster-built
-/// profile. Where MinGW-w64, NSIS or the Rust target are missing, skipped with a line naming
+/// profile and without the standalone app (CI's cold build of it costs more time than CI's
+/// budget has; docs/testing.md). Where MinGW-w64, NSIS or the Rust target are missing, skipped with a line naming
 /// what to install (the module is then skipped too), as the host tests skip an optional tool,
 /// but under CI (`$CI` set), which must run it, an error.
 fn windows_test_dist() -> nice_plug_xtask::Result<()> {

@@ -108,13 +108,31 @@ const PACKAGES: [&str; 6] = [
     "sake-glug-c",
 ];
 
-/// Builds every Windows product with `profile`, in two cargo runs. The first makes the plugin
+/// Whether a Windows build makes the standalone app: the release does; the `windows-test` build
+/// (`cargo xtask test`'s) does not, to keep CI's cold build within its budget (docs/testing.md).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum App {
+    Built,
+    Left,
+}
+
+impl App {
+    pub fn of(profile: &str) -> Self {
+        if profile == TEST_PROFILE {
+            Self::Left
+        } else {
+            Self::Built
+        }
+    }
+}
+
+/// Builds the Windows products with `profile`, in two cargo runs. The first makes the plugin
 /// with its editor, the command line with `ogg` and the C library; the plugin's DLL is laid out
-/// as its CLAP and VST3 bundles at once. The second makes the standalone app, with the plugin's
-/// `standalone` feature, and replaces the DLL: cargo unifies a package's features within a run,
-/// so one run would give the plugin nice-plug's tracing-subscriber, which installs a global
-/// logger and panic hook in every host that loads it.
-pub fn build(profile: &str) -> anyhow::Result<()> {
+/// as its CLAP and VST3 bundles at once. The second, with `App::Built`, makes the standalone app,
+/// with the plugin's `standalone` feature, and replaces the DLL: cargo unifies a package's
+/// features within a run, so one run would give the plugin nice-plug's tracing-subscriber, which
+/// installs a global logger and panic hook in every host that loads it.
+pub fn build(profile: &str, app: App) -> anyhow::Result<()> {
     require_tools("the Windows build")?;
     let started = std::time::Instant::now();
     cargo_build(
@@ -125,19 +143,21 @@ pub fn build(profile: &str) -> anyhow::Result<()> {
         &profile_dir(profile).join("sake_glug_plugin.dll"),
         &bundled_dir(profile),
     )?;
-    cargo_build(
-        profile,
-        &[
-            &PACKAGES[..],
+    if app == App::Built {
+        cargo_build(
+            profile,
             &[
-                "--bin",
-                "sake-glug-standalone",
-                "--features",
-                "sake-glug-plugin/standalone",
-            ],
-        ]
-        .concat(),
-    )?;
+                &PACKAGES[..],
+                &[
+                    "--bin",
+                    "sake-glug-standalone",
+                    "--features",
+                    "sake-glug-plugin/standalone",
+                ],
+            ]
+            .concat(),
+        )?;
+    }
     println!(
         "windows: built with the {profile} profile in {:.0} s",
         started.elapsed().as_secs_f64()
@@ -163,7 +183,8 @@ fn bundle_plugin(library: &Path, bundled: &Path) -> anyhow::Result<()> {
 /// What the Windows build made.
 pub struct Built {
     cli: PathBuf,
-    standalone: PathBuf,
+    /// None where the build left the app out.
+    standalone: Option<PathBuf>,
     clap: PathBuf,
     vst3: PathBuf,
     library: PathBuf,
@@ -171,25 +192,29 @@ pub struct Built {
 }
 
 impl Built {
-    pub fn here(profile: &str) -> anyhow::Result<Self> {
+    /// What `build(profile, app)` made. An app left by an earlier build is not taken.
+    pub fn here(profile: &str, app: App) -> anyhow::Result<Self> {
         let release = profile_dir(profile);
         let bundled = bundled_dir(profile);
         let built = Self {
             cli: release.join("sake-glug.exe"),
-            standalone: release.join("sake-glug-standalone.exe"),
+            standalone: (app == App::Built).then(|| release.join("sake-glug-standalone.exe")),
             clap: bundled.join(format!("{PLUGIN}.clap")),
             vst3: bundled.join(format!("{PLUGIN}.vst3")),
             library: release.join("sake_glug.dll"),
             import_library: release.join("libsake_glug.dll.a"),
         };
         for path in [
-            &built.cli,
-            &built.standalone,
-            &built.clap,
-            &built.vst3,
-            &built.library,
-            &built.import_library,
-        ] {
+            Some(&built.cli),
+            built.standalone.as_ref(),
+            Some(&built.clap),
+            Some(&built.vst3),
+            Some(&built.library),
+            Some(&built.import_library),
+        ]
+        .into_iter()
+        .flatten()
+        {
             anyhow::ensure!(
                 path.exists(),
                 "{} is missing: the Windows build did not make it",
@@ -231,6 +256,11 @@ pub fn dist(built: &Built, out: &Path) -> anyhow::Result<Vec<PathBuf>> {
     crate::dist::third_party(&notices, TARGET, &PRODUCTS)?;
     lay_out(built, &notices, &root)?;
     let zip = out.join(format!("{stem}.zip"));
+    // zip adds to an archive that exists, keeping the files an earlier tree had and this one
+    // has not.
+    if zip.exists() {
+        std::fs::remove_file(&zip)?;
+    }
     crate::dist::run_checked(
         Command::new("zip")
             .args(["-q", "-X", "-r", "-9"])
@@ -255,7 +285,9 @@ pub fn dist(built: &Built, out: &Path) -> anyhow::Result<Vec<PathBuf>> {
 fn lay_out(built: &Built, notices: &Path, root: &Path) -> anyhow::Result<()> {
     let bin = root.join("bin");
     copy_stripped(&built.cli, &bin.join("sake-glug.exe"))?;
-    copy_stripped(&built.standalone, &bin.join("sake-glug-standalone.exe"))?;
+    if let Some(standalone) = &built.standalone {
+        copy_stripped(standalone, &bin.join("sake-glug-standalone.exe"))?;
+    }
     // The C library's DLL beside the programs: on the PATH with them, and found there by a
     // program that has it beside itself or on its PATH.
     copy_stripped(&built.library, &bin.join("sake_glug.dll"))?;
