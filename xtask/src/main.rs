@@ -5,7 +5,8 @@
 //!   app can be built. Without the app's libraries (pkg-config's `alsa` and `jack`) it
 //!   skips the app and ends with one line naming the `apt-get install` that adds them.
 //! - `cargo xtask test`: every test: formatting and lints, the Rust suites, then the bundles in a
-//!   real VST3 host and the standalone app under a JACK server, then the Python package installed
+//!   real VST3 host and the standalone app under a JACK server, the Windows release under Wine
+//!   (where MinGW-w64, NSIS and Wine are installed; CI installs them), then the Python package installed
 //!   into the virtual environment and its pytest suite. Without the app's libraries it
 //!   stops at once, naming the `apt-get install`.
 //! - `cargo xtask docs [--bench]`: regenerates every table and picture of docs/ from the current
@@ -30,8 +31,10 @@
 //! - `cargo xtask dist`: the release in target/dist/ (the Debian package, the tarball with its
 //!   install.sh, the wheel, THIRD-PARTY.md), packed from the release builds that `cargo xtask
 //!   test` makes (built first if they are not; see dist.rs).
-//! - `cargo xtask dist windows`: the Windows installer and zip in target/dist/, cross-built with
-//!   MinGW-w64 (windows.rs); not yet part of `cargo xtask test` (issue 46).
+//! - `cargo xtask dist windows [--profile windows-test]`: the Windows installer and zip in
+//!   target/dist/, cross-built with MinGW-w64 (windows.rs); with the `windows-test` profile
+//!   (built without link-time optimisation and without the standalone app, as `cargo xtask
+//!   test` builds it for its Wine tests), in target/dist-windows-test/.
 //!
 //! Each product is built with only its features: the bundles with `editor` (which brings
 //! `plugin`), the command line with `cli`, the standalone app with `standalone`, so none compiles
@@ -114,17 +117,25 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             build_wheel()?;
             // The release packed from those builds, for the host tests to install and check.
             dist()?;
+            // The Windows release, built faster than the shipped one, for tests/host/test_windows.py
+            // to install and run under Wine.
+            windows_test_dist()?;
             host_tests()?;
             python_tests()
         }
         // The Windows release alone, beside whatever target/dist holds.
+        // `--profile windows-test`: the build `cargo xtask test` checks, in target/dist-windows-test.
         Some("dist") if args.get(1).is_some_and(|arg| arg == "windows") => {
             nice_plug_xtask::chdir_workspace_root()?;
-            windows::build()?;
-            for artefact in windows::dist(&windows::Built::here()?, &target_dir().join("dist"))? {
-                println!("dist: {}", artefact.display());
-            }
-            Ok(())
+            let profile = match &args[2..] {
+                [] => windows::RELEASE_PROFILE,
+                [option, profile] if option == "--profile" => profile.as_str(),
+                _ => anyhow::bail!(
+                    "cargo xtask dist windows takes only `--profile NAME`, not `{}`",
+                    args[2..].join(" ")
+                ),
+            };
+            windows_dist(profile)
         }
         Some("dist") => {
             nice_plug_xtask::chdir_workspace_root()?;
@@ -188,6 +199,33 @@ fn xtask() -> nice_plug_xtask::Result<()> {
         }
         _ => nice_plug_xtask::main(),
     }
+}
+
+/// The Windows installer and zip of `profile`, built and packed (windows.rs).
+fn windows_dist(profile: &str) -> nice_plug_xtask::Result<()> {
+    let app = windows::App::of(profile);
+    windows::build(profile, app)?;
+    let out = windows::dist_dir(profile);
+    for artefact in windows::dist(&windows::Built::here(profile, app)?, &out)? {
+        println!("dist: {}", artefact.display());
+    }
+    Ok(())
+}
+
+/// The Windows release that tests/host/test_windows.py runs under Wine, in the faster-built
+/// profile and without the standalone app (CI's cold build of it costs more time than CI's
+/// budget has; docs/testing.md). Where MinGW-w64, NSIS or the Rust target are missing, skipped with a line naming
+/// what to install (the module is then skipped too), as the host tests skip an optional tool,
+/// but under CI (`$CI` set), which must run it, an error.
+fn windows_test_dist() -> nice_plug_xtask::Result<()> {
+    if let Err(missing) = windows::require_tools("cargo xtask test") {
+        if std::env::var_os("CI").is_some() {
+            return Err(missing);
+        }
+        println!("{missing:#}; skipped, with its tests under Wine");
+        return Ok(());
+    }
+    windows_dist(windows::TEST_PROFILE)
 }
 
 /// The CLAP and VST3 bundles under target/bundled/, and the release CLI beside them.

@@ -63,42 +63,106 @@ pub fn require_tools(command: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Where cargo leaves the Windows builds.
-fn release_dir() -> PathBuf {
-    crate::target_dir().join(TARGET).join("release")
+/// The cargo profile the shipped Windows release is built with.
+pub const RELEASE_PROFILE: &str = "release";
+/// The profile of the Windows build `cargo xtask test` runs under Wine: the release's code, built
+/// faster (Cargo.toml says how).
+pub const TEST_PROFILE: &str = "windows-test";
+
+/// Where cargo leaves the Windows builds of `profile`.
+fn profile_dir(profile: &str) -> PathBuf {
+    crate::target_dir().join(TARGET).join(profile)
 }
 
-/// Where the Windows bundles are laid out (the Linux ones are in target/bundled).
-fn bundled_dir() -> PathBuf {
-    crate::target_dir().join(TARGET).join("bundled")
+/// Where the Windows bundles of `profile` are laid out (the Linux ones are in target/bundled).
+fn bundled_dir(profile: &str) -> PathBuf {
+    profile_dir(profile).join("bundled")
 }
 
-fn cargo_build(package: &str, what: &[&str]) -> anyhow::Result<()> {
-    let mut args = vec![
-        "build",
-        "--release",
-        "--target",
-        TARGET,
-        "--package",
-        package,
-    ];
+/// Where the installer and zip of `profile` are written: target/dist for the release (beside the
+/// Linux release), a folder of their own for any other profile, so that no test build is taken
+/// for the release.
+pub fn dist_dir(profile: &str) -> PathBuf {
+    if profile == RELEASE_PROFILE {
+        crate::target_dir().join("dist")
+    } else {
+        crate::target_dir().join(format!("dist-{profile}"))
+    }
+}
+
+fn cargo_build(profile: &str, what: &[&str]) -> anyhow::Result<()> {
+    let mut args = vec!["build", "--profile", profile, "--target", TARGET];
     args.extend(what);
     crate::cargo(&args)
 }
 
-/// Builds every Windows product: the plugin with its editor (laid out as its CLAP and VST3
-/// bundles at once, before the app's build of the same library with other features replaces
-/// the DLL), the standalone app, the command line with `ogg` and the C library.
-pub fn build() -> anyhow::Result<()> {
+/// The packages of the Windows products, each run of their build names them all: cargo unifies
+/// the features of their shared crates over the packages a run names, so both runs build those
+/// crates alike and the second compiles again only what `standalone` changes.
+const PACKAGES: [&str; 6] = [
+    "--package",
+    "sake-glug-plugin",
+    "--package",
+    "sake-glug",
+    "--package",
+    "sake-glug-c",
+];
+
+/// Whether a Windows build makes the standalone app: the release does; the `windows-test` build
+/// (`cargo xtask test`'s) does not, to keep CI's cold build within its budget (docs/testing.md).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum App {
+    Built,
+    Left,
+}
+
+impl App {
+    pub fn of(profile: &str) -> Self {
+        if profile == TEST_PROFILE {
+            Self::Left
+        } else {
+            Self::Built
+        }
+    }
+}
+
+/// Builds the Windows products with `profile`, in two cargo runs. The first makes the plugin
+/// with its editor, the command line with `ogg` and the C library; the plugin's DLL is laid out
+/// as its CLAP and VST3 bundles at once. The second, with `App::Built`, makes the standalone app,
+/// with the plugin's `standalone` feature, and replaces the DLL: cargo unifies a package's
+/// features within a run, so one run would give the plugin nice-plug's tracing-subscriber, which
+/// installs a global logger and panic hook in every host that loads it.
+pub fn build(profile: &str, app: App) -> anyhow::Result<()> {
     require_tools("the Windows build")?;
-    cargo_build("sake-glug-plugin", &["--lib"])?;
-    bundle_plugin(&release_dir().join("sake_glug_plugin.dll"), &bundled_dir())?;
+    let started = std::time::Instant::now();
     cargo_build(
-        "sake-glug-plugin",
-        &["--bin", "sake-glug-standalone", "--features", "standalone"],
+        profile,
+        &[&PACKAGES[..], &["--lib", "--bin", "sake-glug"]].concat(),
     )?;
-    cargo_build("sake-glug", &["--bin", "sake-glug", "--features", "ogg"])?;
-    cargo_build("sake-glug-c", &[])
+    bundle_plugin(
+        &profile_dir(profile).join("sake_glug_plugin.dll"),
+        &bundled_dir(profile),
+    )?;
+    if app == App::Built {
+        cargo_build(
+            profile,
+            &[
+                &PACKAGES[..],
+                &[
+                    "--bin",
+                    "sake-glug-standalone",
+                    "--features",
+                    "sake-glug-plugin/standalone",
+                ],
+            ]
+            .concat(),
+        )?;
+    }
+    println!(
+        "windows: built with the {profile} profile in {:.0} s",
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 /// The plugin's DLL as Windows hosts want it: `Sake Glug.clap` (CLAP has no bundle on Windows)
@@ -119,7 +183,8 @@ fn bundle_plugin(library: &Path, bundled: &Path) -> anyhow::Result<()> {
 /// What the Windows build made.
 pub struct Built {
     cli: PathBuf,
-    standalone: PathBuf,
+    /// None where the build left the app out.
+    standalone: Option<PathBuf>,
     clap: PathBuf,
     vst3: PathBuf,
     library: PathBuf,
@@ -127,25 +192,29 @@ pub struct Built {
 }
 
 impl Built {
-    pub fn here() -> anyhow::Result<Self> {
-        let release = release_dir();
-        let bundled = bundled_dir();
+    /// What `build(profile, app)` made. An app left by an earlier build is not taken.
+    pub fn here(profile: &str, app: App) -> anyhow::Result<Self> {
+        let release = profile_dir(profile);
+        let bundled = bundled_dir(profile);
         let built = Self {
             cli: release.join("sake-glug.exe"),
-            standalone: release.join("sake-glug-standalone.exe"),
+            standalone: (app == App::Built).then(|| release.join("sake-glug-standalone.exe")),
             clap: bundled.join(format!("{PLUGIN}.clap")),
             vst3: bundled.join(format!("{PLUGIN}.vst3")),
             library: release.join("sake_glug.dll"),
             import_library: release.join("libsake_glug.dll.a"),
         };
         for path in [
-            &built.cli,
-            &built.standalone,
-            &built.clap,
-            &built.vst3,
-            &built.library,
-            &built.import_library,
-        ] {
+            Some(&built.cli),
+            built.standalone.as_ref(),
+            Some(&built.clap),
+            Some(&built.vst3),
+            Some(&built.library),
+            Some(&built.import_library),
+        ]
+        .into_iter()
+        .flatten()
+        {
             anyhow::ensure!(
                 path.exists(),
                 "{} is missing: the Windows build did not make it",
@@ -179,9 +248,19 @@ pub fn dist(built: &Built, out: &Path) -> anyhow::Result<Vec<PathBuf>> {
     let work = out.join("windows-work");
     let root = work.join(&stem);
     let notices = work.join("THIRD-PARTY.md");
+    // A tree left by a packing that failed half way would add its files to this one.
+    if work.exists() {
+        std::fs::remove_dir_all(&work)?;
+    }
+    std::fs::create_dir_all(&work).with_context(|| format!("making {}", work.display()))?;
     crate::dist::third_party(&notices, TARGET, &PRODUCTS)?;
     lay_out(built, &notices, &root)?;
     let zip = out.join(format!("{stem}.zip"));
+    // zip adds to an archive that exists, keeping the files an earlier tree had and this one
+    // has not.
+    if zip.exists() {
+        std::fs::remove_file(&zip)?;
+    }
     crate::dist::run_checked(
         Command::new("zip")
             .args(["-q", "-X", "-r", "-9"])
@@ -206,7 +285,9 @@ pub fn dist(built: &Built, out: &Path) -> anyhow::Result<Vec<PathBuf>> {
 fn lay_out(built: &Built, notices: &Path, root: &Path) -> anyhow::Result<()> {
     let bin = root.join("bin");
     copy_stripped(&built.cli, &bin.join("sake-glug.exe"))?;
-    copy_stripped(&built.standalone, &bin.join("sake-glug-standalone.exe"))?;
+    if let Some(standalone) = &built.standalone {
+        copy_stripped(standalone, &bin.join("sake-glug-standalone.exe"))?;
+    }
     // The C library's DLL beside the programs: on the PATH with them, and found there by a
     // program that has it beside itself or on its PATH.
     copy_stripped(&built.library, &bin.join("sake_glug.dll"))?;

@@ -5,6 +5,10 @@
 /// finished file should get the permissions any new file gets (0o666 less the umask), as if it
 /// had been written in place.
 pub fn temp_file_builder() -> tempfile::Builder<'static, 'static> {
+    #[cfg_attr(
+        not(unix),
+        expect(unused_mut, reason = "Windows files have no mode bits to set")
+    )]
     let mut builder = tempfile::Builder::new();
     #[cfg(unix)]
     {

@@ -4,7 +4,9 @@
 //! envelope) describe what is *felt*, not the waveform: an amplitude envelope that jumps at every
 //! glug onset and decays like the glug, a felt frequency, and one transient per audible glug. The
 //! shared logic (envelope, breakpoints, frequency mapping) lives here so the formats agree on
-//! every number.
+//! every number. Its exp and ln are libm's, pure Rust, not the platform's C maths library
+//! (glibc's and MinGW-w64's differ in the last bit), so a clip written on Windows is the Linux
+//! one byte for byte (tests/host/test_windows.py).
 
 use std::fmt;
 use std::str::FromStr;
@@ -186,7 +188,7 @@ pub fn is_audible(glug: &Glug) -> bool {
 /// an upper bound of the glug's `|y|`.
 fn unit_envelope(glug: &Glug, tau: f64) -> f64 {
     (0..2)
-        .map(|k| glug.amplitudes[k].abs() * (-glug.decay_per_s[k] * tau).exp())
+        .map(|k| glug.amplitudes[k].abs() * libm::exp(-glug.decay_per_s[k] * tau))
         .sum()
 }
 
@@ -383,11 +385,11 @@ impl<'a> EnvelopeSum<'a> {
         for &i in self.sorted[..started].iter().rev() {
             let glug = &self.glugs[i];
             let tau = t - glug.onset_s;
-            if self.largest_amplitude * (-self.slowest_decay_per_s * tau).exp() < 1e-15 {
+            if self.largest_amplitude * libm::exp(-self.slowest_decay_per_s * tau) < 1e-15 {
                 break;
             }
             for k in 0..2 {
-                let amplitude = glug.amplitudes[k].abs() * (-glug.decay_per_s[k] * tau).exp();
+                let amplitude = glug.amplitudes[k].abs() * libm::exp(-glug.decay_per_s[k] * tau);
                 sums.components[k] += amplitude;
                 sums.total += amplitude;
                 let gain = glug.actuator_gain[k];
@@ -505,7 +507,7 @@ pub fn envelope_breakpoints(source: &ClipSource) -> Vec<Breakpoint> {
         let decay_stop_s = (next_onset_s - ONSET_LEAD_S - MIN_DECAY_STEP_S).min(end_s);
         let slowest = glug.decay_per_s[0].min(glug.decay_per_s[1]);
         let step_s = if slowest > 0.0 {
-            (DECAY_STEP_FALL.ln() / slowest).clamp(MIN_DECAY_STEP_S, MAX_DECAY_STEP_S)
+            (libm::log(DECAY_STEP_FALL) / slowest).clamp(MIN_DECAY_STEP_S, MAX_DECAY_STEP_S)
         } else {
             MAX_DECAY_STEP_S
         };

@@ -27,6 +27,7 @@ mod args;
 mod watch;
 
 use std::process::ExitCode;
+#[cfg(unix)]
 use std::time::Duration;
 
 use nice_plug::prelude::nice_export_standalone_with_args;
@@ -37,9 +38,11 @@ use sake_glug_plugin::SakeGlug;
 
 /// How long the wrapper gets to stop after a quit signal before the process ends anyway (it
 /// takes a few tens of milliseconds when the audio server answers).
+#[cfg(unix)]
 const QUIT_GRACE: Duration = Duration::from_millis(250);
 /// How long without an audio callback means that the audio server or device went away (longer
 /// than any period a JACK server or an ALSA device runs at).
+#[cfg(unix)]
 const AUDIO_LOST_AFTER: Duration = Duration::from_secs(1);
 
 fn main() -> ExitCode {
