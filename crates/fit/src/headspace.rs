@@ -161,7 +161,52 @@ pub fn fit_law(points: [&[(f64, f64)]; 2], pocket_ml: f64) -> HeadspaceLaw {
         law.headspace_heard = true;
         law.modes = points.map(|p| mode_law(p, best_ml, pocket_ml));
     }
+    if law.modes[leading].is_some_and(|m| m.follows()) {
+        // A mode that follows the air is a Helmholtz cavity wherever the data allow one: the
+        // exponent a few glugs' scatter gives trades against H along a ridge, and ½ on it is
+        // the physics, not a guess.
+        let allowed = |residual: f64| n * (residual.max(1e-300) / floor).ln() <= CHI2_1_95;
+        let at_half = |h: f64| helmholtz_at(data, h).map(|(_, residual)| residual);
+        let helmholtz_ml = if at_half(default_ml).is_some_and(allowed) {
+            Some(default_ml)
+        } else {
+            grid.iter()
+                .filter_map(|&(h, _)| at_half(h).map(|residual| (h, residual)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .filter(|&(_, residual)| allowed(residual))
+                .map(|(h, _)| h)
+        };
+        if let Some(h) = helmholtz_ml {
+            law.headspace_ml = h;
+            law.headspace_heard = h != default_ml;
+            law.modes = points.map(|p| mode_law(p, h, pocket_ml));
+            if let (Some(mode), Some((intercept, _))) =
+                (law.modes[leading].as_mut(), helmholtz_at(data, h))
+            {
+                mode.exponent = HELMHOLTZ;
+                mode.full_hz = (intercept - HELMHOLTZ * (h + pocket_ml).ln()).exp();
+            }
+        }
+    }
     law
+}
+
+/// A Helmholtz cavity's exponent: f ∝ (air)^(−½).
+const HELMHOLTZ: f64 = 0.5;
+
+/// The line of ln f against ln(H + added) with its slope held at −½: its intercept and residual
+/// sum of squares.
+fn helmholtz_at(points: &[(f64, f64)], headspace_ml: f64) -> Option<(f64, f64)> {
+    if points.is_empty() {
+        return None;
+    }
+    let lifted: Vec<f64> = points
+        .iter()
+        .map(|&(added_ml, hz)| hz.ln() + HELMHOLTZ * (headspace_ml + added_ml).ln())
+        .collect();
+    let intercept = lifted.iter().sum::<f64>() / lifted.len() as f64;
+    let residual = lifted.iter().map(|y| (y - intercept).powi(2)).sum();
+    Some((intercept, residual))
 }
 
 #[cfg(test)]
@@ -203,6 +248,43 @@ mod tests {
         assert!((mode.full_hz / first_hz - 1.0).abs() < 0.02, "{law:?}");
         assert!(!law.modes[1].unwrap().follows(), "{law:?}");
         assert_eq!(law.model().exponent[1], 0.0);
+    }
+
+    const SEED: u64 = 5;
+
+    /// A cavity's glugs under the law with `exponent` over 40 ml of air (5 ml a pocket, 20
+    /// glugs), each pitch off by a scatter of `scatter` (a fixed pseudo-random draw).
+    fn cavity(exponent: f64, scatter: f64) -> Points {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(SEED);
+        (1..=20)
+            .map(|i| {
+                let added = 5.0 * i as f64;
+                let draw = rng.random::<f64>() - 0.5;
+                let hz = 400.0 * (40.0 / (40.0 + added)).powf(exponent) * (1.0 + scatter * draw);
+                (added, hz)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_cavity_the_data_allow_to_be_helmholtz_is_written_at_a_half() {
+        let low = cavity(0.5, 0.2);
+        let free = mode_law(&low, 40.0, 5.0).unwrap();
+        // The scatter alone moves the free line's slope well off ½ ...
+        assert!((free.exponent - 0.5).abs() > 0.05, "{free:?}");
+        // ... and the law, which the data let be a Helmholtz cavity, is one.
+        let law = fit_law([&low, &[]], 5.0);
+        assert_eq!(law.modes[0].unwrap().exponent, 0.5, "{law:?}");
+        assert!(law.modes[0].unwrap().follows(), "{law:?}");
+    }
+
+    #[test]
+    fn a_mode_the_data_hold_off_a_half_keeps_its_own_exponent() {
+        // A tube's quarter-wave mode, f ∝ 1/air.
+        let law = fit_law([&cavity(1.0, 0.004), &[]], 5.0);
+        let mode = law.modes[0].unwrap();
+        assert!((mode.exponent - 1.0).abs() < 0.1, "{law:?}");
     }
 
     #[test]

@@ -8,7 +8,7 @@ use super::estimate::MIN_UNITS_FOR_MODEL;
 use super::estimate::{range_of, Estimate};
 use super::headspace::{fit_law, HeadspaceLaw};
 use super::model_toml::model_toml;
-use super::pour::{intervals, pockets, rate_error};
+use super::pour::{fitted_intervals, pockets, rate_error};
 use super::recording::{FittedUnit, RecordingFit, LOW_EXPLAINED};
 use super::stats::{bootstrap, iqr, median, Line, NORMAL_IQR};
 use super::units::Modes;
@@ -634,7 +634,7 @@ fn timing_estimates(inputs: &LiquidInputs) -> Vec<Estimate> {
     let relative_intervals: Vec<f64> = recordings
         .iter()
         .flat_map(|r| {
-            let all = intervals(r);
+            let all = fitted_intervals(r);
             let typical = median(&all);
             all.into_iter().map(move |dt| dt / typical)
         })

@@ -12,13 +12,26 @@ const SHORT_INTERVAL: f64 = 0.4;
 /// Two tilts closer than this are one (degrees).
 pub const SAME_TILT_DEG: f64 = 0.5;
 
-/// The intervals between consecutive units of `recording`, those that tell a pocket.
+/// The intervals between consecutive glugs of `recording`: its units detected, kept or rejected
+/// (a glug no fit described still poured its pocket), those that tell a pocket. A rejected unit's
+/// onset is placed only to the glug detector's 25 ms, which a median shrugs off: the pace and the
+/// pocket come from these.
 pub fn intervals(recording: &RecordingFit) -> Vec<f64> {
-    let all: Vec<f64> = recording
-        .units
-        .windows(2)
-        .map(|pair| pair[1].fit.onset_s - pair[0].fit.onset_s)
-        .collect();
+    pocket_intervals(recording.detected.iter().map(|unit| unit.onset_s))
+}
+
+/// The intervals between consecutive units of `recording` kept, those that tell a pocket: their
+/// onsets placed by their fits, for the intervals' scatter (j_t), which a rejected unit's loose
+/// onset would widen.
+pub fn fitted_intervals(recording: &RecordingFit) -> Vec<f64> {
+    pocket_intervals(recording.units.iter().map(|unit| unit.fit.onset_s))
+}
+
+/// The intervals between consecutive `onsets_s`, without those that count a missed unit or a
+/// spurious one.
+fn pocket_intervals(onsets_s: impl Iterator<Item = f64>) -> Vec<f64> {
+    let onsets_s: Vec<f64> = onsets_s.collect();
+    let all: Vec<f64> = onsets_s.windows(2).map(|pair| pair[1] - pair[0]).collect();
     let typical = median(&all);
     all.into_iter()
         .filter(|&dt| dt < LONG_INTERVAL * typical && dt > SHORT_INTERVAL * typical)

@@ -83,6 +83,70 @@ fn segment_powers(samples: &[f32], sample_rate: f64, mut each: impl FnMut(&[f64]
     sample_rate / len as f64
 }
 
+/// A held line stands at least this far above its neighbourhood in the quiet segments: 10 dB.
+const HELD_LINE_ABOVE: f64 = 10.0;
+/// A held line's loud segments ([`NOISE_QUANTILE`] from the top) hold at most this many times
+/// its quiet ones: 3 dB (a bin of noise alone spreads 7.2 times between them, a glug's mode more).
+const HELD_LINE_STEADY: f64 = 2.0;
+/// A held line is as narrow as a steady sinusoid's: [`HELD_LINE_ABOVE`] down this many bins
+/// either side (a Hann window's main lobe is 2 wide; a mode decaying at B is B/π Hz wide, 8 bins
+/// at 140 /s).
+const HELD_LINE_WIDTH_BINS: usize = 3;
+/// A unit's peak within this many of the recording's bins of a held line is that line.
+const HELD_LINE_REACH_BINS: f64 = 2.0;
+
+/// The lines a recording holds throughout ([`Spectrum::held_lines`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct HeldLines {
+    /// Their frequencies (Hz).
+    pub hz: Vec<f64>,
+    /// A peak this near one (Hz) is that line.
+    pub reach_hz: f64,
+}
+
+impl HeldLines {
+    /// Whether a peak at `hz` is one of these lines.
+    pub fn holds(&self, hz: f64) -> bool {
+        self.hz
+            .iter()
+            .any(|&line| (hz - line).abs() <= self.reach_hz)
+    }
+}
+
+/// Per bin of `samples`' Welch segments, the power at each of the `quantiles` of its segments'
+/// powers; the bins' spacing (Hz) and the number of segments.
+fn segment_quantiles<const N: usize>(
+    samples: &[f32],
+    sample_rate: f64,
+    quantiles: [f64; N],
+) -> (f64, usize, [Vec<f64>; N]) {
+    let mut segments: Vec<Vec<f64>> = Vec::new();
+    let bin_hz = segment_powers(samples, sample_rate, |segment| {
+        segments.push(segment.to_vec())
+    });
+    let bins = segments.first().map_or(0, Vec::len);
+    let mut at: [Vec<f64>; N] = std::array::from_fn(|_| Vec::with_capacity(bins));
+    let mut powers = Vec::with_capacity(segments.len());
+    for bin in 0..bins {
+        powers.clear();
+        powers.extend(segments.iter().map(|s| s[bin]));
+        powers.sort_by(f64::total_cmp);
+        for (values, q) in at.iter_mut().zip(quantiles) {
+            values.push(powers[((q * powers.len() as f64) as usize).min(powers.len() - 1)]);
+        }
+    }
+    (bin_hz, segments.len(), at)
+}
+
+/// The median of `values` over the bins within [`NOISE_NEIGHBOURHOOD`] of `bin`'s frequency.
+fn neighbourhood_median(values: &[f64], bin: usize) -> f64 {
+    let from = ((bin as f64 / NOISE_NEIGHBOURHOOD) as usize).max(1);
+    let to = ((bin as f64 * NOISE_NEIGHBOURHOOD).ceil() as usize + 1).min(values.len());
+    let mut near: Vec<f64> = values[from.min(bin)..to.max(bin + 1)].to_vec();
+    near.sort_by(f64::total_cmp);
+    near[near.len() / 2]
+}
+
 /// The averaged power spectrum of a recording.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Spectrum {
@@ -109,35 +173,46 @@ impl Spectrum {
     /// over that quantile of noise's own spread, times the segments; then the median of that over
     /// its neighbourhood ([`NOISE_NEIGHBOURHOOD`]).
     pub fn noise_of(samples: &[f32], sample_rate: f64) -> Self {
-        let mut segments: Vec<Vec<f64>> = Vec::new();
-        let bin_hz = segment_powers(samples, sample_rate, |segment| {
-            segments.push(segment.to_vec())
-        });
-        let bins = segments.first().map_or(0, Vec::len);
-        let count = segments.len() as f64;
-        let quiet: Vec<f64> = (0..bins)
-            .map(|bin| {
-                let mut powers: Vec<f64> = segments.iter().map(|s| s[bin]).collect();
-                powers.sort_by(f64::total_cmp);
-                let at = ((NOISE_QUANTILE * powers.len() as f64) as usize).min(powers.len() - 1);
-                // A noise periodogram's bin is exponential: its q-quantile is −ln(1 − q) times
-                // its mean.
-                powers[at] / -(1.0 - NOISE_QUANTILE).ln() * count
-            })
+        let (bin_hz, count, [quiet]) = segment_quantiles(samples, sample_rate, [NOISE_QUANTILE]);
+        // A noise periodogram's bin is exponential: its q-quantile is −ln(1 − q) times its mean.
+        let quiet: Vec<f64> = quiet
+            .iter()
+            .map(|q| q / -(1.0 - NOISE_QUANTILE).ln() * count as f64)
             .collect();
         // A mode that rings in every segment (glugs faster than it decays) is no quieter in
         // the quiet ones: a bin's noise is the median over its neighbourhood, where such a peak
         // is a few bins of many (and noise is smooth, but for hum's few lines).
-        let power = (0..bins)
-            .map(|bin| {
-                let from = ((bin as f64 / NOISE_NEIGHBOURHOOD) as usize).max(1);
-                let to = ((bin as f64 * NOISE_NEIGHBOURHOOD).ceil() as usize + 1).min(bins);
-                let mut near: Vec<f64> = quiet[from.min(bin)..to.max(bin + 1)].to_vec();
-                near.sort_by(f64::total_cmp);
-                near[near.len() / 2]
-            })
+        let power = (0..quiet.len())
+            .map(|bin| neighbourhood_median(&quiet, bin))
             .collect();
         Self { bin_hz, power }
+    }
+
+    /// The lines the recording holds between its glugs as during them (mains hum and its
+    /// harmonics, a machine's whine): a bin that is a local maximum of its segments'
+    /// [`NOISE_QUANTILE`] powers, stands [`HELD_LINE_ABOVE`] above its neighbourhood's, and whose
+    /// loud segments hold at most [`HELD_LINE_STEADY`] times its quiet ones. A glug's mode, even
+    /// one ringing in every segment, comes and goes with its onsets; a held line does not.
+    pub fn held_lines(samples: &[f32], sample_rate: f64) -> HeldLines {
+        let (bin_hz, _, [quiet, loud]) =
+            segment_quantiles(samples, sample_rate, [NOISE_QUANTILE, 1.0 - NOISE_QUANTILE]);
+        let bins = quiet.len();
+        let first_bin = ((LOWEST_PEAK_HZ / bin_hz).ceil() as usize).max(HELD_LINE_WIDTH_BINS);
+        let hz = (first_bin..bins.saturating_sub(HELD_LINE_WIDTH_BINS))
+            .filter(|&bin| {
+                quiet[bin] > quiet[bin - 1]
+                    && quiet[bin] >= quiet[bin + 1]
+                    && quiet[bin] >= HELD_LINE_ABOVE * neighbourhood_median(&quiet, bin)
+                    && loud[bin] <= HELD_LINE_STEADY * quiet[bin]
+                    && quiet[bin - HELD_LINE_WIDTH_BINS].max(quiet[bin + HELD_LINE_WIDTH_BINS])
+                        <= quiet[bin] / HELD_LINE_ABOVE
+            })
+            .map(|bin| bin as f64 * bin_hz)
+            .collect();
+        HeldLines {
+            hz,
+            reach_hz: HELD_LINE_REACH_BINS * bin_hz,
+        }
     }
 
     /// This spectrum less `noise` (of the same recording), each bin kept at least
@@ -171,9 +246,10 @@ impl Spectrum {
     /// The frequencies (Hz, ascending) of the one or two strongest peaks at least
     /// [`PEAK_SEPARATION`] apart, a peak's frequency refined by a parabola through its bin and
     /// its neighbours' log powers.
-    pub fn peaks(&self) -> Vec<f64> {
+    /// No peak is taken at one of the recording's `held` lines: they ring no glug.
+    pub fn peaks(&self, held: &HeldLines) -> Vec<f64> {
         let mut peaks: Vec<f64> = self
-            .peaks_within(WEAKEST_PEAK)
+            .peaks_within(WEAKEST_PEAK, held)
             .into_iter()
             .map(|(hz, _)| hz)
             .collect();
@@ -183,13 +259,14 @@ impl Spectrum {
 
     /// The one or two strongest peaks `(Hz, power)`, strongest first, the second at least
     /// [`PEAK_SEPARATION`] from the first and within `weakest` of its power.
-    fn peaks_within(&self, weakest: f64) -> Vec<(f64, f64)> {
+    fn peaks_within(&self, weakest: f64, held: &HeldLines) -> Vec<(f64, f64)> {
         let first_bin = ((LOWEST_PEAK_HZ / self.bin_hz).ceil() as usize).max(1);
         let mut maxima: Vec<(f64, f64)> = (first_bin..self.power.len().saturating_sub(1))
             .filter(|&bin| {
                 self.power[bin] > self.power[bin - 1] && self.power[bin] >= self.power[bin + 1]
             })
             .map(|bin| (self.refined_hz(bin), self.power[bin]))
+            .filter(|&(hz, _)| !held.holds(hz))
             .collect();
         maxima.sort_by(|a, b| b.1.total_cmp(&a.1));
         let Some(&(strongest_hz, strongest)) = maxima.first() else {
@@ -234,11 +311,22 @@ impl Spectrum {
 /// The peaks of a unit's own span `(Hz, power)`, strongest first: its strongest, and a second
 /// [`PEAK_SEPARATION`] from it within 20 dB if there is one.
 pub fn own_peaks(samples: &[f64], sample_rate: f64) -> Vec<(f64, f64)> {
-    Spectrum::of_span(samples, sample_rate).peaks_within(WEAKEST_OWN_PEAK)
+    Spectrum::of_span(samples, sample_rate).peaks_within(WEAKEST_OWN_PEAK, &HeldLines::default())
 }
 
-/// The strongest peak `(Hz, power)` of a unit's own span at or above `lowest_hz`, if any.
-pub fn own_peak_above(samples: &[f64], sample_rate: f64, lowest_hz: f64) -> Option<(f64, f64)> {
+/// [`own_peaks`], the recording's `held` lines left out: they ring no glug.
+pub fn own_peaks_beside(samples: &[f64], sample_rate: f64, held: &HeldLines) -> Vec<(f64, f64)> {
+    Spectrum::of_span(samples, sample_rate).peaks_within(WEAKEST_OWN_PEAK, held)
+}
+
+/// The strongest peak `(Hz, power)` of a unit's own span at or above `lowest_hz`, if any, none
+/// at one of the recording's `held` lines.
+pub fn own_peak_above(
+    samples: &[f64],
+    sample_rate: f64,
+    lowest_hz: f64,
+    held: &HeldLines,
+) -> Option<(f64, f64)> {
     let spectrum = Spectrum::of_span(samples, sample_rate);
     let first_bin = ((lowest_hz.max(LOWEST_PEAK_HZ) / spectrum.bin_hz).ceil() as usize).max(1);
     (first_bin..spectrum.power.len().saturating_sub(1))
@@ -246,8 +334,9 @@ pub fn own_peak_above(samples: &[f64], sample_rate: f64, lowest_hz: f64) -> Opti
             spectrum.power[bin] > spectrum.power[bin - 1]
                 && spectrum.power[bin] >= spectrum.power[bin + 1]
         })
-        .max_by(|&a, &b| spectrum.power[a].total_cmp(&spectrum.power[b]))
         .map(|bin| (spectrum.refined_hz(bin), spectrum.power[bin]))
+        .filter(|&(hz, _)| !held.holds(hz))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
 impl Spectrum {
@@ -269,6 +358,48 @@ mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
     use rand_xoshiro::Xoshiro256PlusPlus;
+
+    /// Glugs 10 a second (a 300 Hz mode decaying at 20 /s, ringing on into the next glug, and
+    /// a 760 Hz one at 140 /s, at the same pitch in every glug) over 50 Hz mains hum with its
+    /// third harmonic (26 dB under the glugs' peak: a span's strongest peak where a glug is weak)
+    /// and white noise, at 16 kHz: the hum is held, neither mode is.
+    #[test]
+    fn mains_hum_is_a_held_line_and_a_glugs_modes_are_not() {
+        let fs = 16_000.0;
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+        let mut samples = vec![0.0f64; (3.0 * fs) as usize];
+        let mut onset = 0.01;
+        while onset < 3.0 {
+            let level = 0.6 + 0.8 * rng.random::<f64>();
+            for (n, y) in samples.iter_mut().enumerate().skip((onset * fs) as usize) {
+                let tau = n as f64 / fs - onset;
+                *y += level
+                    * ((-20.0 * tau).exp() * (std::f64::consts::TAU * 300.0 * tau).sin()
+                        + 0.6 * (-140.0 * tau).exp() * (std::f64::consts::TAU * 760.0 * tau).sin());
+            }
+            onset += 0.07 + 0.06 * rng.random::<f64>();
+        }
+        let recording: Vec<f32> = samples
+            .iter()
+            .enumerate()
+            .map(|(n, y)| {
+                let t = n as f64 / fs;
+                let hum = (std::f64::consts::TAU * 50.0 * t).sin()
+                    + (std::f64::consts::TAU * 150.0 * t).sin() / 3.0;
+                (y + 0.05 * hum + 0.002 * (2.0 * rng.random::<f64>() - 1.0)) as f32
+            })
+            .collect();
+        let held = Spectrum::held_lines(&recording, fs);
+        assert!(held.holds(50.0), "50 Hz hum not held: {held:?}");
+        for mode_hz in [300.0, 760.0] {
+            assert!(
+                held.hz
+                    .iter()
+                    .all(|&line| (line / mode_hz - 1.0).abs() > 0.1),
+                "the {mode_hz} Hz mode taken for a held line: {held:?}"
+            );
+        }
+    }
 
     /// Glugs (a 200 Hz mode, decaying at 30 /s, 6 a second) with white noise 10 dB below their
     /// RMS, at 16 kHz: the noise read from the quiet segments, and the glugs' bright share once

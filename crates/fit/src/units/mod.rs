@@ -25,7 +25,7 @@ use sake_glug_engine::{Constant, Range};
 
 use super::listen::glug_onsets;
 use super::onsets::detect_onsets;
-use super::spectrum::{own_peaks, Spectrum};
+use super::spectrum::{own_peaks_beside, Spectrum};
 pub use modes::{local_split, Modes};
 use window::{Span, Window};
 
@@ -595,7 +595,8 @@ fn one_per_glug(detected: &[usize], glugs: &[usize], fs: f64) -> Vec<usize> {
 pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
     let fs = sample_rate as f64;
     let spectrum = Spectrum::of(samples, fs);
-    let peaks = spectrum.peaks();
+    let held = Spectrum::held_lines(samples, fs);
+    let peaks = spectrum.peaks(&held);
     // The paper's ratio of f2 to f1 guesses the other component when only one shows.
     const RATIO: f64 = 300.0 / 80.0;
     let (start_hz, one_peak) = match peaks.as_slice() {
@@ -634,7 +635,7 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
             });
             continue;
         }
-        let span = Span::of(&residual, first, end, onset, fs);
+        let span = Span::of(&residual, (first, end), onset, fs, &held);
         match fit_one_way(&span, start_hz, strides) {
             Ok(unit) => {
                 let with_short = second_mode::with_second_mode(&span, unit);
@@ -693,10 +694,18 @@ fn at_peak(span: &Span, unit: UnitFit) -> Result<UnitFit, Failed> {
         .copied()
         .collect();
     let rate = span.fs / unit.stride as f64;
-    let peak_hz = own_peaks(&read, rate).first().map_or(f64::NAN, |p| p.0);
+    let peak_hz = own_peaks_beside(&read, rate, &span.held)
+        .first()
+        .map_or(f64::NAN, |p| p.0);
     let component_hz = unit.stronger().map_or(f64::NAN, |c| c.heard_hz);
+    // A gliding mode's energy is spread over the pitches it sweeps, so its peak may lie anywhere
+    // between where it starts and its own frequency.
+    let (low_hz, high_hz) = unit
+        .stronger()
+        .and_then(|c| c.glide.map(|g| (c.frequency_hz * g.ratio, c.frequency_hz)))
+        .map_or((component_hz, component_hz), |(a, b)| (a.min(b), a.max(b)));
     let tolerance = (AT_PEAK_SHARE * peak_hz).max(rate / read.len() as f64);
-    if (component_hz - peak_hz).abs() <= tolerance {
+    if peak_hz >= low_hz - tolerance && peak_hz <= high_hz + tolerance {
         Ok(unit)
     } else {
         Err(Box::new((
@@ -722,7 +731,7 @@ fn fit_one_way(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<Unit
     let Err(first_reason) = paper else {
         return paper.map(|unit| with_glide(span, unit));
     };
-    let peaks = own_peaks(&span.samples, span.fs);
+    let peaks = own_peaks_beside(&span.samples, span.fs, &span.held);
     if peaks.is_empty() {
         return Err(Box::new((Rejection::NoResonance, None)));
     }

@@ -58,7 +58,7 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
     }
     // The short mode sought lies above the unit's own; below it lie hum and the skirts of the
     // long mode's misfit.
-    let (short_hz, _) = own_peak_above(&left, span.fs, main.heard_hz * SEPARATE_MODES)?;
+    let (short_hz, _) = own_peak_above(&left, span.fs, main.heard_hz * SEPARATE_MODES, &span.held)?;
     let strides = Strides::for_highest(short_hz.max(main.heard_hz), span.fs);
     let poles = eq1::pencil_poles(&left, strides.pencil, span.fs);
     let short = eq1::nearest_pole(&poles, short_hz).unwrap_or((short_hz, SHORT_DECAY_GUESS_PER_S));

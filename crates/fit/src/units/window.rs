@@ -5,6 +5,8 @@ use std::f64::consts::TAU;
 
 use num_complex::Complex;
 
+use crate::spectrum::HeldLines;
+
 /// One unit's span of the recording (less the units fitted before it), at the full rate.
 pub(crate) struct Span {
     /// The samples `[first, end)` of the recording.
@@ -17,17 +19,26 @@ pub(crate) struct Span {
     pub onset: usize,
     /// The sample rate (Hz).
     pub fs: f64,
+    /// The lines the whole recording holds (hum), which no unit's peak is taken at.
+    pub held: HeldLines,
 }
 
 impl Span {
     /// The span `[first, end)` of `signal` with its unit detected at `onset`.
-    pub fn of(signal: &[f32], first: usize, end: usize, onset: usize, fs: f64) -> Self {
+    pub fn of(
+        signal: &[f32],
+        (first, end): (usize, usize),
+        onset: usize,
+        fs: f64,
+        held: &HeldLines,
+    ) -> Self {
         Self {
             samples: signal[first..end].iter().map(|&y| f64::from(y)).collect(),
             first,
             end,
             onset,
             fs,
+            held: held.clone(),
         }
     }
 
