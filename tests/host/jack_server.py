@@ -88,10 +88,17 @@ def stop(process, sig=signal.SIGTERM, timeout_s=10):
     return process.returncode
 
 
-def start_jack(name, period, scheduling=("--no-realtime",)):
+# Outside real time, a client the server waits on this long (ms) before it drops it: jackd's
+# 500 ms default let a loaded machine (CI beside other work) starve the app's callback past it,
+# the server dropped the app's client, and the app ended on its own lost-audio watch mid-test.
+NO_REALTIME = ("--no-realtime", "-t", "10000")
+
+
+def start_jack(name, period, scheduling=NO_REALTIME):
     """Starts a JACK server called `name` on the dummy driver at RATE, `period` frames a cycle,
-    with `scheduling` (`-R -P 70` for real time); returns (process, its log). Raises
-    RuntimeError with the server's last words if it does not come up."""
+    with `scheduling` (`-R -P 70` for real time, whose client timeout must stay below jackd's
+    watchdog); returns (process, its log). Raises RuntimeError with the server's last words if
+    it does not come up."""
     import jack
 
     log = tempfile.TemporaryFile()
