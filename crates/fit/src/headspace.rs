@@ -165,24 +165,21 @@ pub fn fit_law(points: [&[(f64, f64)]; 2], pocket_ml: f64) -> HeadspaceLaw {
         // A mode that follows the air is a Helmholtz cavity wherever the data allow one: the
         // exponent a few glugs' scatter gives trades against H along a ridge, and ½ on it is
         // the physics, not a guess.
-        let allowed = |residual: f64| n * (residual.max(1e-300) / floor).ln() <= CHI2_1_95;
-        let at_half = |h: f64| helmholtz_at(data, h).map(|(_, residual)| residual);
-        let helmholtz_ml = if at_half(default_ml).is_some_and(allowed) {
-            Some(default_ml)
-        } else {
-            grid.iter()
-                .filter_map(|&(h, _)| at_half(h).map(|residual| (h, residual)))
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-                .filter(|&(_, residual)| allowed(residual))
-                .map(|(h, _)| h)
+        let allowed = |&(_, _, residual): &(f64, f64, f64)| {
+            n * (residual.max(1e-300) / floor).ln() <= CHI2_1_95
         };
-        if let Some(h) = helmholtz_ml {
+        let at_half = |h: f64| helmholtz_at(data, h).map(|(intercept, r)| (h, intercept, r));
+        let helmholtz = at_half(default_ml).filter(allowed).or_else(|| {
+            grid.iter()
+                .filter_map(|&(h, _)| at_half(h))
+                .min_by(|a, b| a.2.total_cmp(&b.2))
+                .filter(allowed)
+        });
+        if let Some((h, intercept, _)) = helmholtz {
             law.headspace_ml = h;
             law.headspace_heard = h != default_ml;
             law.modes = points.map(|p| mode_law(p, h, pocket_ml));
-            if let (Some(mode), Some((intercept, _))) =
-                (law.modes[leading].as_mut(), helmholtz_at(data, h))
-            {
+            if let Some(mode) = law.modes[leading].as_mut() {
                 mode.exponent = HELMHOLTZ;
                 mode.full_hz = (intercept - HELMHOLTZ * (h + pocket_ml).ln()).exp();
             }

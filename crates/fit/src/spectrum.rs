@@ -190,8 +190,9 @@ impl Spectrum {
 
     /// The lines the recording holds between its glugs as during them (mains hum and its
     /// harmonics, a machine's whine): a bin that is a local maximum of its segments'
-    /// [`NOISE_QUANTILE`] powers, stands [`HELD_LINE_ABOVE`] above its neighbourhood's, and whose
-    /// loud segments hold at most [`HELD_LINE_STEADY`] times its quiet ones. A glug's mode, even
+    /// [`NOISE_QUANTILE`] powers, stands [`HELD_LINE_ABOVE`] above its neighbourhood's, falls
+    /// as far within [`HELD_LINE_WIDTH_BINS`] either side, and whose loud segments hold at most
+    /// [`HELD_LINE_STEADY`] times its quiet ones. A glug's mode, even
     /// one ringing in every segment, comes and goes with its onsets; a held line does not.
     pub fn held_lines(samples: &[f32], sample_rate: f64) -> HeldLines {
         let (bin_hz, _, [quiet, loud]) =
@@ -260,14 +261,7 @@ impl Spectrum {
     /// The one or two strongest peaks `(Hz, power)`, strongest first, the second at least
     /// [`PEAK_SEPARATION`] from the first and within `weakest` of its power.
     fn peaks_within(&self, weakest: f64, held: &HeldLines) -> Vec<(f64, f64)> {
-        let first_bin = ((LOWEST_PEAK_HZ / self.bin_hz).ceil() as usize).max(1);
-        let mut maxima: Vec<(f64, f64)> = (first_bin..self.power.len().saturating_sub(1))
-            .filter(|&bin| {
-                self.power[bin] > self.power[bin - 1] && self.power[bin] >= self.power[bin + 1]
-            })
-            .map(|bin| (self.refined_hz(bin), self.power[bin]))
-            .filter(|&(hz, _)| !held.holds(hz))
-            .collect();
+        let mut maxima: Vec<(f64, f64)> = self.maxima_above(LOWEST_PEAK_HZ, held).collect();
         maxima.sort_by(|a, b| b.1.total_cmp(&a.1));
         let Some(&(strongest_hz, strongest)) = maxima.first() else {
             return Vec::new();
@@ -279,6 +273,22 @@ impl Spectrum {
         let mut peaks = vec![(strongest_hz, strongest)];
         peaks.extend(second.copied());
         peaks
+    }
+
+    /// Its local maxima `(Hz, power)` at or above `lowest_hz` (and [`LOWEST_PEAK_HZ`]), in
+    /// order, a maximum's frequency refined; none at one of `held`'s lines.
+    fn maxima_above<'a>(
+        &'a self,
+        lowest_hz: f64,
+        held: &'a HeldLines,
+    ) -> impl Iterator<Item = (f64, f64)> + 'a {
+        let first_bin = ((lowest_hz.max(LOWEST_PEAK_HZ) / self.bin_hz).ceil() as usize).max(1);
+        (first_bin..self.power.len().saturating_sub(1))
+            .filter(|&bin| {
+                self.power[bin] > self.power[bin - 1] && self.power[bin] >= self.power[bin + 1]
+            })
+            .map(|bin| (self.refined_hz(bin), self.power[bin]))
+            .filter(|&(hz, _)| !held.holds(hz))
     }
 
     /// The spectrum of one stretch of samples: a Hann window, zero-padded.
@@ -309,13 +319,9 @@ impl Spectrum {
 }
 
 /// The peaks of a unit's own span `(Hz, power)`, strongest first: its strongest, and a second
-/// [`PEAK_SEPARATION`] from it within 20 dB if there is one.
-pub fn own_peaks(samples: &[f64], sample_rate: f64) -> Vec<(f64, f64)> {
-    Spectrum::of_span(samples, sample_rate).peaks_within(WEAKEST_OWN_PEAK, &HeldLines::default())
-}
-
-/// [`own_peaks`], the recording's `held` lines left out: they ring no glug.
-pub fn own_peaks_beside(samples: &[f64], sample_rate: f64, held: &HeldLines) -> Vec<(f64, f64)> {
+/// [`PEAK_SEPARATION`] from it within 20 dB if there is one; none at one of the recording's
+/// `held` lines, which ring no glug.
+pub fn own_peaks(samples: &[f64], sample_rate: f64, held: &HeldLines) -> Vec<(f64, f64)> {
     Spectrum::of_span(samples, sample_rate).peaks_within(WEAKEST_OWN_PEAK, held)
 }
 
@@ -327,15 +333,8 @@ pub fn own_peak_above(
     lowest_hz: f64,
     held: &HeldLines,
 ) -> Option<(f64, f64)> {
-    let spectrum = Spectrum::of_span(samples, sample_rate);
-    let first_bin = ((lowest_hz.max(LOWEST_PEAK_HZ) / spectrum.bin_hz).ceil() as usize).max(1);
-    (first_bin..spectrum.power.len().saturating_sub(1))
-        .filter(|&bin| {
-            spectrum.power[bin] > spectrum.power[bin - 1]
-                && spectrum.power[bin] >= spectrum.power[bin + 1]
-        })
-        .map(|bin| (spectrum.refined_hz(bin), spectrum.power[bin]))
-        .filter(|&(hz, _)| !held.holds(hz))
+    Spectrum::of_span(samples, sample_rate)
+        .maxima_above(lowest_hz, held)
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 

@@ -25,7 +25,7 @@ use sake_glug_engine::{Constant, Range};
 
 use super::listen::glug_onsets;
 use super::onsets::detect_onsets;
-use super::spectrum::{own_peaks_beside, Spectrum};
+use super::spectrum::{own_peaks, Spectrum};
 pub use modes::{local_split, Modes};
 use window::{Span, Window};
 
@@ -694,7 +694,7 @@ fn at_peak(span: &Span, unit: UnitFit) -> Result<UnitFit, Failed> {
         .copied()
         .collect();
     let rate = span.fs / unit.stride as f64;
-    let peak_hz = own_peaks_beside(&read, rate, &span.held)
+    let peak_hz = own_peaks(&read, rate, &span.held)
         .first()
         .map_or(f64::NAN, |p| p.0);
     let component_hz = unit.stronger().map_or(f64::NAN, |c| c.heard_hz);
@@ -731,7 +731,7 @@ fn fit_one_way(span: &Span, start_hz: [f64; 2], strides: Strides) -> Result<Unit
     let Err(first_reason) = paper else {
         return paper.map(|unit| with_glide(span, unit));
     };
-    let peaks = own_peaks_beside(&span.samples, span.fs, &span.held);
+    let peaks = own_peaks(&span.samples, span.fs, &span.held);
     if peaks.is_empty() {
         return Err(Box::new((Rejection::NoResonance, None)));
     }
