@@ -4,15 +4,15 @@
 //! family, not a point.
 //!
 //! Two disjoint sets of seeds: the **development** set, run while the fit is tuned, and the
-//! **held-out** set, run only at the end. Each prints its table (per draw the truth, the model's
+//! **held-out** set, run once, at the end. Each prints its table (per draw the truth, the model's
 //! value and a pass or a miss per constant; per constant the share within tolerance and the
-//! draws that miss) and writes it as markdown to the file that `SAKE_GLUG_FAMILY_TABLE` (the
-//! development set) or `SAKE_GLUG_FAMILY_HELD_OUT_TABLE` (the held-out set) names. The goal, each
-//! constant within its tolerance in at least 90 % of the draws, is not met by today's fit, so
-//! both are `#[ignore]`d:
+//! draws that miss) and holds docs/fit.md's block to it; the development set is also held to the
+//! goal, each constant within its tolerance in at least 90 % of the draws. Sixty fits take about
+//! 17 minutes on 2 cores, so both are `#[ignore]`d, outside CI; `cargo xtask docs family` writes
+//! the development block:
 //!
 //! ```sh
-//! SAKE_GLUG_FAMILY_TABLE=family.md cargo test --test fit family -- --ignored --nocapture
+//! cargo test --all-features --test fit the_development_family -- --ignored --nocapture
 //! ```
 //!
 //! While tuning, `SAKE_GLUG_FAMILY_SEEDS=37,43` fits only those draws of the set, and
@@ -527,9 +527,10 @@ fn markdown(set: &str, outcomes: &[Outcome]) -> String {
     text
 }
 
-/// Fits every draw of `seeds`, prints the table, writes it where `table_variable` names, and
-/// holds each constant to the goal.
-fn run_family(set: &str, seeds: Range<u64>, table_variable: &str) {
+/// Fits every draw of `seeds`, prints the table and holds docs/fit.md's block `block` to it (or
+/// writes it there, with `SAKE_GLUG_WRITE_FIT_TABLES`); the outcomes, or none when
+/// `SAKE_GLUG_FAMILY_SEEDS` picks some draws while tuning.
+fn run_family(set: &str, seeds: Range<u64>, block: &str, command: &str) -> Option<Vec<Outcome>> {
     let only: Option<Vec<u64>> = std::env::var("SAKE_GLUG_FAMILY_SEEDS").ok().map(|list| {
         list.split(',')
             .map(|seed| {
@@ -546,38 +547,54 @@ fn run_family(set: &str, seeds: Range<u64>, table_variable: &str) {
     let table = markdown(set, &outcomes);
     println!("{table}");
     if only.is_some() {
-        return;
+        return None;
     }
-    if let Some(path) = std::env::var_os(table_variable) {
-        std::fs::write(&path, &table).unwrap();
-    }
-    let short: Vec<String> = MEASURES
+    super::documented(block, &table, command);
+    Some(outcomes)
+}
+
+/// The constants within tolerance in fewer than [`GOAL_SHARE`] of `outcomes`, with their shares.
+fn short_of_goal(outcomes: &[Outcome]) -> Vec<String> {
+    MEASURES
         .iter()
-        .zip(summary(&outcomes))
+        .zip(summary(outcomes))
         .filter(|(_, (share, _))| *share < GOAL_SHARE)
         .map(|(measure, (share, _))| format!("{} {:.0} %", measure.name, share * 100.0))
-        .collect();
-    assert!(
-        short.is_empty(),
-        "the {set} set: within tolerance in fewer than {:.0} % of the draws: {}",
-        GOAL_SHARE * 100.0,
-        short.join(", ")
-    );
+        .collect()
 }
 
+/// The development set meets the goal, and docs/fit.md reports it as the fit gives it.
 #[test]
-#[ignore = "the fit does not yet meet it — issue 45"]
+#[ignore = "60 fits, about 17 minutes on 2 cores: run outside CI, by `cargo xtask docs family`"]
 fn the_development_family_is_fitted_within_tolerance() {
-    run_family("development", DEVELOPMENT_SEEDS, "SAKE_GLUG_FAMILY_TABLE");
+    let command = "cargo xtask docs family";
+    if let Some(outcomes) = run_family(
+        "development",
+        DEVELOPMENT_SEEDS,
+        "family-development",
+        command,
+    ) {
+        let short = short_of_goal(&outcomes);
+        assert!(
+            short.is_empty(),
+            "the development set: within tolerance in fewer than {:.0} % of the draws: {}",
+            GOAL_SHARE * 100.0,
+            short.join(", ")
+        );
+    }
 }
 
+/// The held-out set, fitted once when the fit was tuned on the development set: docs/fit.md
+/// reports it as it came out, whatever it shows, and this test holds the report (a change to the
+/// fit that moves a held-out draw shows here).
 #[test]
-#[ignore = "the held-out set: run only at the end (issue 45); the fit does not yet meet it"]
-fn the_held_out_family_is_fitted_within_tolerance() {
+#[ignore = "60 fits, about 17 minutes on 2 cores: run outside CI"]
+fn the_held_out_family_is_reported_as_fitted() {
     run_family(
         "held-out",
         HELD_OUT_SEEDS,
-        "SAKE_GLUG_FAMILY_HELD_OUT_TABLE",
+        "family-held-out",
+        "SAKE_GLUG_WRITE_FIT_TABLES=1 cargo test --all-features --test fit the_held_out_family -- --ignored",
     );
 }
 
@@ -828,6 +845,25 @@ fn mains_hum_is_no_glugs_mode() {
 #[test]
 fn a_glug_no_fit_described_still_sets_the_pace() {
     assert_draws_pass(&[32], &[7]);
+}
+
+/// Draws 11 and 53 of the development set: a cavity gliding down into its f, falling with the
+/// headspace from 503 and 686 Hz, beside a steady bubble at 759 and 749 Hz. The bubble's pitch and
+/// its law (none) come within tolerance: a full bottle's lone cavity is placed by its own f, as its
+/// neighbours' modes record theirs (MODEL.md §13, "The bottle's two modes"). Placed by the pitch
+/// it is heard at, near the bubble, it rang f2: γ2 −0.19 and −0.27, f2 583 and 526 Hz.
+#[test]
+fn a_full_bottles_lone_cavity_is_placed_by_its_own_frequency() {
+    assert_draws_pass(&[11, 53], &[1, 6]);
+}
+
+/// Draw 45 of the development set: a Helmholtz cavity falling from 102 Hz beside a bubble at
+/// 704 Hz. The bubble's pitch and its law (none) come within tolerance: a component whose
+/// amplitude the fit held at 0 is no mode (MODEL.md §13, "Each unit"). Kept, four early units'
+/// such components at 859–953 Hz wrote a law of γ2 0.07 and, from it, f2 770 Hz.
+#[test]
+fn a_component_that_rings_nothing_is_no_mode() {
+    assert_draws_pass(&[45], &[1, 6]);
 }
 
 /// Fits each development draw of `seeds` and fails with the rows of those that miss any of

@@ -30,9 +30,6 @@ const FIRST_CLIPS: [&str; 8] = [
     "mineclonia-drinking-48k.wav",
 ];
 
-/// The page that holds the tables.
-const FIT_PAGE: &str = "docs/fit.md";
-
 fn recordings() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/recordings")
 }
@@ -234,23 +231,7 @@ fn heard_and_documented(clips: &[PathBuf], name: &str) -> Vec<Row> {
     let rows: Vec<Row> = clips.iter().map(|clip| row(clip)).collect();
     let table = table(&rows);
     eprintln!("{table}");
-    let page = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(FIT_PAGE);
-    let text = std::fs::read_to_string(&page).expect("docs/fit.md");
-    let begin = format!("<!-- generated:{name}:begin -->\n");
-    let end = format!("<!-- generated:{name}:end -->");
-    let (start, stop) = (
-        text.find(&begin).expect("the block's start") + begin.len(),
-        text.find(&end).expect("the block's end"),
-    );
-    if std::env::var_os("SAKE_GLUG_WRITE_FIT_TABLES").is_some() {
-        std::fs::write(&page, format!("{}{table}{}", &text[..start], &text[stop..])).unwrap();
-    } else {
-        assert_eq!(
-            &text[start..stop],
-            table,
-            "{FIT_PAGE}'s table `{name}` is not what the fit gives: run `cargo xtask docs fit`"
-        );
-    }
+    super::documented(name, &table, "cargo xtask docs fit");
     rows
 }
 

@@ -19,6 +19,33 @@ use sake_glug_engine::{UnitOnset, Voicing};
 use sake_glug_fit::{fit_session, FitSession, SessionFit};
 use sake_glug_render::{render_scene, BottleReport, RenderError, RenderObserver, Scene};
 
+/// The page that reports the fit on data it was not tuned on; its tables are written by the
+/// tests that hold them.
+const FIT_PAGE: &str = "docs/fit.md";
+
+/// Holds docs/fit.md's block `name` (between `<!-- generated:NAME:begin -->` and its end) to
+/// `table`, or writes it there with `SAKE_GLUG_WRITE_FIT_TABLES`; `command` is the one that
+/// writes it, named when they differ.
+pub fn documented(name: &str, table: &str, command: &str) {
+    let page = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(FIT_PAGE);
+    let text = std::fs::read_to_string(&page).expect("docs/fit.md");
+    let begin = format!("<!-- generated:{name}:begin -->\n");
+    let end = format!("<!-- generated:{name}:end -->");
+    let (start, stop) = (
+        text.find(&begin).expect("the block's start") + begin.len(),
+        text.find(&end).expect("the block's end"),
+    );
+    if std::env::var_os("SAKE_GLUG_WRITE_FIT_TABLES").is_some() {
+        std::fs::write(&page, format!("{}{table}{}", &text[..start], &text[stop..])).unwrap();
+    } else {
+        assert_eq!(
+            &text[start..stop],
+            table,
+            "{FIT_PAGE}'s table `{name}` is not what the fit gives: run `{command}`"
+        );
+    }
+}
+
 /// A render's samples, the engine's units and its volume 5 times a second (a scale's log).
 pub struct Rendered {
     pub sample_rate: u32,

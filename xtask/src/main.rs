@@ -157,10 +157,15 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             build_cli()?;
             paper::paper()
         }
-        // The fit's table of the development clips (docs/fit.md), written by the test that holds it.
-        Some("docs") if args.get(1).is_some_and(|arg| arg == "fit") => {
+        // The fit's tables of the development clips and family (docs/fit.md), each written by
+        // the test that holds it.
+        Some("docs")
+            if args
+                .get(1)
+                .is_some_and(|arg| arg == "fit" || arg == "family") =>
+        {
             nice_plug_xtask::chdir_workspace_root()?;
-            fit_docs()
+            fit_docs(&args[1])
         }
         // The cost figures alone (callgrind, and the benchmark's report with --bench): seconds,
         // where the whole of `docs` renders for minutes.
@@ -934,18 +939,35 @@ fn files_in(folder: &Path) -> nice_plug_xtask::Result<Vec<PathBuf>> {
 const SOUND_DESIGNER_PAGE: &str = "docs/guide/sound-designer.md";
 const HAPTIC_DESIGNER_PAGE: &str = "docs/guide/haptic-designer.md";
 
-/// docs/fit.md's table of the development clips, written by the fit suite's test that holds it
-/// (in the profile the tests run in, as CI runs it). The held-out clips' table is written once,
-/// when the fit is tuned, by its own (ignored) test: never by a command that runs while tuning.
-fn fit_docs() -> nice_plug_xtask::Result<()> {
-    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .args([
-            "test",
-            "--all-features",
-            "--test",
-            "fit",
+/// docs/fit.md's tables of the development clips (`fit`) and of the development family of
+/// simulated bottles (`family`, about 17 minutes), each written by the fit suite's test that
+/// holds it (in the profile the tests run in, as CI runs it). The held-out tables are written
+/// once, when the fit is tuned, by their own tests: never by a command that runs while tuning.
+fn fit_docs(which: &str) -> nice_plug_xtask::Result<()> {
+    let (test, ignored) = match which {
+        "family" => (
+            "family::the_development_family_is_fitted_within_tolerance",
+            true,
+        ),
+        _ => (
             "listening::development_clips_sound_nearer_than_the_default_bottle",
-        ])
+            false,
+        ),
+    };
+    let mut args = vec![
+        "test",
+        "--all-features",
+        "--test",
+        "fit",
+        test,
+        "--",
+        "--exact",
+    ];
+    if ignored {
+        args.push("--ignored");
+    }
+    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .args(&args)
         .env("SAKE_GLUG_WRITE_FIT_TABLES", "1")
         .status()?;
     if !status.success() {

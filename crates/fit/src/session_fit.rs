@@ -11,7 +11,7 @@ use super::pour::{complete_without_weight, pockets, tilt_rates};
 use super::recording::{fit_recording, RecordingFit};
 use super::session::FitSession;
 use super::stats::median;
-use super::units::{local_split, Modes, UnitFit};
+use super::units::{local_split, Modes};
 use sake_glug_engine::Constant;
 
 /// A whole session, fitted.
@@ -142,15 +142,14 @@ fn place_lone_modes(recording: &mut RecordingFit) {
         .filter(|u| u.fit.amplitude.iter().all(|&a| a > 0.0))
         .map(|u| (u.fit.onset_s, u.fit.frequency_hz))
         .collect();
-    let lone = |fit: &UnitFit| fit.fitted().count() == 1;
-    for unit in &mut recording.units {
-        if let (true, Some(split)) = (lone(&unit.fit), local_split(unit.fit.onset_s, &both)) {
-            unit.fit.assign(&split);
-        }
-    }
-    for fit in recording.detected.iter_mut().filter_map(|d| d.fit.as_mut()) {
-        if let (true, Some(split)) = (lone(fit), local_split(fit.onset_s, &both)) {
-            fit.assign(&split);
+    let fits = recording
+        .units
+        .iter_mut()
+        .map(|unit| &mut unit.fit)
+        .chain(recording.detected.iter_mut().filter_map(|d| d.fit.as_mut()));
+    for fit in fits.filter(|fit| fit.rings_one_mode()) {
+        if let Some(split) = local_split(fit.onset_s, &both) {
+            fit.assign_by_neighbours(&split);
         }
     }
 }

@@ -142,6 +142,16 @@ impl Component {
             * (TAU * self.cycles(tau) + self.phase).sin()
     }
 
+    /// The frequency its mode records in its unit: its own f, or the one it is heard at where its
+    /// glide is slower than its ring (its own f is then a guess).
+    fn recorded_hz(&self) -> f64 {
+        if self.unheard_glide().is_some() {
+            self.heard_hz
+        } else {
+            self.frequency_hz
+        }
+    }
+
     /// Why its glide is not heard, if it glides more slowly than it rings ([`GLIDE_REACHED`]).
     fn unheard_glide(&self) -> Option<Rejection> {
         let glide = self.glide?;
@@ -239,6 +249,11 @@ pub struct UnitFit {
 impl UnitFit {
     fn new(fitted: Fitted, placed: Placed, start: Option<[f64; 7]>, method: UnitMethod) -> Self {
         let mut sorted = fitted.components.to_vec();
+        // A component the amplitudes' fit held at 0 rings nothing, and its frequency is whatever
+        // Levenberg-Marquardt left it at: it is no mode of the unit's.
+        if sorted.iter().any(|c| c.amplitude > 0.0) {
+            sorted.retain(|c| c.amplitude > 0.0);
+        }
         sorted.sort_by(|a, b| a.heard_hz.total_cmp(&b.heard_hz));
         for component in &mut sorted {
             component.in_span = in_span(component, fitted.onset_s, placed);
@@ -283,10 +298,27 @@ impl UnitFit {
     /// Puts each component in the mode `modes` gives the frequency it is heard at (the stronger,
     /// where two fall in one).
     pub fn assign(&mut self, modes: &Modes) {
+        self.assign_by(modes, |c| c.heard_hz);
+    }
+
+    /// Puts each component in the mode `split` gives the frequency it would record there
+    /// ([`UnitFit::frequency_hz`]): a split taken between neighbours' recorded f1 and f2 compares
+    /// like with like. A cavity gliding down into its f is heard well above it, so a full
+    /// bottle's lone cavity, heard near the bubble, would be put in the bubble's mode.
+    pub fn assign_by_neighbours(&mut self, split: &Modes) {
+        self.assign_by(split, Component::recorded_hz);
+    }
+
+    /// Whether it rings one mode only.
+    pub fn rings_one_mode(&self) -> bool {
+        self.amplitude.iter().filter(|&&a| a > 0.0).count() == 1
+    }
+
+    fn assign_by(&mut self, modes: &Modes, pitch: impl Fn(&Component) -> f64) {
         let mut best: [Option<Component>; 2] = [None, None];
         let count = self.fitted().count();
         for (index, component) in self.fitted().enumerate() {
-            let mode = modes.mode_of(component.heard_hz, index, count);
+            let mode = modes.mode_of(pitch(component), index, count);
             if best[mode].is_none_or(|b| b.in_span < component.in_span) {
                 best[mode] = Some(*component);
             }
