@@ -7,10 +7,11 @@
 //! its pitch within 15 %, its bright share within 10 points, and its distance below the
 //! default's; or the fit refuses the clip, with its reason.
 //!
-//! The development half (the first clips and `dev/`) is what the fit was tuned on; the held-out
-//! half (`held-out/`) was looked at once, at the end. docs/fit.md holds both tables as this test
-//! writes them (`SAKE_GLUG_WRITE_FIT_TABLES=1`, or `cargo xtask docs fit`); the test holds the
-//! docs to what the fit gives.
+//! The development half (the first clips and `dev/`) is what the fit was tuned on; the first
+//! held-out half (`held-out/`) was run once at e092597d and has been seen since; the second
+//! held-out set (`held-out-2/`) was gathered after, and run once at the end. docs/fit.md holds
+//! their tables as these tests write them (`SAKE_GLUG_WRITE_FIT_TABLES=1`; `cargo xtask docs fit`
+//! writes the development one); each test holds the docs to what the fit gives.
 
 use std::path::{Path, PathBuf};
 
@@ -58,9 +59,14 @@ fn development() -> Vec<PathBuf> {
         .collect()
 }
 
-/// The held-out half.
+/// The first held-out half: run once at e092597d, and seen since (docs/fit.md).
 fn held_out() -> Vec<PathBuf> {
     clips_in(&recordings().join("held-out"))
+}
+
+/// The second held-out set, gathered after the first was seen: run once, at the end.
+fn second_held_out() -> Vec<PathBuf> {
+    clips_in(&recordings().join("held-out-2"))
 }
 
 /// One clip, fitted and heard.
@@ -251,10 +257,20 @@ fn development_clips_sound_nearer_than_the_default_bottle() {
     assert!(missed.is_empty(), "{missed:#?}");
 }
 
+/// The first held-out half, seen since it was run once at e092597d (one clip of it led to a rule
+/// of the listening fit): docs/fit.md reports it as the fit gives it.
 #[test]
-#[ignore = "the held-out half is run once, when the fit is tuned on the development half (issue 45)"]
-fn held_out_clips_sound_nearer_than_the_default_bottle() {
+fn the_first_held_out_half_is_reported_as_fitted() {
     let rows = heard_and_documented(&held_out(), "fit-held-out");
+    assert!(rows.len() >= 5, "{} held-out clips", rows.len());
+}
+
+/// The second held-out set, run once when the fit was tuned: docs/fit.md reports it as it came
+/// out, whatever it shows, and this test holds the report; then the issue's claim, which it
+/// showed: every clip's model nearer than the default bottle, or the clip refused.
+#[test]
+fn the_second_held_out_set_is_reported_and_sounds_nearer_than_the_default_bottle() {
+    let rows = heard_and_documented(&second_held_out(), "fit-held-out-2");
     assert!(rows.len() >= 5, "{} held-out clips", rows.len());
     let missed = missed(&rows);
     assert!(missed.is_empty(), "{missed:#?}");

@@ -940,7 +940,7 @@ const SOUND_DESIGNER_PAGE: &str = "docs/guide/sound-designer.md";
 const HAPTIC_DESIGNER_PAGE: &str = "docs/guide/haptic-designer.md";
 
 /// docs/fit.md's tables of the development clips (`fit`) and of the development family of
-/// simulated bottles (`family`, about 17 minutes), each written by the fit suite's test that
+/// simulated bottles (`family`, 10–15 minutes), each written by the fit suite's test that
 /// holds it (in the profile the tests run in, as CI runs it). The held-out tables are written
 /// once, when the fit is tuned, by their own tests: never by a command that runs while tuning.
 fn fit_docs(which: &str) -> nice_plug_xtask::Result<()> {

@@ -4,7 +4,8 @@
 //! how far what a listener hears of them lies from what they hear of the recording: the glug rate,
 //! the median glug pitch, the pitch's fall, the share of the energy above 700 Hz and the
 //! log-spectral distance ([`super::listen`], [`super::compare`]). Where the units explain at
-//! least half of every recording, their model is kept; elsewhere it is one of the search's starts.
+//! least half of every recording and set some of its constants, their model is kept; elsewhere it
+//! is one of the search's starts.
 
 use argmin::core::{CostFunction, Error as ArgminError, Executor};
 use argmin::solver::neldermead::NelderMead;
@@ -338,8 +339,16 @@ pub(crate) fn fit_by_listening(
     capacity_ml: f64,
 ) -> Option<ListeningFit> {
     // Where the units explain at least half of every recording, the model is theirs: the
-    // listening fit is for the recordings the paper's units describe poorly.
-    if recordings.iter().all(|r| r.explained >= LOW_EXPLAINED) {
+    // listening fit is for the recordings the paper's units describe poorly. Unless the units
+    // set none of the constants it fits (too few units for any): their model is then the default
+    // bottle, which describes no recording.
+    let knobs = knobs();
+    let units_set_some = knobs.iter().any(|knob| {
+        estimates
+            .iter()
+            .any(|e| e.key == knob.key && e.in_model && e.value.is_finite())
+    });
+    if units_set_some && recordings.iter().all(|r| r.explained >= LOW_EXPLAINED) {
         return None;
     }
     let base: toml::Table = toml::from_str(model_toml).ok()?;
@@ -347,7 +356,6 @@ pub(crate) fn fit_by_listening(
     if targets.iter().all(|t| t.glugs < 2) {
         return None;
     }
-    let knobs = knobs();
     let units_value = |key: &str| value_in(&base, key).unwrap_or_else(|| default_of(key));
     let bounds = search_bounds(&knobs, &targets);
     let search = Search {
