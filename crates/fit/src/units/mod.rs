@@ -327,11 +327,7 @@ impl UnitFit {
             // A glide slower than its ring never reaches its own f: the mode is the pitch heard.
             let heard = component.filter(|c| c.unheard_glide().is_some());
             self.amplitude[mode] = component.map_or(0.0, |c| c.amplitude);
-            self.frequency_hz[mode] = match (component, heard) {
-                (_, Some(c)) => c.heard_hz,
-                (Some(c), None) => c.frequency_hz,
-                (None, None) => f64::NAN,
-            };
+            self.frequency_hz[mode] = component.map_or(f64::NAN, |c| c.recorded_hz());
             self.glide[mode] = component.and_then(|c| c.glide).filter(|_| heard.is_none());
             self.decay_per_s[mode] = component.map_or(f64::NAN, |c| c.decay_per_s);
             self.swept[mode] = component.is_some_and(|c| c.glide.is_some());
