@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// How a repository path starts: one of the top-level folders, or it is a top-level file.
-const FOLDERS: [&str; 15] = [
+const FOLDERS: [&str; 16] = [
     "src/",
     "actuators/",
     "crates/",
@@ -26,6 +26,7 @@ const FOLDERS: [&str; 15] = [
     "presets/",
     "experiments/",
     "python/",
+    "web/",
     ".ci/",
 ];
 const FILES: [&str; 9] = [

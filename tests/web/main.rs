@@ -197,6 +197,11 @@ fn bad_arguments_are_refused_with_a_message() {
         let message = live.process(frames).unwrap_err().0;
         assert!(message.contains("a block is a whole number"), "{message}");
     }
+    let message = live.set_actuator(Some("[response]\n")).unwrap_err().0;
+    assert!(message.starts_with("actuator profile:"), "{message}");
+    let huge = "#".repeat(sake_glug_actuator::MAX_PROFILE_BYTES as usize + 1);
+    let message = live.set_actuator(Some(&huge)).unwrap_err().0;
+    assert!(message.contains("over the limit"), "{message}");
     // Refused calls changed nothing: the handle still plays the built-in pour.
     let (samples, _) = builtin_pour(&mut live, 48_000.0, MAX_BLOCK_FRAMES);
     assert!(samples == offline(&Scene::default()).0);
@@ -214,4 +219,41 @@ fn a_full_queue_is_refused_until_a_block_takes_it() {
     assert!(message.contains("render a block first"), "{message}");
     live.process(1.0).unwrap();
     live.refill().unwrap();
+}
+
+#[test]
+fn a_phones_gravity_is_the_bottles_tilt_as_the_plugin_reads_it() {
+    use sake_glug_web::live::tilt_of;
+    assert_eq!(tilt_of([0.0, 1.0, 0.0], "+y").unwrap(), Some(0.0));
+    assert_eq!(tilt_of([0.0, 0.0, 9.81], "+y").unwrap(), Some(90.0));
+    assert_eq!(tilt_of([0.0, -2.0, 0.0], "+y").unwrap(), Some(180.0));
+    assert_eq!(tilt_of([0.0, 0.0, 0.0], "+y").unwrap(), None);
+    let message = tilt_of([0.0, 1.0, 0.0], "up").unwrap_err().0;
+    assert!(message.contains("is not an axis"), "{message}");
+}
+
+#[test]
+fn an_actuator_profile_compensates_as_the_c_library_does() {
+    let profile = sake_glug_actuator::SHIPPED
+        .iter()
+        .find(|(name, _)| *name == "lra")
+        .map(|(_, text)| *text)
+        .unwrap();
+    let mut live = LiveGlug::new(48_000.0, None, None).unwrap();
+    live.set_actuator(Some(profile)).unwrap();
+    let (samples, _) = builtin_pour(&mut live, 48_000.0, 128);
+    let scene = Scene {
+        actuator: Some(
+            sake_glug_actuator::ActuatorProfile::parse(profile)
+                .unwrap()
+                .response(),
+        ),
+        ..Scene::default()
+    };
+    let (expected, _) = offline(&scene);
+    assert!(samples == expected, "the renderer's --actuator lra");
+    assert!(
+        samples != offline(&Scene::default()).0,
+        "the profile changed the pour"
+    );
 }

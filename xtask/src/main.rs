@@ -5,7 +5,8 @@
 //!   app can be built. Without the app's libraries (pkg-config's `alsa` and `jack`) it
 //!   skips the app and ends with one line naming the `apt-get install` that adds them.
 //! - `cargo xtask test`: every test: formatting and lints, the Rust suites, then the bundles in a
-//!   real VST3 host and the standalone app under a JACK server, the Windows release under Wine
+//!   real VST3 host and the standalone app under a JACK server, the npm package in Node.js and
+//!   headless Chromium, the Windows release under Wine
 //!   (where MinGW-w64, NSIS and Wine are installed; CI installs them), then the Python package installed
 //!   into the virtual environment and its pytest suite. Without the app's libraries it
 //!   stops at once, naming the `apt-get install`.
@@ -26,6 +27,10 @@
 //! - `cargo xtask fuzz`: every libFuzzer target of fuzz/ (`cargo install cargo-fuzz`) for
 //!   `FUZZ_SECONDS` each (60 by default), keeping their minimised corpora and any failing input
 //!   as a regression the ordinary tests replay; summarised in docs/fuzzing.md.
+//! - `cargo xtask web [test | screenshot]`: the npm package of web/ (the engine in WebAssembly,
+//!   its JS glue, the engine's tables) packed into target/web/ (web.rs); with `test`, its tests
+//!   in Node.js and headless Chromium against the release CLI; with `screenshot`, the page that
+//!   pours in headless Chromium, for the guide (docs/web-page.png).
 //! - `cargo xtask wheel`: the Python package (python/) as a wheel in target/wheels/, built by
 //!   maturin from the virtual environment.
 //! - `cargo xtask dist`: the release in target/dist/ (the Debian package, the tarball with its
@@ -46,6 +51,7 @@ use std::process::Command;
 mod dist;
 mod paper;
 mod screenshots;
+mod web;
 mod windows;
 
 /// An error is said in one line, without the backtrace anyhow adds under `RUST_BACKTRACE`: it
@@ -114,6 +120,10 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             build_standalone()?;
             // The C library that the examples of examples/ link (tests/host/test_capi.py).
             build_c_library()?;
+            // The npm package (web/): the engine in WebAssembly, in Node.js and headless
+            // Chromium, against the CLI just built (skipped where its tools are missing, but
+            // under CI).
+            web::build_and_test(Path::new(&cli()))?;
             build_wheel()?;
             // The release packed from those builds, for the host tests to install and check.
             dist()?;
@@ -147,6 +157,24 @@ fn xtask() -> nice_plug_xtask::Result<()> {
             build_c_library()?;
             build_wheel()?;
             dist()
+        }
+        // The npm package of web/ (the engine in WebAssembly), packed into target/web/;
+        // `cargo xtask web test` runs its tests against the release CLI, `cargo xtask web
+        // screenshot` draws the page for the guide.
+        Some("web") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            let tarball = web::build()?;
+            match args.get(1).map(String::as_str) {
+                Some("test") => {
+                    build_cli()?;
+                    web::test(&tarball, Path::new(&cli()))
+                }
+                Some("screenshot") => web::screenshot(Path::new(web::SCREENSHOT)),
+                Some(other) => {
+                    anyhow::bail!("cargo xtask web takes `test` or `screenshot`, not `{other}`")
+                }
+                None => Ok(()),
+            }
         }
         Some("wheel") => {
             nice_plug_xtask::chdir_workspace_root()?;
@@ -495,9 +523,10 @@ fn live_latency() -> nice_plug_xtask::Result<()> {
 }
 
 /// The pictures of docs/ that `cargo xtask docs` does not draw, and the command that does.
-const PICTURES_ELSEWHERE: [(&str, &str); 2] = [
+const PICTURES_ELSEWHERE: [(&str, &str); 3] = [
     ("docs/editor-idle.png", "cargo xtask screenshots"),
     ("docs/editor-pouring.png", "cargo xtask screenshots"),
+    (web::SCREENSHOT, "cargo xtask web screenshot"),
 ];
 
 /// Says which pictures of docs/ this run did not regenerate (older than `started`), and what

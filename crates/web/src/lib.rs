@@ -81,6 +81,13 @@ impl Glug {
         self.live.reset().map_err(js)
     }
 
+    /// Compensates the units that start from the next block on for the actuator whose profile
+    /// file's text is `profileText` (MODEL.md §18); null plays the model's drive as it is.
+    #[wasm_bindgen(js_name = setActuator)]
+    pub fn set_actuator(&mut self, profile_text: Option<String>) -> Result<(), JsError> {
+        self.live.set_actuator(profile_text.as_deref()).map_err(js)
+    }
+
     /// Renders `frames` samples (0 to `maxBlockFrames()`) into the handle's buffer, at
     /// `outputPtr()` in the WebAssembly memory.
     pub fn process(&mut self, frames: f64) -> Result<(), JsError> {
@@ -176,6 +183,15 @@ pub fn max_units() -> usize {
 #[wasm_bindgen(js_name = unitFields)]
 pub fn unit_fields() -> Vec<String> {
     UNIT_FIELDS.iter().map(|&field| field.to_owned()).collect()
+}
+
+/// The bottle's tilt (°) from a gravity reading `x, y, z` that points up (the sensor at rest
+/// reads +1 g away from the earth), `axis` the sensor axis from the bottle's base to its mouth
+/// (`+x`, `-y`, …): the plugin's reading of a phone's gravity. Undefined if the reading has no
+/// direction.
+#[wasm_bindgen(js_name = tiltFromGravity)]
+pub fn tilt_from_gravity(x: f64, y: f64, z: f64, axis: &str) -> Result<Option<f64>, JsError> {
+    live::tilt_of([x, y, z], axis).map_err(js)
 }
 
 /// The version of the engine inside (the release's).

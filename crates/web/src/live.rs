@@ -7,6 +7,8 @@
 //! first and refused with a [`LiveError`], which lib.rs turns into a JavaScript `Error`.
 
 use sake_glug::{Command, SakeGlug, SakeGlugState, SakeGlugUnit, SAKE_GLUG_MAX_QUEUED_CONTROLS};
+use sake_glug_actuator::{ActuatorProfile, MAX_PROFILE_BYTES};
+use sake_glug_device::axis::{tilt_from_gravity, Axis};
 use sake_glug_engine::config::SEED;
 use sake_glug_engine::{Control, ControlValues, Preset};
 use sake_glug_model_file::ModelFile;
@@ -147,6 +149,32 @@ impl LiveGlug {
     /// MODEL.md §8 reset at the first sample of the next block.
     pub fn reset(&mut self) -> Result<(), LiveError> {
         self.queue(Command::Reset)
+    }
+
+    /// Compensates the units that start from the next block on for the actuator whose profile is
+    /// `profile_text` (MODEL.md §18), as `sake-glug render --actuator` does; `None` plays the
+    /// model's drive as it is.
+    pub fn set_actuator(&mut self, profile_text: Option<&str>) -> Result<(), LiveError> {
+        let response = match profile_text {
+            None => None,
+            Some(text) if text.len() as u64 > MAX_PROFILE_BYTES => {
+                return refuse(format!(
+                    "actuator profile: {} bytes, over the limit of {MAX_PROFILE_BYTES} bytes",
+                    text.len()
+                ))
+            }
+            Some(text) => Some(
+                ActuatorProfile::parse(text)
+                    .map_err(|error| LiveError(format!("actuator profile: {error}")))?
+                    .response(),
+            ),
+        };
+        self.glug.set_actuator(response).map_err(|_| {
+            LiveError(format!(
+                "{SAKE_GLUG_MAX_QUEUED_CONTROLS} control calls already wait for the next block: \
+                 render a block first"
+            ))
+        })
     }
 
     fn queue(&mut self, command: Command) -> Result<(), LiveError> {
@@ -299,4 +327,14 @@ fn checked_seed(seed: Option<f64>) -> Result<u64, LiveError> {
         None => Ok(SEED.range.default as u64),
         Some(seed) => checked_whole("the seed", seed),
     }
+}
+
+/// The bottle's tilt (°) from a gravity reading that points up, along the sensor axis `axis`
+/// (`+y`: from the base to the mouth), as the plugin reads a phone's gravity over OSC; `None`
+/// when the reading has no direction.
+pub fn tilt_of(reading: [f64; 3], axis: &str) -> Result<Option<f64>, LiveError> {
+    let axis: Axis = axis
+        .parse()
+        .map_err(|error| LiveError(format!("{error}")))?;
+    Ok(tilt_from_gravity(reading, axis))
 }
