@@ -257,3 +257,22 @@ fn an_actuator_profile_compensates_as_the_c_library_does() {
         "the profile changed the pour"
     );
 }
+
+#[test]
+fn a_clip_of_units_is_refused_when_its_numbers_are_not_units() {
+    use sake_glug_web::live::{clip, CLIP_UNIT_FIELDS};
+    let unit = [0.1, 0.5, 0.33, 80.0, 300.0, 45.0, 40.0];
+    assert_eq!(unit.len(), CLIP_UNIT_FIELDS.len());
+    let rumble = clip("rumble", &unit, 0.5, "web", 1.0).unwrap();
+    assert!(rumble.contains("\"frames\""), "{rumble}");
+    let message = clip("rumble", &unit[..6], 0.5, "web", 1.0).unwrap_err().0;
+    assert!(message.contains("7 numbers each"), "{message}");
+    let message = clip("rumble", &[f64::NAN; 7], 0.5, "web", 1.0)
+        .unwrap_err()
+        .0;
+    assert!(message.contains("not finite"), "{message}");
+    let message = clip("ogg", &unit, 0.5, "web", 1.0).unwrap_err().0;
+    assert!(message.contains("no clip format `ogg`"), "{message}");
+    let message = clip("ahap", &unit, -1.0, "web", 1.0).unwrap_err().0;
+    assert!(message.contains("finite number of seconds"), "{message}");
+}

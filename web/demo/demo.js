@@ -13,9 +13,7 @@ import {
   renderInContext,
   builtInPour,
   encodeWav,
-  rumbleFrames,
-  androidSteps,
-  vibratePattern,
+  clip,
   HapticsDriver,
   tiltFromOrientation,
 } from "../src/index.js";
@@ -267,35 +265,31 @@ async function renderClip() {
     control: control.id,
     value: page.controls[control.id],
   }));
-  const clip = await renderInContext({
+  const rendered = await renderInContext({
     sampleRate: CLIP_RATE,
     model: model(),
     score: [...settings, ...builtInPour(CLIP_RATE)],
   });
-  const seconds = clip.samples.length / CLIP_RATE;
+  const seconds = rendered.samples.length / CLIP_RATE;
   const took = (performance.now() - started) / 1000;
-  offer("download-wav", encodeWav(clip.samples, CLIP_RATE), "audio/wav");
-  const rounded = (x) => Math.round(x * 1e4) / 1e4;
-  const frames = rumbleFrames(clip.units, { sampleRate: CLIP_RATE, durationS: seconds });
-  const rumble = {
-    rate_hz: 100,
-    frames: frames.map((f) => ({ t_ms: rounded(f.tMs), low: rounded(f.low), high: rounded(f.high) })),
-  };
-  offer("download-rumble", JSON.stringify(rumble), "application/json");
-  const steps = androidSteps(clip.units, { sampleRate: CLIP_RATE, durationS: seconds });
-  const waveform = { timings: steps.map((s) => s.durationMs), amplitudes: steps.map((s) => s.amplitude), repeat: -1 };
-  offer("download-android", JSON.stringify(waveform), "application/json");
-  page.clip = { units: clip.units, seconds, pattern: vibratePattern(steps) };
+  offer("download-wav", encodeWav(rendered.samples, CLIP_RATE), "audio/wav");
+  // The clips by the renderer's own writers, in the engine.
+  const clipOf = (format) => clip(format, rendered.units, { durationS: seconds, name: "web", seed: 1 });
+  offer("download-ahap", clipOf("ahap"), "application/json");
+  offer("download-haptic", clipOf("haptic"), "application/json");
+  offer("download-rumble", clipOf("rumble"), "application/json");
+  offer("download-android", clipOf("android-waveform"), "application/json");
+  page.clip = { units: rendered.units, seconds };
   if (!page.node) {
     // Not pouring live: the page shows the clip.
-    drawClip(clip.samples);
+    drawClip(rendered.samples);
     page.units = 0;
     $("units").replaceChildren();
-    showUnits(clip.units);
+    showUnits(rendered.units);
     $("status").textContent = `The clip: ${seconds.toFixed(2)} s.`;
   }
   $("feel").hidden = !(navigator.getGamepads || navigator.vibrate);
-  $("render-status").textContent = `${seconds.toFixed(2)} s, ${clip.units.length} units, rendered in ${took.toFixed(2)} s (${(seconds / took).toFixed(0)}× real time).`;
+  $("render-status").textContent = `${seconds.toFixed(2)} s, ${rendered.units.length} units, rendered in ${took.toFixed(2)} s (${(seconds / took).toFixed(0)}× real time).`;
   $("render").disabled = false;
 }
 

@@ -10,6 +10,9 @@ import {
   unitFields,
   version as wasmVersion,
   tiltFromGravity as wasmTiltFromGravity,
+  clip as wasmClip,
+  clipFormats as wasmClipFormats,
+  clipUnitFields,
 } from "../dist/sake_glug_web.js";
 import { CONTROLS, PRESETS, CONSTANTS, VERSION } from "../dist/tables.js";
 
@@ -294,6 +297,31 @@ export function tiltFromOrientation(beta, gamma) {
   const g = (gamma * Math.PI) / 180;
   // "Up" in the phone's frame, after its rotations about x by beta and about y by gamma.
   return tiltFromGravity([-Math.sin(g) * Math.cos(b), Math.sin(b), Math.cos(g) * Math.cos(b)]);
+}
+
+/**
+ * A haptic clip's text, written by the renderer's own writer (the file `sake-glug render -o
+ * FORMAT:FILE` writes for the same units): `format` one of `clipFormats()` ("ahap", "haptic",
+ * "rumble", "android-waveform", "android-xml", "haps"), from a render's `units` (each with its
+ * `timeS`), `durationS` long; `name` and `seed` go into its description.
+ */
+export function clip(format, units, { durationS, name = "web", seed = 1 }) {
+  requireLoaded();
+  const width = clipUnitFields().length;
+  const table = new Float64Array(units.length * width);
+  units.forEach((unit, i) => {
+    table.set(
+      [unit.timeS, unit.amplitude, unit.viscosityC, unit.f1Hz, unit.f2Hz, unit.b1PerS, unit.b2PerS],
+      i * width,
+    );
+  });
+  return wasmClip(format, table, durationS, name, seed);
+}
+
+/** The clip formats `clip` writes. */
+export function clipFormats() {
+  requireLoaded();
+  return wasmClipFormats();
 }
 
 /** The names of a unit's numbers, in the order of a unit table's rows. */

@@ -67,6 +67,17 @@ export function modelText(values: Record<string, number>): string;
 export function unitFieldNames(): readonly string[];
 /** The most frames a block renders and the most units it keeps. */
 export function limits(): { maxBlockFrames: number; maxUnits: number };
+/** The clip formats `clip` writes. */
+export function clipFormats(): string[];
+/**
+ * A haptic clip's text by the renderer's own writer ("ahap", "haptic", "rumble",
+ * "android-waveform", "android-xml", "haps"), from a render's units (each with its timeS).
+ */
+export function clip(
+  format: string,
+  units: Unit[],
+  options: { durationS: number; name?: string; seed?: number },
+): string;
 /** The bottle's tilt (°) from a gravity reading that points up, along `axis` ("+y" by default). */
 export function tiltFromGravity(reading: [number, number, number], axis?: string): number | null;
 /** The bottle's tilt (°) from a DeviceOrientationEvent's beta and gamma (°). */

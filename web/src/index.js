@@ -20,6 +20,8 @@ export {
   limits,
   tiltFromGravity,
   tiltFromOrientation,
+  clip,
+  clipFormats,
   CONTROLS,
   CONSTANTS,
   PRESETS,

@@ -60,11 +60,14 @@ test("the page loads, builds its controls and renders its clip with no console e
     const presets = $("preset").options.length;
     $("render").click();
     await window.sakeGlugPage.rendering;
-    return { version: $("version").textContent, sliders, presets, wav: $("download-wav").href, status: $("render-status").textContent };`);
+    const offered = ["wav", "ahap", "haptic", "rumble", "android"].filter((kind) => $("download-" + kind).href.startsWith("blob:"));
+    const ahap = JSON.parse(await (await fetch($("download-ahap").href)).text());
+    return { version: $("version").textContent, sliders, presets, offered, ahapVersion: ahap.Version, status: $("render-status").textContent };`);
   assert.match(shown.version, /^engine \d+\.\d+\.\d+$/);
   assert.equal(shown.sliders, 8, "the five controls and the headspace law's three");
   assert.equal(shown.presets, 8);
-  assert.match(shown.wav, /^blob:/, "a WAV to download");
+  assert.deepEqual(shown.offered, ["wav", "ahap", "haptic", "rumble", "android"], "the files to download");
+  assert.equal(shown.ahapVersion, 1, "an .ahap pattern");
   assert.match(shown.status, /units, rendered in/);
   const errors = (await browser.console()).filter((entry) => entry.level === "SEVERE" || entry.level === "WARNING");
   assert.deepEqual(errors, [], "the console's errors and warnings");

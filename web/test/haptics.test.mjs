@@ -8,7 +8,16 @@ import { test } from "node:test";
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
 import { join } from "node:path";
-import { render, rumbleFrames, androidSteps, vibratePattern, HapticsDriver, RUMBLE_RATE_HZ } from "../src/index.js";
+import {
+  render,
+  rumbleFrames,
+  androidSteps,
+  vibratePattern,
+  HapticsDriver,
+  RUMBLE_RATE_HZ,
+  clip,
+  clipFormats,
+} from "../src/index.js";
 import { cli, workFolder } from "./support/cli.mjs";
 import { SCENES } from "./support/scenes.mjs";
 
@@ -152,4 +161,44 @@ test("without a gamepad or a vibrator the driver calls nothing and fails nothing
     assert.ok(played.low > 0 && played.high > 0, "the envelope is still there for a page to show");
     driver.stop();
   }
+});
+
+/** Two JSON values alike, their numbers within `tolerance` of each other (relative). */
+function assertAlike(ours, theirs, tolerance, where) {
+  if (typeof theirs === "number") {
+    assert.ok(Math.abs(ours - theirs) <= tolerance * Math.abs(theirs), `${where}: ${ours}, the CLI's ${theirs}`);
+  } else if (theirs !== null && typeof theirs === "object") {
+    assert.deepEqual(Object.keys(ours), Object.keys(theirs), `${where}: keys`);
+    for (const key of Object.keys(theirs)) assertAlike(ours[key], theirs[key], tolerance, `${where}.${key}`);
+  } else {
+    assert.equal(ours, theirs, where);
+  }
+}
+
+test("the clips the package writes are the CLI's: rumble and Android's byte for byte, .ahap, .haptic and .haps to an f64's last bits", async () => {
+  const folder = workFolder("clip-files");
+  const files = {
+    ahap: "c.ahap",
+    haptic: "c.haptic",
+    rumble: "c.rumble.json",
+    "android-waveform": "c.android.json",
+    "android-xml": "c.xml",
+    haps: "c.haps",
+  };
+  assert.deepEqual(clipFormats(), Object.keys(files));
+  cli(["render", ...Object.entries(files).flatMap(([format, file]) => ["-o", `${format}:${file}`])], folder);
+  const { samples, units, sampleRate } = await render({ sampleRate: 48000 });
+  const durationS = samples.length / sampleRate;
+  for (const [format, file] of Object.entries(files)) {
+    const ours = clip(format, units, { durationS, name: "default", seed: 1 });
+    const theirs = readFileSync(join(folder, file), "utf8");
+    if (["rumble", "android-waveform", "android-xml"].includes(format)) {
+      assert.equal(ours, theirs, `${format}: the CLI's bytes`);
+    } else {
+      // A unit's heard amplitude is G·a here, the CLI multiplies c·a by G: the last bits differ.
+      assertAlike(JSON.parse(ours), JSON.parse(theirs), 1e-14, format);
+    }
+  }
+  assert.throws(() => clip("wav", units, { durationS }), /no clip format `wav`: the page writes ahap, haptic/);
+  assert.throws(() => clip("ahap", units, { durationS: NaN }), /a clip lasts a finite number of seconds/);
 });

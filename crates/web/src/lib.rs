@@ -194,6 +194,35 @@ pub fn tilt_from_gravity(x: f64, y: f64, z: f64, axis: &str) -> Result<Option<f6
     live::tilt_of([x, y, z], axis).map_err(js)
 }
 
+/// A haptic clip's text written by the renderer's own writer: `format` one of `clipFormats()`,
+/// `units` a Float64Array of `clipUnitFields()` numbers a unit (a render's units), the clip
+/// `durationS` long, `name` and `seed` in its description.
+#[wasm_bindgen]
+pub fn clip(
+    format: &str,
+    units: &[f64],
+    duration_s: f64,
+    name: &str,
+    seed: f64,
+) -> Result<String, JsError> {
+    live::clip(format, units, duration_s, name, seed).map_err(js)
+}
+
+/// The clip formats `clip` writes.
+#[wasm_bindgen(js_name = clipFormats)]
+pub fn clip_formats() -> Vec<String> {
+    live::CLIP_FORMATS.iter().map(|&f| f.to_owned()).collect()
+}
+
+/// The numbers of a unit that `clip` reads, in order.
+#[wasm_bindgen(js_name = clipUnitFields)]
+pub fn clip_unit_fields() -> Vec<String> {
+    live::CLIP_UNIT_FIELDS
+        .iter()
+        .map(|&f| f.to_owned())
+        .collect()
+}
+
 /// The version of the engine inside (the release's).
 #[wasm_bindgen]
 pub fn version() -> String {

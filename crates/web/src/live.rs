@@ -338,3 +338,97 @@ pub fn tilt_of(reading: [f64; 3], axis: &str) -> Result<Option<f64>, LiveError> 
         .map_err(|error| LiveError(format!("{error}")))?;
     Ok(tilt_from_gravity(reading, axis))
 }
+
+/// The numbers of one unit that [`clip`] reads, in this order: its onset (s from the start of the
+/// clip), its amplitude as heard (G·a), c, f1, f2, B1 and B2.
+pub const CLIP_UNIT_FIELDS: [&str; 7] = [
+    "timeS",
+    "amplitude",
+    "viscosityC",
+    "f1Hz",
+    "f2Hz",
+    "b1PerS",
+    "b2PerS",
+];
+
+/// The clip formats [`clip`] writes, each by the renderer's own writer.
+pub const CLIP_FORMATS: [&str; 6] = [
+    "ahap",
+    "haptic",
+    "rumble",
+    "android-waveform",
+    "android-xml",
+    "haps",
+];
+
+/// A haptic clip of `duration_s` seconds written by the renderer from `units` ([`CLIP_UNIT_FIELDS`]
+/// numbers each, as a render's units give them): its `format`'s text (one of [`CLIP_FORMATS`];
+/// `.haptic` with the default band, rumble at its default rate), at the output ceiling 1, without
+/// an actuator's compensation; `name` and `seed` go into the clip's description. The renderer
+/// computes each unit's amplitudes from its onset's and its gain's; these are the heard ones, so
+/// a number may differ from the CLI's in its last bits.
+pub fn clip(
+    format: &str,
+    units: &[f64],
+    duration_s: f64,
+    name: &str,
+    seed: f64,
+) -> Result<String, LiveError> {
+    use sake_glug_render::clips::{ClipSource, Glug, HapticBand};
+    use sake_glug_render::sinks;
+    if !units.len().is_multiple_of(CLIP_UNIT_FIELDS.len()) {
+        return refuse(format!(
+            "a clip's units are {} numbers each ({}), not {} numbers",
+            CLIP_UNIT_FIELDS.len(),
+            CLIP_UNIT_FIELDS.join(", "),
+            units.len()
+        ));
+    }
+    if units.iter().any(|x| !x.is_finite()) {
+        return refuse("a clip's units hold a number that is not finite".to_owned());
+    }
+    if !(duration_s.is_finite() && duration_s >= 0.0) {
+        return refuse(format!(
+            "a clip lasts a finite number of seconds from 0, not {duration_s}"
+        ));
+    }
+    let seed = checked_whole("the seed", seed)?;
+    let glugs: Vec<Glug> = units
+        .chunks_exact(CLIP_UNIT_FIELDS.len())
+        .map(|unit| {
+            let &[onset_s, amplitude, c, f1, f2, b1, b2] = unit else {
+                unreachable!("chunks of the fields' length")
+            };
+            Glug {
+                onset_s,
+                amplitudes: [c * amplitude, (1.0 - c) * amplitude],
+                frequency_hz: [f1, f2],
+                decay_per_s: [b1, b2],
+                viscosity: c,
+                actuator_gain: [1.0, 1.0],
+            }
+        })
+        .collect();
+    let source = ClipSource {
+        duration_s,
+        glugs: &glugs,
+        ceiling: 1.0,
+        scene_name: name,
+        seed,
+    };
+    Ok(match format {
+        "ahap" => sinks::ahap_json(&source),
+        "haptic" => sinks::haptic_json(&source, &HapticBand::default()),
+        "rumble" => sinks::rumble_json(&source, sinks::DEFAULT_RUMBLE_RATE_HZ),
+        "android-waveform" => sinks::android_waveform_json(&source),
+        "android-xml" => sinks::android_xml(&source),
+        "haps" => sinks::haps_json(&source),
+        _ => {
+            return refuse(format!(
+                "no clip format `{}`: the page writes {}",
+                format.escape_debug(),
+                CLIP_FORMATS.join(", ")
+            ))
+        }
+    })
+}
