@@ -239,12 +239,14 @@ async function phoneTilt() {
       return;
     }
   }
+  $("tilt-source").textContent = "Waiting for the phone's orientation (none comes on a computer)…";
   window.addEventListener("deviceorientation", (event) => {
     if (event.beta === null || event.gamma === null) return;
     const tilt = tiltFromOrientation(event.beta, event.gamma);
-    if (tilt !== null) setControl("tilt", Math.round(tilt * 100) / 100);
+    if (tilt === null) return;
+    $("tilt-source").textContent = "Tilt follows the phone: hold it upright, then pour it over its top edge.";
+    setControl("tilt", Math.round(tilt * 100) / 100);
   });
-  $("tilt-source").textContent = "Tilt follows the phone: hold it upright, then pour it over its top edge.";
 }
 
 /** A file of `bytes` offered as a download by link `id`. */

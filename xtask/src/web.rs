@@ -281,16 +281,20 @@ pub fn test(tarball: &Path, cli: &Path) -> anyhow::Result<()> {
         .map(|name| format!("test/{name}"))
         .collect();
     suites.sort();
+    // The tests' folders (the empty folder the tarball installs into, the CLI's renders), made
+    // afresh each run.
+    let work = std::path::absolute(target_dir().join("web/work"))?;
+    if work.exists() {
+        std::fs::remove_dir_all(&work)?;
+    }
+    std::fs::create_dir_all(&work)?;
     let status = Command::new("node")
         .current_dir(WEB)
         .args(["--test", "--test-reporter=spec"])
         .args(&suites)
         .env("SAKE_GLUG_TARBALL", tarball)
         .env("SAKE_GLUG_CLI", std::path::absolute(cli)?)
-        .env(
-            "SAKE_GLUG_WORK",
-            std::path::absolute(target_dir().join("web"))?,
-        )
+        .env("SAKE_GLUG_WORK", &work)
         .status()
         .context("running node (Debian's `nodejs`; .ci/run installs it)")?;
     anyhow::ensure!(
