@@ -9,7 +9,8 @@
 //!
 //! The development half (the first clips and `dev/`) is what the fit was tuned on; the first
 //! held-out half (`held-out/`) was run once at e092597d and has been seen since; the second
-//! held-out set (`held-out-2/`) was gathered after, and run once at the end. docs/fit.md holds
+//! held-out set (`held-out-2/`) was gathered after, and run once at the end; the third
+//! (`held-out-3/`), gathered when the first two had been used, is not yet run. docs/fit.md holds
 //! their tables as these tests write them (`SAKE_GLUG_WRITE_FIT_TABLES=1`; `cargo xtask docs fit`
 //! writes the development one); each test holds the docs to what the fit gives.
 
@@ -67,6 +68,11 @@ fn held_out() -> Vec<PathBuf> {
 /// The second held-out set, gathered after the first was seen: run once, at the end.
 fn second_held_out() -> Vec<PathBuf> {
     clips_in(&recordings().join("held-out-2"))
+}
+
+/// The third held-out set, gathered when the first two had been used: run once, at the end.
+fn third_held_out() -> Vec<PathBuf> {
+    clips_in(&recordings().join("held-out-3"))
 }
 
 /// One clip, fitted and heard.
@@ -274,4 +280,14 @@ fn the_second_held_out_set_is_reported_and_sounds_nearer_than_the_default_bottle
     assert!(rows.len() >= 5, "{} held-out clips", rows.len());
     let missed = missed(&rows);
     assert!(missed.is_empty(), "{missed:#?}");
+}
+
+/// The third held-out set, to be run once when the fit is tuned on the development half and the
+/// development family: docs/fit.md then reports it as it came out, whatever it shows, and this
+/// test holds the report. Not yet run.
+#[test]
+#[ignore = "held out: run once, when the fit is done with the development half and family"]
+fn the_third_held_out_set_is_reported_as_fitted() {
+    let rows = heard_and_documented(&third_held_out(), "fit-held-out-3");
+    assert!(rows.len() >= 6, "{} held-out clips", rows.len());
 }

@@ -17,8 +17,8 @@ const RISE: f64 = 2.0;
 /// …to at least this share of the loudest frame (−30 dB: what stands out of a pour, not the
 /// small bubbles and the codec's noise between its glugs)…
 const ABOVE_LOUDEST: f64 = 1e-3;
-/// …and this many times the noise (12 dB, as the fit's onsets ask: the noise the quietest tenth
-/// of the frames that are not digital silence), a gate never set higher than
+/// …and this many times the noise (12 dB, as the fit's onsets ask; the noise here the quietest
+/// tenth of the frames that are not digital silence), a gate never set higher than
 /// [`NOISE_GATE_CAP`] of the loudest frame, so that a pour whose glugs never fall quiet keeps
 /// every glug…
 const ABOVE_NOISE: f64 = 16.0;

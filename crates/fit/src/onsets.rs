@@ -13,6 +13,8 @@ const RISE: f64 = 4.0;
 const ABOVE_NOISE: f64 = 16.0;
 /// …and at least this fraction of the loudest window's (−50 dB).
 const ABOVE_LOUDEST: f64 = 1e-5;
+/// The noise is the energy of the quietest windows: 1 in this many.
+const NOISE_QUANTILE: usize = 100;
 /// Two onsets are at least this far apart (s).
 const MIN_SEPARATION_S: f64 = 0.010;
 
@@ -26,12 +28,13 @@ pub fn detect_onsets(samples: &[f32], sample_rate: f64, low_hz: f64) -> Vec<usiz
     }
     let square = |n: usize| f64::from(samples[n]).powi(2);
     let sum = |from: usize, len: usize| (from..from + len).map(square).sum::<f64>();
-    // The noise: the quietest tenth of the windows; the loudest window.
+    // The noise: the quietest hundredth of the windows (a pour whose rings overlap is quiet only
+    // before its first glug); the loudest window.
     let mut windows: Vec<f64> = (0..samples.len() / after)
         .map(|i| sum(i * after, after) / after as f64)
         .collect();
     windows.sort_by(f64::total_cmp);
-    let noise = windows[windows.len() / 10];
+    let noise = windows[windows.len() / NOISE_QUANTILE];
     let loudest = windows[windows.len() - 1];
     let gate = (ABOVE_NOISE * noise).max(ABOVE_LOUDEST * loudest);
     // The noise also keeps the ratio finite and steady where both windows are quiet.
