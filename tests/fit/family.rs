@@ -38,8 +38,9 @@ use super::{add_noise, glug_rms, write_wav};
 /// The development set: tune the fit on these draws only. Its second half, 1001–1060, was the
 /// first held-out set, run once at e092597d (docs/fit.md at 480fbdd5) and seen since.
 pub const DEVELOPMENT_SEEDS: [Range<u64>; 2] = [1..61, 1001..1061];
-/// The held-out set: run once, at the end, and reported whatever it shows.
-pub const HELD_OUT_SEEDS: Range<u64> = 2001..2061;
+/// The held-out set: run once, at the end, and reported whatever it shows. Seeds 2001–2060, the
+/// set before it, were run once with a candidate fit kept off main (docs/fit.md) and are seen.
+pub const HELD_OUT_SEEDS: Range<u64> = 3001..3061;
 /// The goal: each constant within its tolerance in this share of the draws.
 const GOAL_SHARE: f64 = 0.9;
 
@@ -926,6 +927,26 @@ fn a_clip_too_short_for_any_unit_estimate_is_fitted_by_listening() {
 #[test]
 fn a_pour_whose_rings_overlap_is_heard() {
     assert_draws_pass(&[1030, 1048], &[0, 1, 2, 3, 4]);
+}
+
+/// Draws 1004, 1049 and 1057 of the development set: a cavity gliding down 1.5–1.8-fold into a
+/// pitch that falls as the bottle empties. Its pitch as heard comes within tolerance: the model's
+/// own f is the units' pitch as heard over the model's own glide factor (MODEL.md §13,
+/// Estimates), where it was the units' own f, which one unit's fit trades against its ρ and τ_g
+/// (before, with ρ also the median over every unit: f1 177, 108 and 183 Hz for 186, 101 and 212;
+/// with the units' own f alone put back, 108 and 183).
+#[test]
+fn a_gliding_cavity_is_heard_where_its_units_are() {
+    assert_draws_pass(&[1004, 1049, 1057], &[0]);
+}
+
+/// Draw 48 of the development set: a cavity gliding 1.41-fold, whose glide 18 of its 47 units
+/// fitted steady (a glide slower than its ring is not heard in one unit). Its ρ1 is the median
+/// over the units that glide (MODEL.md §13, Estimates), where it was the median over every unit
+/// with a steady one counted as 1, which gave 1.31.
+#[test]
+fn a_gliding_bottles_steady_units_do_not_flatten_its_glide() {
+    assert_draws_pass(&[48], &[8]);
 }
 
 /// Fits each development draw of `seeds` and fails with the rows of those that miss any of

@@ -11,7 +11,7 @@ use super::model_toml::model_toml;
 use super::pour::{fitted_intervals, pockets, rate_error};
 use super::recording::{FittedUnit, RecordingFit, LOW_EXPLAINED};
 use super::stats::{bootstrap, iqr, median, Line, NORMAL_IQR};
-use super::units::Modes;
+use super::units::{Modes, UnitGlide};
 use sake_glug_engine::curves::REFERENCE_TILT_DEG;
 use sake_glug_engine::{Constant, Control, Curve, Headspace};
 use sake_glug_model_file::FittedVolumes;
@@ -168,21 +168,98 @@ fn unit_counts(units: &[FittedUnit]) -> [usize; 18] {
     ]
 }
 
-/// Each mode's (C − V_i, f_i) of the units whose volume is known.
-fn pitch_points(units: &[FittedUnit], capacity_ml: f64) -> [Vec<(f64, f64)>; 2] {
+/// Each mode's (C − V_i, f_i) of the units whose volume is known, f_i as the model would have to
+/// ring to be heard where unit i is ([`own_hz`]).
+fn pitch_points(
+    units: &[FittedUnit],
+    capacity_ml: f64,
+    glides_heard: bool,
+) -> [Vec<(f64, f64)>; 2] {
+    let own = own_hz(units, glides_heard);
     [0, 1].map(|k| {
         units
             .iter()
             .filter(|u| u.volume_ml.is_finite() && u.fit.frequency_hz[k].is_finite())
-            .map(|u| (capacity_ml - u.volume_ml, u.fit.frequency_hz[k]))
+            .map(|u| (capacity_ml - u.volume_ml, own(u, k)))
             .collect()
     })
 }
 
+/// Unit k's mode as heard: its own f moved by its glide 1/(2B) after the onset, where its ring's
+/// energy is centred (MODEL.md §5.2).
+fn heard_hz(unit: &FittedUnit, k: usize) -> f64 {
+    let glide = unit.fit.glide[k];
+    let centre_s = 0.5 / unit.fit.decay_per_s[k];
+    unit.fit.frequency_hz[k] * glide.map_or(1.0, |g| g.factor(centre_s))
+}
+
+/// A unit's mode k as the model's own f. Where the model's mode glides, the pitch the unit is heard
+/// at, over the model's glide factor where its ring's energy is centred (MODEL.md §13): a glide's
+/// ρ, τ_g and f trade against each other in one unit's fit, while the pitch heard is what its
+/// samples fix, and the model, gliding by the units' median glide, is then heard where the units
+/// are. Where the model's mode is steady, the unit's own f: a glide a few units show is no
+/// bottle's, and a steady model is played at the f its units' fits end at. Where the units'
+/// glides are not the recordings' (`glides_heard` false: they explain under half of one), the
+/// units' own f too: the model is then fitted by listening, which hears the pitch itself, and the
+/// glides the units' fits traded for it would only move where that search starts.
+fn own_hz(units: &[FittedUnit], glides_heard: bool) -> impl Fn(&FittedUnit, usize) -> f64 {
+    let glide = glides(units);
+    let decay = model_decays(units);
+    let factor = [0, 1].map(|k| {
+        let (ratio, time_ms) = glide[k];
+        (glides_heard
+            && (ratio - 1.0).abs() >= GLIDE_HEARD
+            && time_ms.is_finite()
+            && decay[k].is_finite())
+        .then(|| {
+            UnitGlide {
+                ratio,
+                time_s: 1e-3 * time_ms,
+            }
+            .factor(0.5 / decay[k])
+        })
+    });
+    move |unit, k| match factor[k] {
+        Some(factor) => heard_hz(unit, k) / factor,
+        None => unit.fit.frequency_hz[k],
+    }
+}
+
+/// Each mode's B (1/s) as the model writes it: the median over the units. A mode rising into its
+/// pitch, fitted steady, decays up to three times as fast as it rings; where enough units fitted
+/// the mode gliding, its decay is theirs (MODEL.md §13).
+fn unit_decays(units: &[FittedUnit]) -> [Vec<f64>; 2] {
+    [0, 1].map(|k| {
+        let of = |swept_only: bool| -> Vec<f64> {
+            units
+                .iter()
+                .filter(|u| !swept_only || u.fit.swept[k])
+                .map(|u| u.fit.decay_per_s[k])
+                .filter(|v| v.is_finite())
+                .collect()
+        };
+        let swept = of(true);
+        if swept.len() >= MIN_SWEPT_UNITS {
+            swept
+        } else {
+            of(false)
+        }
+    })
+}
+
+fn model_decays(units: &[FittedUnit]) -> [f64; 2] {
+    unit_decays(units).map(|b| median(&b))
+}
+
 /// The headspace law of a liquid's units (MODEL.md §5.1, §13) in a bottle whose pocket is
 /// `pocket_ml`.
-fn headspace_law(units: &[FittedUnit], capacity_ml: f64, pocket_ml: f64) -> HeadspaceLaw {
-    let points = pitch_points(units, capacity_ml);
+fn headspace_law(
+    units: &[FittedUnit],
+    capacity_ml: f64,
+    pocket_ml: f64,
+    glides_heard: bool,
+) -> HeadspaceLaw {
+    let points = pitch_points(units, capacity_ml, glides_heard);
     fit_law([&points[0], &points[1]], pocket_ml)
 }
 
@@ -198,7 +275,12 @@ fn model_pocket_ml(recordings: &[&RecordingFit]) -> f64 {
 }
 
 /// The unit-based estimates of a liquid, in [`unit_keys`] order (NaN where unknown).
-fn unit_estimates(units: &[FittedUnit], capacity_ml: f64, pocket_ml: f64) -> Vec<f64> {
+fn unit_estimates(
+    units: &[FittedUnit],
+    capacity_ml: f64,
+    pocket_ml: f64,
+    glides_heard: bool,
+) -> Vec<f64> {
     let of = |get: &dyn Fn(&FittedUnit) -> f64| {
         units
             .iter()
@@ -206,7 +288,8 @@ fn unit_estimates(units: &[FittedUnit], capacity_ml: f64, pocket_ml: f64) -> Vec
             .filter(|v| v.is_finite())
             .collect::<Vec<_>>()
     };
-    let points = pitch_points(units, capacity_ml);
+    let points = pitch_points(units, capacity_ml, glides_heard);
+    let own = own_hz(units, glides_heard);
     let law = fit_law([&points[0], &points[1]], pocket_ml);
     // Where a mode follows the headspace, its spread is the scatter around the law (as the
     // engine reads it), over the units whose volume places them on it.
@@ -220,30 +303,15 @@ fn unit_estimates(units: &[FittedUnit], capacity_ml: f64, pocket_ml: f64) -> Vec
                 })
                 .collect()
         } else {
-            of(&|u| u.fit.frequency_hz[k])
+            of(&|u| own(u, k))
         }
     });
     let quoted_hz = [0, 1].map(|k| match law.modes[k] {
         Some(mode) if mode.follows() => mode.full_hz,
-        _ => median(&of(&|u| u.fit.frequency_hz[k])),
+        _ => median(&of(&|u| own(u, k))),
     });
     let exponent = law.modes.map(|mode| mode.map_or(f64::NAN, |m| m.exponent));
-    // A mode rising into its pitch, fitted steady, decays up to three times as fast as it rings;
-    // where enough units fitted the mode gliding, its decay is theirs (MODEL.md §13).
-    let b = [0, 1].map(|k| {
-        let swept = of(&|u| {
-            if u.fit.swept[k] {
-                u.fit.decay_per_s[k]
-            } else {
-                f64::NAN
-            }
-        });
-        if swept.len() >= MIN_SWEPT_UNITS {
-            swept
-        } else {
-            of(&|u| u.fit.decay_per_s[k])
-        }
-    });
+    let b = unit_decays(units);
     // A spread over the modes with enough units to show one.
     let mean_over_modes = |values: &[Vec<f64>; 2], spread: &dyn Fn(&[f64]) -> f64| {
         let spreads: Vec<f64> = values
@@ -302,20 +370,29 @@ fn unit_estimates(units: &[FittedUnit], capacity_ml: f64, pocket_ml: f64) -> Vec
     ]
 }
 
-/// Each mode's glide (MODEL.md §5.2, §13): ρ the median over the units ringing it (1 for a unit
-/// whose component does not glide, so that a glide a few units show is no bottle's), τ_g (ms) the
-/// median over those that glide.
+/// Each mode's glide (MODEL.md §5.2, §13): ρ and τ_g the medians over the units whose component
+/// in the mode glides, where those are at least half of the units ringing it; else no glide
+/// (ρ = 1), as a glide a few units show is no bottle's. A unit whose glide is slower than its ring is fitted
+/// steady, so a gliding bottle's units that glide are its ρ; counted as 1 they pulled its ρ
+/// towards 1 (a development draw's 1.41 to 1.31, with 18 of its 47 units steady).
 fn glides(units: &[FittedUnit]) -> [(f64, f64); 2] {
     [0, 1].map(|k| {
-        let ringing = units.iter().filter(|u| u.fit.frequency_hz[k].is_finite());
-        let ratios: Vec<f64> = ringing
-            .clone()
-            .map(|u| u.fit.glide[k].map_or(1.0, |g| g.ratio))
+        let ringing = units
+            .iter()
+            .filter(|u| u.fit.frequency_hz[k].is_finite())
+            .count();
+        let gliding: Vec<UnitGlide> = units
+            .iter()
+            .filter(|u| u.fit.frequency_hz[k].is_finite())
+            .filter_map(|u| u.fit.glide[k])
             .collect();
-        let times_ms: Vec<f64> = ringing
-            .filter_map(|u| u.fit.glide[k].map(|g| 1e3 * g.time_s))
-            .collect();
-        (median(&ratios), median(&times_ms))
+        let times_ms: Vec<f64> = gliding.iter().map(|g| 1e3 * g.time_s).collect();
+        if 2 * gliding.len() >= ringing && !gliding.is_empty() {
+            let ratios: Vec<f64> = gliding.iter().map(|g| g.ratio).collect();
+            (median(&ratios), median(&times_ms))
+        } else {
+            (1.0, median(&times_ms))
+        }
     })
 }
 
@@ -402,9 +479,12 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
         .collect();
     let detected = recordings.iter().map(|r| r.detected.len()).sum();
     let pocket_ml = model_pocket_ml(recordings);
-    let values = unit_estimates(&units, capacity_ml, pocket_ml);
+    // The units' glides are the recordings' where the units explain at least half of each (as
+    // where the listening fit keeps their model).
+    let glides_heard = recordings.iter().all(|r| r.explained >= LOW_EXPLAINED);
+    let values = unit_estimates(&units, capacity_ml, pocket_ml, glides_heard);
     let intervals = bootstrap(&units, |sample| {
-        unit_estimates(sample, capacity_ml, pocket_ml)
+        unit_estimates(sample, capacity_ml, pocket_ml, glides_heard)
     });
     let mut estimates: Vec<Estimate> = unit_keys()
         .into_iter()
@@ -434,7 +514,7 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
     check_glides(&mut estimates);
     check_headspace(
         &mut estimates,
-        &headspace_law(&units, capacity_ml, pocket_ml),
+        &headspace_law(&units, capacity_ml, pocket_ml, glides_heard),
     );
     estimates.extend(timing_estimates(inputs));
     estimates.push(Estimate::measured(
