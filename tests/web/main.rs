@@ -6,34 +6,15 @@
 
 #[path = "../capi/allocations.rs"]
 mod allocations;
+#[path = "../support/mod.rs"]
+mod support;
 
-use sake_glug_engine::{Control, UnitOnset, Voicing};
-use sake_glug_render::{render_scene, RenderError, Scene};
+use sake_glug_engine::Control;
+use sake_glug_render::Scene;
 use sake_glug_web::{LiveGlug, MAX_BLOCK_FRAMES, UNIT_FIELDS};
 
 use allocations::counted;
-
-/// A scene rendered offline: its samples and its units.
-fn offline(scene: &Scene) -> (Vec<f32>, Vec<(UnitOnset, Voicing)>) {
-    struct Units(Vec<(UnitOnset, Voicing)>);
-    impl sake_glug_render::RenderObserver for Units {
-        fn unit_started(&mut self, onset: &UnitOnset, voicing: Voicing) {
-            self.0.push((*onset, voicing));
-        }
-    }
-    let mut samples = Vec::new();
-    let mut units = Units(Vec::new());
-    render_scene(
-        scene,
-        |block: &[f32]| {
-            samples.extend_from_slice(block);
-            Ok::<(), RenderError>(())
-        },
-        &mut units,
-    )
-    .unwrap();
-    (samples, units.0)
-}
+use support::offline;
 
 fn control(param_id: &str) -> u32 {
     Control::ALL
