@@ -6,9 +6,10 @@
 //!   (not committed),
 //!   then `npm pack` into <target dir>/web/.
 //! - [`test`]: web/test/ under Node.js's own test runner: the packed tarball installed into an
-//!   empty folder and rendering the CLI's samples, 128-frame blocks at 44.1 and 48 kHz, the
-//!   haptics against the CLI's clips, bad input; then the page and an OfflineAudioContext render
-//!   through the AudioWorklet in headless Chromium, driven by chromedriver.
+//!   empty folder and rendering the CLI's samples, its TypeScript types checked by the pinned
+//!   `tsc`, 128-frame blocks at 44.1 and 48 kHz, the haptics against the CLI's clips, bad input;
+//!   then the page and an OfflineAudioContext render through the AudioWorklet in headless
+//!   Chromium, driven by chromedriver.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -25,6 +26,11 @@ const WEB: &str = "web";
 const DIST: &str = "web/dist";
 /// The Rust target of the .wasm.
 const WASM_TARGET: &str = "wasm32-unknown-unknown";
+/// The oldest Node.js the package supports, its `engines` in web/package.json.
+const MIN_NODE: u32 = 20;
+/// The TypeScript check's files: the example, its tsconfig, and the npm manifest and lock that
+/// pin TypeScript.
+const TYPES: &str = "web/test/types";
 
 /// What building and testing the package needs that is missing here, each with how to get it
 /// (.ci/run gets them all): the Rust target, wasm-bindgen-cli of the lock's version, Node.js
@@ -52,10 +58,24 @@ pub fn missing_tools() -> Vec<String> {
     if let Err(error) = require_wasm_bindgen() {
         missing.push(format!("{error:#}"));
     }
-    for (tool, package) in [("node", "nodejs"), ("npm", "npm")] {
-        if Command::new(tool).arg("--version").output().is_err() {
-            missing.push(format!("{tool} (Debian's `{package}`)"));
+    match Command::new("node").arg("--version").output() {
+        Err(_) => missing.push("node (Debian's `nodejs`)".into()),
+        Ok(out) => {
+            // The package asks for Node.js 20 (web/package.json's engines) and is tested there
+            // alone: an older one would test what the guide does not claim.
+            let version = String::from_utf8_lossy(&out.stdout).trim().to_owned();
+            let major = version
+                .trim_start_matches('v')
+                .split('.')
+                .next()
+                .and_then(|major| major.parse::<u32>().ok());
+            if major.is_none_or(|major| major < MIN_NODE) {
+                missing.push(format!("Node.js {MIN_NODE} or newer, not {version}"));
+            }
         }
+    }
+    if Command::new("npm").arg("--version").output().is_err() {
+        missing.push("npm (Debian's `npm`)".into());
     }
     missing
 }
@@ -288,6 +308,7 @@ pub fn test(tarball: &Path, cli: &Path) -> anyhow::Result<()> {
         std::fs::remove_dir_all(&work)?;
     }
     std::fs::create_dir_all(&work)?;
+    let typescript = typescript()?;
     let status = Command::new("node")
         .current_dir(WEB)
         .args(["--test", "--test-reporter=spec"])
@@ -295,6 +316,7 @@ pub fn test(tarball: &Path, cli: &Path) -> anyhow::Result<()> {
         .env("SAKE_GLUG_TARBALL", tarball)
         .env("SAKE_GLUG_CLI", std::path::absolute(cli)?)
         .env("SAKE_GLUG_WORK", &work)
+        .env("SAKE_GLUG_TYPESCRIPT", typescript)
         .status()
         .context("running node (Debian's `nodejs`; .ci/run installs it)")?;
     anyhow::ensure!(
@@ -302,4 +324,33 @@ pub fn test(tarball: &Path, cli: &Path) -> anyhow::Result<()> {
         "the web package's tests failed ({status})"
     );
     Ok(())
+}
+
+/// The TypeScript that types.test.mjs checks the package's types with: the version
+/// web/test/types/package-lock.json pins (with its hash), installed by `npm ci` into
+/// <target dir>/web/typescript, again only when the lock changes. `--prefer-offline` takes it from
+/// npm's cache where it is, so a machine that has installed it once needs no registry. Returns
+/// the installed package's folder.
+fn typescript() -> anyhow::Result<PathBuf> {
+    let folder = std::path::absolute(target_dir().join("web/typescript"))?;
+    let installed = folder.join("node_modules/typescript");
+    let lock = std::fs::read(Path::new(TYPES).join("package-lock.json"))?;
+    let current = std::fs::read(folder.join("package-lock.json")).ok();
+    if current.as_deref() == Some(&lock[..]) && installed.join("bin/tsc").exists() {
+        return Ok(installed);
+    }
+    std::fs::create_dir_all(&folder)?;
+    for file in ["package.json", "package-lock.json"] {
+        std::fs::copy(Path::new(TYPES).join(file), folder.join(file))?;
+    }
+    let status = Command::new("npm")
+        .current_dir(&folder)
+        .args(["ci", "--prefer-offline", "--no-audit", "--no-fund"])
+        .status()
+        .context("running npm (Debian's `npm`; .ci/run installs it)")?;
+    anyhow::ensure!(
+        status.success(),
+        "installing TypeScript for the web package's type check failed ({status})"
+    );
+    Ok(installed)
 }
