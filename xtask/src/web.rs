@@ -10,6 +10,7 @@
 //!   `tsc`, 128-frame blocks at 44.1 and 48 kHz, the haptics against the CLI's clips, bad input;
 //!   then the page and an OfflineAudioContext render through the AudioWorklet in headless
 //!   Chromium, driven by chromedriver.
+//! - [`figures`]: the size and speed of docs/guide/web.md, measured (`cargo xtask docs web`).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -353,4 +354,124 @@ fn typescript() -> anyhow::Result<PathBuf> {
         "installing TypeScript for the web package's type check failed ({status})"
     );
     Ok(installed)
+}
+
+/// The guide's page on the package, whose block `web-figures` [`figures`] writes.
+pub const GUIDE: &str = "docs/guide/web.md";
+
+/// The package's size and speed for the guide, measured in one run on the package that
+/// [`build`] wrote: the .wasm and the JavaScript modules a page loads, raw and gzipped; a minute
+/// of continuous glugs rendered by the release CLI at `cli`, by the package in Node.js and in
+/// headless Chromium, and through its AudioWorklet there (web/test/support/speed.mjs times
+/// them). `Ok(None)`, with a line saying why, where Chromium is not installed.
+pub fn figures(cli: &Path) -> anyhow::Result<Option<String>> {
+    let dist = Path::new(DIST);
+    let wasm = std::fs::read(dist.join("sake_glug_web_bg.wasm"))?;
+    // Every JavaScript file of the package's API, glue, tables and worklet (not the demo's).
+    let mut scripts: Vec<PathBuf> = [dist.join("sake_glug_web.js"), dist.join("tables.js")].into();
+    for entry in std::fs::read_dir(Path::new(WEB).join("src"))? {
+        let path = entry?.path();
+        if path.extension().is_some_and(|extension| extension == "js") {
+            scripts.push(path);
+        }
+    }
+    let (mut script_bytes, mut script_gzipped) = (0, 0);
+    for script in &scripts {
+        let text = std::fs::read(script)?;
+        script_bytes += text.len();
+        script_gzipped += gzipped_len(&text)?;
+    }
+
+    let out = Command::new("node")
+        .current_dir(WEB)
+        .arg("test/support/speed.mjs")
+        .env("SAKE_GLUG_CLI", std::path::absolute(cli)?)
+        .env(
+            "SAKE_GLUG_WORK",
+            std::path::absolute(target_dir().join("web"))?,
+        )
+        .output()
+        .context("running node (Debian's `nodejs`)")?;
+    anyhow::ensure!(
+        out.status.success(),
+        "timing the web package failed ({}):\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let speed: Value = serde_json::from_slice(&out.stdout)?;
+    if let Some(missing) = speed["missing"].as_str() {
+        println!("{GUIDE}: web-figures kept: Chromium is needed to time the page ({missing})");
+        return Ok(None);
+    }
+    let number = |key: &str| speed[key].as_f64().context("speed.mjs left out a figure");
+    let seconds = number("seconds")?;
+    let times = |key: &str| -> anyhow::Result<f64> {
+        let ms = speed["ms"][key]
+            .as_f64()
+            .context("speed.mjs left out a time")?;
+        Ok(seconds / (ms / 1e3))
+    };
+    let worklet = times("worklet")?;
+    let load = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|text| text.split_whitespace().next().map(str::to_owned))
+        .unwrap_or_else(|| "unknown".into());
+    Ok(Some(format!(
+        "\nChromium {chromium}, Node.js {node}; the machine's load average {load} at the end.\n\n\
+         | the package's | bytes | gzipped |\n\
+         |---|---:|---:|\n\
+         | engine, `sake_glug_web_bg.wasm` | {wasm} | {wasm_gz} |\n\
+         | JavaScript: the API, the worklet, wasm-bindgen's glue, the tables ({files} files) | \
+         {script_bytes} | {script_gzipped} |\n\n\
+         A minute of continuous glugs ({capacity:.0} ml bottle, tilt {tilt}°, pour time {pour} s, \
+         {rate} Hz, {units} units),\nthe best of {runs} runs of each:\n\n\
+         | render | × real time |\n\
+         |---|---:|\n\
+         | `sake-glug render` natively: the whole process, its WAV file written | {cli:.0}× |\n\
+         | the package's `render` in Node.js, 4096-frame blocks | {node_speed:.0}× |\n\
+         | the package's `render` on the page's thread in Chromium, 4096-frame blocks | \
+         {page:.0}× |\n\
+         | `renderInContext`: the AudioWorklet in an OfflineAudioContext, 128-frame blocks | \
+         {worklet:.0}× |\n\n\
+         At the AudioWorklet's speed a live node takes about {share:.1} % of one core.\n",
+        chromium = speed["chromium"].as_str().unwrap_or("(version unknown)"),
+        node = speed["node"].as_str().unwrap_or("(version unknown)"),
+        wasm = thousands(wasm.len()),
+        wasm_gz = thousands(gzipped_len(&wasm)?),
+        files = scripts.len(),
+        script_bytes = thousands(script_bytes),
+        script_gzipped = thousands(script_gzipped),
+        capacity = number("capacityMl")?,
+        tilt = number("tiltDeg")?,
+        pour = number("pourTimeS")?,
+        rate = number("sampleRate")?,
+        units = number("units")?,
+        runs = number("runs")?,
+        cli = times("cli")?,
+        node_speed = times("node")?,
+        page = times("page")?,
+        share = 100.0 / worklet,
+    )))
+}
+
+/// The length of `bytes` gzipped at the best compression, as a server would send them
+/// pre-compressed.
+fn gzipped_len(bytes: &[u8]) -> anyhow::Result<usize> {
+    use std::io::Write;
+    let mut encoder = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+    encoder.write_all(bytes)?;
+    Ok(encoder.finish()?.len())
+}
+
+/// `n` with a comma between each three digits, as the guide writes byte counts.
+fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut text = String::new();
+    for (k, digit) in digits.chars().enumerate() {
+        if k > 0 && (digits.len() - k) % 3 == 0 {
+            text.push(',');
+        }
+        text.push(digit);
+    }
+    text
 }
