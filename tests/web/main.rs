@@ -164,8 +164,9 @@ fn bad_arguments_are_refused_with_a_message() {
 
     let mut live = LiveGlug::new(48_000.0, None, None).unwrap();
     let message = live.set(control("tilt"), f64::NAN).unwrap_err().0;
+    // Said to be no number, not merely out of range (which NaN also is).
     assert!(
-        message.contains("Tilt (tilt)") && message.contains("NaN"),
+        message.contains("Tilt (tilt)") && message.contains("NaN is not a finite number"),
         "{message}"
     );
     let message = live.set(control("visc"), 1.5).unwrap_err().0;
