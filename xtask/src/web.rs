@@ -382,14 +382,17 @@ pub fn figures(cli: &Path) -> anyhow::Result<Option<String>> {
         script_gzipped += gzipped_len(&text)?;
     }
 
+    // The renders' folder (a minute's WAV file), made afresh each run as the tests' is.
+    let work = std::path::absolute(target_dir().join("web/speed"))?;
+    if work.exists() {
+        std::fs::remove_dir_all(&work)?;
+    }
+    std::fs::create_dir_all(&work)?;
     let out = Command::new("node")
         .current_dir(WEB)
         .arg("test/support/speed.mjs")
         .env("SAKE_GLUG_CLI", std::path::absolute(cli)?)
-        .env(
-            "SAKE_GLUG_WORK",
-            std::path::absolute(target_dir().join("web"))?,
-        )
+        .env("SAKE_GLUG_WORK", &work)
         .output()
         .context("running node (Debian's `nodejs`)")?;
     anyhow::ensure!(
