@@ -8,6 +8,8 @@ mod bad_calls;
 mod header;
 mod realtime;
 mod same_samples;
+#[path = "../support/mod.rs"]
+mod support;
 
 use std::ffi::CString;
 

@@ -6,31 +6,10 @@
 use sake_glug::*;
 use sake_glug_engine::{Engine, UnitOnset, Voicing, PRESETS};
 use sake_glug_model_file::ModelFile;
-use sake_glug_render::{render_scene, RenderError, Scene, DEFAULT_SCENE};
+use sake_glug_render::{Scene, DEFAULT_SCENE};
 
 use super::{builtin_pour, Live};
-
-/// A scene rendered offline: its samples and its units as the renderer reports them.
-fn offline(scene: &Scene) -> (Vec<f32>, Vec<(UnitOnset, Voicing)>) {
-    struct Units(Vec<(UnitOnset, Voicing)>);
-    impl sake_glug_render::RenderObserver for Units {
-        fn unit_started(&mut self, onset: &UnitOnset, voicing: Voicing) {
-            self.0.push((*onset, voicing));
-        }
-    }
-    let mut samples = Vec::new();
-    let mut units = Units(Vec::new());
-    render_scene(
-        scene,
-        |block: &[f32]| {
-            samples.extend_from_slice(block);
-            Ok::<(), RenderError>(())
-        },
-        &mut units,
-    )
-    .unwrap();
-    (samples, units.0)
-}
+use crate::support::offline;
 
 fn assert_same_samples(live: &[f32], offline: &[f32], what: &str) {
     assert_eq!(live.len(), offline.len(), "{what}: length");

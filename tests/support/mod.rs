@@ -5,9 +5,9 @@ pub mod fuzz;
 
 use sake_glug_engine::synthesis::reference;
 use sake_glug_engine::{
-    AnchoredF32, ControlSource, ControlValues, Engine, ModelConfig, Pour, UnitOnset,
+    AnchoredF32, ControlSource, ControlValues, Engine, ModelConfig, Pour, UnitOnset, Voicing,
 };
-use sake_glug_render::{LaneBuffers, Scene};
+use sake_glug_render::{render_scene, LaneBuffers, RenderError, RenderObserver, Scene};
 use sake_glug_reports::accuracy;
 use sake_glug_reports::timing::{self, RenderSpec};
 
@@ -28,6 +28,29 @@ pub fn render_in_blocks(scene: &Scene, len: usize, block_sizes: &[usize]) -> Vec
         done += size;
     }
     out
+}
+
+/// A scene rendered as `sake-glug render` renders it: its samples and its units as the renderer
+/// reports them, which the C library's and the web binding's live handles must give bit for bit.
+pub fn offline(scene: &Scene) -> (Vec<f32>, Vec<(UnitOnset, Voicing)>) {
+    struct Units(Vec<(UnitOnset, Voicing)>);
+    impl RenderObserver for Units {
+        fn unit_started(&mut self, onset: &UnitOnset, voicing: Voicing) {
+            self.0.push((*onset, voicing));
+        }
+    }
+    let mut samples = Vec::new();
+    let mut units = Units(Vec::new());
+    render_scene(
+        scene,
+        |block: &[f32]| {
+            samples.extend_from_slice(block);
+            Ok::<(), RenderError>(())
+        },
+        &mut units,
+    )
+    .unwrap();
+    (samples, units.0)
 }
 
 /// The f64 reference of the same scene.

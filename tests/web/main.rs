@@ -6,34 +6,15 @@
 
 #[path = "../capi/allocations.rs"]
 mod allocations;
+#[path = "../support/mod.rs"]
+mod support;
 
-use sake_glug_engine::{Control, UnitOnset, Voicing};
-use sake_glug_render::{render_scene, RenderError, Scene};
+use sake_glug_engine::Control;
+use sake_glug_render::Scene;
 use sake_glug_web::{LiveGlug, MAX_BLOCK_FRAMES, UNIT_FIELDS};
 
 use allocations::counted;
-
-/// A scene rendered offline: its samples and its units.
-fn offline(scene: &Scene) -> (Vec<f32>, Vec<(UnitOnset, Voicing)>) {
-    struct Units(Vec<(UnitOnset, Voicing)>);
-    impl sake_glug_render::RenderObserver for Units {
-        fn unit_started(&mut self, onset: &UnitOnset, voicing: Voicing) {
-            self.0.push((*onset, voicing));
-        }
-    }
-    let mut samples = Vec::new();
-    let mut units = Units(Vec::new());
-    render_scene(
-        scene,
-        |block: &[f32]| {
-            samples.extend_from_slice(block);
-            Ok::<(), RenderError>(())
-        },
-        &mut units,
-    )
-    .unwrap();
-    (samples, units.0)
-}
+use support::offline;
 
 fn control(param_id: &str) -> u32 {
     Control::ALL
@@ -183,8 +164,9 @@ fn bad_arguments_are_refused_with_a_message() {
 
     let mut live = LiveGlug::new(48_000.0, None, None).unwrap();
     let message = live.set(control("tilt"), f64::NAN).unwrap_err().0;
+    // Said to be no number, not merely out of range (which NaN also is).
     assert!(
-        message.contains("Tilt (tilt)") && message.contains("NaN"),
+        message.contains("Tilt (tilt)") && message.contains("NaN is not a finite number"),
         "{message}"
     );
     let message = live.set(control("visc"), 1.5).unwrap_err().0;

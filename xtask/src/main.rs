@@ -13,12 +13,15 @@
 //! - `cargo xtask docs [--bench]`: regenerates every table and picture of docs/ from the current
 //!   code (the accuracy table and plot, the stability report, the pour plot, the presets as
 //!   scene files and VST3 preset files, a VST3 ramp measured in Ardour when it is installed, the
-//!   standalone app's live latency under a JACK server when one can run, the paper's numbers),
+//!   standalone app's live latency under a JACK server when one can run, the paper's numbers,
+//!   the web package's size and speed),
 //!   stamped with the commit and the machine, and the cost
 //!   figures of docs/scaling.md (callgrind, when valgrind is installed; the render benchmark's
 //!   last report, or a new one with `--bench`).
 //! - `cargo xtask docs paper`: only docs/paper.md, the paper's numbers beside the product's
 //!   (which `cargo xtask docs` also writes).
+//! - `cargo xtask docs web`: only the web package's size and speed in docs/guide/web.md (which
+//!   `cargo xtask docs` also writes where the package's tools and Chromium are installed).
 //! - `cargo xtask latency`: only the live-latency figures of `cargo xtask docs`
 //!   (docs/latency.md).
 //! - `cargo xtask screenshots`: the editor in a real window (the standalone app under Xvfb), idle
@@ -194,6 +197,13 @@ fn xtask() -> nice_plug_xtask::Result<()> {
         {
             nice_plug_xtask::chdir_workspace_root()?;
             fit_docs(&args[1])
+        }
+        // The web package's size and speed alone (docs/guide/web.md): the package built, and a
+        // minute of glugs timed in Node.js and Chromium, in seconds.
+        Some("docs") if args.get(1).is_some_and(|arg| arg == "web") => {
+            nice_plug_xtask::chdir_workspace_root()?;
+            build_cli()?;
+            web_figures()
         }
         // The cost figures alone (callgrind, and the benchmark's report with --bench): seconds,
         // where the whole of `docs` renders for minutes.
@@ -479,7 +489,32 @@ fn docs() -> nice_plug_xtask::Result<()> {
     )?;
     paper::paper()?;
     vst3_ramp_figures()?;
-    live_latency()
+    live_latency()?;
+    web_figures()
+}
+
+/// docs/guide/web.md's size and speed of the web package, built afresh (web.rs, `figures`);
+/// kept, with a line saying so, where its tools are missing.
+fn web_figures() -> nice_plug_xtask::Result<()> {
+    let missing = web::missing_tools();
+    if !missing.is_empty() {
+        println!(
+            "{}: web-figures kept: the web package needs {}",
+            web::GUIDE,
+            missing.join("; ")
+        );
+        return Ok(());
+    }
+    web::build()?;
+    let started = std::time::Instant::now();
+    match web::figures(Path::new(&cli()))? {
+        Some(figures) => replace_block(
+            web::GUIDE,
+            "web-figures",
+            &format!("{}{figures}", stamp(started.elapsed())),
+        ),
+        None => Ok(()),
+    }
 }
 
 /// docs/latency.md's figures: the standalone app under a JACK server with 64-frame periods,

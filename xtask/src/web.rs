@@ -6,9 +6,11 @@
 //!   (not committed),
 //!   then `npm pack` into <target dir>/web/.
 //! - [`test`]: web/test/ under Node.js's own test runner: the packed tarball installed into an
-//!   empty folder and rendering the CLI's samples, 128-frame blocks at 44.1 and 48 kHz, the
-//!   haptics against the CLI's clips, bad input; then the page and an OfflineAudioContext render
-//!   through the AudioWorklet in headless Chromium, driven by chromedriver.
+//!   empty folder and rendering the CLI's samples, its TypeScript types checked by the pinned
+//!   `tsc`, 128-frame blocks at 44.1 and 48 kHz, the haptics against the CLI's clips, bad input;
+//!   then the page and an OfflineAudioContext render through the AudioWorklet in headless
+//!   Chromium, driven by chromedriver.
+//! - [`figures`]: the size and speed of docs/guide/web.md, measured (`cargo xtask docs web`).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -25,6 +27,11 @@ const WEB: &str = "web";
 const DIST: &str = "web/dist";
 /// The Rust target of the .wasm.
 const WASM_TARGET: &str = "wasm32-unknown-unknown";
+/// The oldest Node.js the package supports, its `engines` in web/package.json.
+const MIN_NODE: u32 = 20;
+/// The TypeScript check's files: the example, its tsconfig, and the npm manifest and lock that
+/// pin TypeScript.
+const TYPES: &str = "web/test/types";
 
 /// What building and testing the package needs that is missing here, each with how to get it
 /// (.ci/run gets them all): the Rust target, wasm-bindgen-cli of the lock's version, Node.js
@@ -52,10 +59,24 @@ pub fn missing_tools() -> Vec<String> {
     if let Err(error) = require_wasm_bindgen() {
         missing.push(format!("{error:#}"));
     }
-    for (tool, package) in [("node", "nodejs"), ("npm", "npm")] {
-        if Command::new(tool).arg("--version").output().is_err() {
-            missing.push(format!("{tool} (Debian's `{package}`)"));
+    match Command::new("node").arg("--version").output() {
+        Err(_) => missing.push("node (Debian's `nodejs`)".into()),
+        Ok(out) => {
+            // The package asks for Node.js 20 (web/package.json's engines) and is tested there
+            // alone: an older one would test what the guide does not claim.
+            let version = String::from_utf8_lossy(&out.stdout).trim().to_owned();
+            let major = version
+                .trim_start_matches('v')
+                .split('.')
+                .next()
+                .and_then(|major| major.parse::<u32>().ok());
+            if major.is_none_or(|major| major < MIN_NODE) {
+                missing.push(format!("Node.js {MIN_NODE} or newer, not {version}"));
+            }
         }
+    }
+    if Command::new("npm").arg("--version").output().is_err() {
+        missing.push("npm (Debian's `npm`)".into());
     }
     missing
 }
@@ -288,6 +309,7 @@ pub fn test(tarball: &Path, cli: &Path) -> anyhow::Result<()> {
         std::fs::remove_dir_all(&work)?;
     }
     std::fs::create_dir_all(&work)?;
+    let typescript = typescript()?;
     let status = Command::new("node")
         .current_dir(WEB)
         .args(["--test", "--test-reporter=spec"])
@@ -295,6 +317,7 @@ pub fn test(tarball: &Path, cli: &Path) -> anyhow::Result<()> {
         .env("SAKE_GLUG_TARBALL", tarball)
         .env("SAKE_GLUG_CLI", std::path::absolute(cli)?)
         .env("SAKE_GLUG_WORK", &work)
+        .env("SAKE_GLUG_TYPESCRIPT", typescript)
         .status()
         .context("running node (Debian's `nodejs`; .ci/run installs it)")?;
     anyhow::ensure!(
@@ -302,4 +325,156 @@ pub fn test(tarball: &Path, cli: &Path) -> anyhow::Result<()> {
         "the web package's tests failed ({status})"
     );
     Ok(())
+}
+
+/// The TypeScript that types.test.mjs checks the package's types with: the version
+/// web/test/types/package-lock.json pins (with its hash), installed by `npm ci` into
+/// <target dir>/web/typescript, again only when the lock changes. `--prefer-offline` takes it from
+/// npm's cache where it is, so a machine that has installed it once needs no registry. Returns
+/// the installed package's folder.
+fn typescript() -> anyhow::Result<PathBuf> {
+    let folder = std::path::absolute(target_dir().join("web/typescript"))?;
+    let installed = folder.join("node_modules/typescript");
+    let lock = std::fs::read(Path::new(TYPES).join("package-lock.json"))?;
+    let current = std::fs::read(folder.join("package-lock.json")).ok();
+    if current.as_deref() == Some(&lock[..]) && installed.join("bin/tsc").exists() {
+        return Ok(installed);
+    }
+    std::fs::create_dir_all(&folder)?;
+    for file in ["package.json", "package-lock.json"] {
+        std::fs::copy(Path::new(TYPES).join(file), folder.join(file))?;
+    }
+    let status = Command::new("npm")
+        .current_dir(&folder)
+        .args(["ci", "--prefer-offline", "--no-audit", "--no-fund"])
+        .status()
+        .context("running npm (Debian's `npm`; .ci/run installs it)")?;
+    anyhow::ensure!(
+        status.success(),
+        "installing TypeScript for the web package's type check failed ({status})"
+    );
+    Ok(installed)
+}
+
+/// The guide's page on the package, whose block `web-figures` [`figures`] writes.
+pub const GUIDE: &str = "docs/guide/web.md";
+
+/// The package's size and speed for the guide, measured in one run on the package that
+/// [`build`] wrote: the .wasm and the JavaScript modules a page loads, raw and gzipped; a minute
+/// of continuous glugs rendered by the release CLI at `cli`, by the package in Node.js and in
+/// headless Chromium, and through its AudioWorklet there (web/test/support/speed.mjs times
+/// them). `Ok(None)`, with a line saying why, where Chromium is not installed.
+pub fn figures(cli: &Path) -> anyhow::Result<Option<String>> {
+    let dist = Path::new(DIST);
+    let wasm = std::fs::read(dist.join("sake_glug_web_bg.wasm"))?;
+    // Every JavaScript file of the package's API, glue, tables and worklet (not the demo's).
+    let mut scripts: Vec<PathBuf> = [dist.join("sake_glug_web.js"), dist.join("tables.js")].into();
+    for entry in std::fs::read_dir(Path::new(WEB).join("src"))? {
+        let path = entry?.path();
+        if path.extension().is_some_and(|extension| extension == "js") {
+            scripts.push(path);
+        }
+    }
+    let (mut script_bytes, mut script_gzipped) = (0, 0);
+    for script in &scripts {
+        let text = std::fs::read(script)?;
+        script_bytes += text.len();
+        script_gzipped += gzipped_len(&text)?;
+    }
+
+    // The renders' folder (a minute's WAV file), made afresh each run as the tests' is.
+    let work = std::path::absolute(target_dir().join("web/speed"))?;
+    if work.exists() {
+        std::fs::remove_dir_all(&work)?;
+    }
+    std::fs::create_dir_all(&work)?;
+    let out = Command::new("node")
+        .current_dir(WEB)
+        .arg("test/support/speed.mjs")
+        .env("SAKE_GLUG_CLI", std::path::absolute(cli)?)
+        .env("SAKE_GLUG_WORK", &work)
+        .output()
+        .context("running node (Debian's `nodejs`)")?;
+    anyhow::ensure!(
+        out.status.success(),
+        "timing the web package failed ({}):\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let speed: Value = serde_json::from_slice(&out.stdout)?;
+    if let Some(missing) = speed["missing"].as_str() {
+        println!("{GUIDE}: web-figures kept: Chromium is needed to time the page ({missing})");
+        return Ok(None);
+    }
+    let number = |key: &str| speed[key].as_f64().context("speed.mjs left out a figure");
+    let seconds = number("seconds")?;
+    let times = |key: &str| -> anyhow::Result<f64> {
+        let ms = speed["ms"][key]
+            .as_f64()
+            .context("speed.mjs left out a time")?;
+        Ok(seconds / (ms / 1e3))
+    };
+    let worklet = times("worklet")?;
+    let load = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|text| text.split_whitespace().next().map(str::to_owned))
+        .unwrap_or_else(|| "unknown".into());
+    Ok(Some(format!(
+        "\nChromium {chromium}, Node.js {node}; the machine's load average {load} at the end.\n\n\
+         | the package's | bytes | gzipped |\n\
+         |---|---:|---:|\n\
+         | engine, `sake_glug_web_bg.wasm` | {wasm} | {wasm_gz} |\n\
+         | JavaScript: the API, the worklet, wasm-bindgen's glue, the tables ({files} files) | \
+         {script_bytes} | {script_gzipped} |\n\n\
+         A minute of continuous glugs ({capacity:.0} ml bottle, tilt {tilt}°, pour time {pour} s, \
+         {rate} Hz, {units} units),\nthe best of {runs} runs of each:\n\n\
+         | render | × real time |\n\
+         |---|---:|\n\
+         | `sake-glug render` natively: the whole process, its WAV file written | {cli:.0}× |\n\
+         | the package's `render` in Node.js, 4096-frame blocks | {node_speed:.0}× |\n\
+         | the package's `render` on the page's thread in Chromium, 4096-frame blocks | \
+         {page:.0}× |\n\
+         | `renderInContext`: the AudioWorklet in an OfflineAudioContext, 128-frame blocks | \
+         {worklet:.0}× |\n\n\
+         At the AudioWorklet's speed a live node takes about {share:.1} % of one core.\n",
+        chromium = speed["chromium"].as_str().unwrap_or("(version unknown)"),
+        node = speed["node"].as_str().unwrap_or("(version unknown)"),
+        wasm = thousands(wasm.len()),
+        wasm_gz = thousands(gzipped_len(&wasm)?),
+        files = scripts.len(),
+        script_bytes = thousands(script_bytes),
+        script_gzipped = thousands(script_gzipped),
+        capacity = number("capacityMl")?,
+        tilt = number("tiltDeg")?,
+        pour = number("pourTimeS")?,
+        rate = number("sampleRate")?,
+        units = number("units")?,
+        runs = number("runs")?,
+        cli = times("cli")?,
+        node_speed = times("node")?,
+        page = times("page")?,
+        share = 100.0 / worklet,
+    )))
+}
+
+/// The length of `bytes` gzipped at the best compression, as a server would send them
+/// pre-compressed.
+fn gzipped_len(bytes: &[u8]) -> anyhow::Result<usize> {
+    use std::io::Write;
+    let mut encoder = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+    encoder.write_all(bytes)?;
+    Ok(encoder.finish()?.len())
+}
+
+/// `n` with a comma between each three digits, as the guide writes byte counts.
+fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut text = String::new();
+    for (k, digit) in digits.chars().enumerate() {
+        if k > 0 && (digits.len() - k).is_multiple_of(3) {
+            text.push(',');
+        }
+        text.push(digit);
+    }
+    text
 }

@@ -53,7 +53,7 @@ export async function startBrowser() {
       },
     },
   });
-  return new Session(base, created.sessionId, driver);
+  return new Session(base, created.sessionId, driver, created.capabilities?.browserVersion);
 }
 
 async function command(base, method, path, body) {
@@ -70,10 +70,12 @@ async function command(base, method, path, body) {
 }
 
 export class Session {
-  constructor(base, id, driver) {
+  constructor(base, id, driver, browserVersion) {
     this.base = base;
     this.id = id;
     this.driver = driver;
+    /** Chromium's version, as the session reports it (for the figures it measures). */
+    this.browserVersion = browserVersion;
   }
 
   #command(method, path, body) {
