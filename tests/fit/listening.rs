@@ -298,12 +298,11 @@ fn the_third_held_out_set_is_reported_as_fitted() {
 }
 
 /// The fourth held-out set, run once when the fit was tuned: docs/fit.md reports it as it came
-/// out, whatever it shows, and this test holds the report; then the claim: every clip's
-/// model nearer than the default bottle, or the clip refused.
+/// out, and this test holds the report. It does not hold the claim, which the set did not
+/// show: five clips nearer than the default bottle, three refused, and one (the Tux Paint toilet)
+/// whose model is the default bottle itself, written where the fit should have refused.
 #[test]
-fn the_fourth_held_out_set_is_reported_and_sounds_nearer_than_the_default_bottle() {
+fn the_fourth_held_out_set_is_reported_as_fitted() {
     let rows = heard_and_documented(&fourth_held_out(), "fit-held-out-4");
     assert!(rows.len() >= 8, "{} held-out clips", rows.len());
-    let missed = missed(&rows);
-    assert!(missed.is_empty(), "{missed:#?}");
 }
