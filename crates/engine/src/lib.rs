@@ -553,11 +553,13 @@ impl<S: Synthesis> Engine<S> {
         }
         let step = advanced.last;
         self.last_outflow = step;
-        self.resting_under = if constant && step.amount_ml == 0.0 && !step.refilled {
-            Some(self.held_pour.raw)
-        } else {
-            None
-        };
+        // Branches, not one select: the usual step flows, and then only the tag is written
+        // (a select built the whole Option, the held inputs copied, at every step).
+        if constant && step.amount_ml == 0.0 && !step.refilled {
+            self.resting_under = Some(self.held_pour.raw);
+        } else if self.resting_under.is_some() {
+            self.resting_under = None;
+        }
     }
 
     /// The pour over a span in which units may start, under the held inputs if `constant`
