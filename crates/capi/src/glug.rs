@@ -82,6 +82,12 @@ struct Audio {
     /// changes it, not at every process call.
     held_lanes: Controls<'static>,
     ramps: PerControl<Option<Ramp>>,
+    /// Whether any of `ramps` is under way: kept as the ramps change, so that the usual call
+    /// checks one flag rather than each control's ramp.
+    ramping: bool,
+    /// θ of `held`, brought into range: the tilt of a call without a ramp, worked out when a
+    /// control call changes it, not at every call.
+    held_tilt_deg: f64,
     /// Storage for the ramps' lanes of one span.
     lanes: PerControl<Box<[f64]>>,
     /// One span of mono samples, for the interleaved call.
@@ -178,6 +184,8 @@ impl SakeGlug {
                 held,
                 held_lanes: Controls::constant(held),
                 ramps: PerControl::splat(None),
+                ramping: false,
+                held_tilt_deg: Control::Tilt.range().sanitize(held.tilt_deg),
                 lanes: PerControl::from_fn(|_| vec![0.0; SPAN].into_boxed_slice()),
                 mono: vec![0.0; SPAN].into_boxed_slice(),
                 units: vec![SakeGlugUnit::default(); SAKE_GLUG_MAX_UNITS].into_boxed_slice(),
@@ -242,6 +250,14 @@ impl SakeGlug {
         let audio = unsafe { self.audio() };
         audio.start_call(&self.commands, &self.actuator);
         let first = audio.engine.position();
+        // A call of at most a span (a game's or a host's small block) is one span, without the
+        // loop's set-up.
+        if out.len() <= SPAN {
+            if !out.is_empty() {
+                audio.render_span(out, first);
+            }
+            return;
+        }
         for span in out.chunks_mut(SPAN) {
             audio.render_span(span, first);
         }
@@ -327,6 +343,8 @@ impl Audio {
             self.apply(command);
         }
         self.held_lanes = Controls::constant(self.held);
+        self.held_tilt_deg = Control::Tilt.range().sanitize(self.held.tilt_deg);
+        self.ramping = self.ramps.iter().any(|(_, ramp)| ramp.is_some());
     }
 
     fn apply(&mut self, command: Command) {
@@ -382,6 +400,8 @@ impl Audio {
             held,
             held_lanes,
             ramps,
+            ramping,
+            held_tilt_deg,
             lanes,
             units,
             kept,
@@ -390,9 +410,9 @@ impl Audio {
             ..
         } = self;
         // No ramp under way (the usual call): every control is its held value.
-        let ramping = ramps.iter().any(|(_, ramp)| ramp.is_some());
+        let ramped = *ramping;
         let ramp_lanes: Controls;
-        let controls = if !ramping {
+        let controls = if !ramped {
             &*held_lanes
         } else {
             ramp_lanes = lanes.each_mut().into_map(|control, lane| {
@@ -411,6 +431,8 @@ impl Audio {
                     }
                 }
             });
+            // The ramps that ended here hold their targets from the next call on.
+            *ramping = ramps.iter().any(|(_, ramp)| ramp.is_some());
             &ramp_lanes
         };
         engine.process_observed(
@@ -424,7 +446,12 @@ impl Audio {
                 None => *lost = lost.saturating_add(1),
             },
         );
-        if let Some(last) = out.len().checked_sub(1) {
+        if out.is_empty() {
+            return;
+        }
+        if !ramped {
+            *last_tilt_deg = *held_tilt_deg;
+        } else if let Some(last) = out.len().checked_sub(1) {
             *last_tilt_deg = Control::Tilt.range().sanitize(controls.tilt_deg.at(last));
         }
     }

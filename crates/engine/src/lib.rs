@@ -81,35 +81,51 @@ pub struct Engine<S: Synthesis = AnchoredF32> {
 /// The inputs that drove the pour over the last span that held them constant: as given, and
 /// brought into range. A span under the very same constants (the usual one: a host's next block,
 /// nothing changed) takes them as they are, without reading and bringing each into range again.
-#[derive(Debug, Clone, Copy, Default)]
-struct HeldPour(Option<(ControlValues, ControlValues)>);
+/// They are read in place, not handed out: a copy of both sets each block cost more than the
+/// comparison.
+#[derive(Debug, Clone, Copy)]
+struct HeldPour {
+    /// Whether `raw` and `sanitized` hold a span's inputs yet.
+    held: bool,
+    raw: ControlValues,
+    sanitized: ControlValues,
+}
+
+impl Default for HeldPour {
+    fn default() -> Self {
+        Self {
+            held: false,
+            raw: ControlValues::splat(0.0),
+            sanitized: ControlValues::splat(0.0),
+        }
+    }
+}
 
 impl HeldPour {
-    /// The pour's inputs over the first `len` samples of `controls` if they hold the very same
-    /// values over them (as constants, or samples that do not change: a ramp's end inside the
-    /// block), as given and brought into range.
+    /// Whether the pour's inputs hold the very same values over the first `len` samples of
+    /// `controls` (as constants, or samples that do not change: a ramp's end inside the block);
+    /// if so, `raw` and `sanitized` are them, as given and brought into range.
     #[inline]
-    fn inputs(
-        &mut self,
-        controls: &Controls,
-        len: usize,
-    ) -> Option<(ControlValues, ControlValues)> {
-        if let Some(held) = self.0 {
-            let same = |control: Control| match controls[control] {
-                // Bit for bit: NaN is held as NaN, and −0 is not 0.
-                Lane::Constant(value) => value.to_bits() == held.0[control].to_bits(),
-                Lane::Samples(_) => false,
-            };
-            if Control::pour().all(same) {
-                return Some(held);
-            }
+    fn take(&mut self, controls: &Controls, len: usize) -> bool {
+        let same = |control: Control| match controls[control] {
+            // Bit for bit: NaN is held as NaN, and −0 is not 0.
+            Lane::Constant(value) => value.to_bits() == self.raw[control].to_bits(),
+            Lane::Samples(_) => false,
+        };
+        (self.held && Control::pour().all(same)) || self.take_new(controls, len)
+    }
+
+    /// [`HeldPour::take`] of inputs that are not those held: out of line, as the usual span
+    /// finds the same ones.
+    #[inline(never)]
+    fn take_new(&mut self, controls: &Controls, len: usize) -> bool {
+        if !controls.pour_is_constant_over(len) {
+            return false;
         }
-        let values = controls
-            .pour_is_constant_over(len)
-            .then(|| controls.values_at(0))?;
-        let held = (values, values.sanitized());
-        self.0 = Some(held);
-        Some(held)
+        self.raw = controls.values_at(0);
+        self.sanitized = self.raw.sanitized();
+        self.held = true;
+        true
     }
 }
 
@@ -325,22 +341,112 @@ impl<S: Synthesis> Engine<S> {
             self.sample = end;
             return;
         }
+        if controls.is_constant() {
+            self.process_constant(controls, out, on_unit);
+            return;
+        }
         let mut done = 0;
-        // Constant lanes need no slicing for each period.
-        let constant = controls.is_constant();
         while done < out.len() {
-            let period_end = (self.sample / GRID as u64 + 1) * GRID as u64;
-            let span = (out.len() - done).min((period_end - self.sample) as usize);
-            let sliced;
-            let span_controls = if constant {
-                controls
-            } else {
-                sliced = controls.offset(done);
-                &sliced
-            };
-            self.process_span(span_controls, &mut out[done..done + span], on_unit);
+            let span = self.span_at(out.len() - done);
+            let sliced = controls.offset(done);
+            self.process_span(&sliced, &mut out[done..done + span], on_unit);
             done += span;
         }
+    }
+
+    /// The samples from the position on that lie in its grid period, at most `left`.
+    #[inline]
+    fn span_at(&self, left: usize) -> usize {
+        let period_end = (self.sample / GRID as u64 + 1) * GRID as u64;
+        left.min((period_end - self.sample) as usize)
+    }
+
+    /// A block under constant controls (every lane a constant: a render's held scene, the C
+    /// library's calls without a ramp). What is the same for every span is done once for the
+    /// block: the pour's inputs and the output's targets taken, the ceiling worked out; a plain
+    /// run of the pour that covers several spans is taken at once, then only the synthesis goes
+    /// span by span; and at a settled gain and ceiling the output stage takes the whole block
+    /// in one pass. The same samples, units and state as span by span: V and g move in closed
+    /// form, exact for any cut of a run; the output stage works sample by sample; and no unit
+    /// starts inside a plain run, so the synthesis of a span never waits on the pour of a later
+    /// one.
+    fn process_constant(
+        &mut self,
+        controls: &Controls,
+        out: &mut [f32],
+        on_unit: &mut impl FnMut(&UnitOnset, Voicing),
+    ) {
+        let constant = self.held_pour.take(controls, out.len());
+        let ceiling = self.ceiling();
+        let settled = self
+            .output
+            .begin_constant_block(controls.gain_db.at(0), ceiling);
+        // The pour has been stepped up to this sample, which may be ahead of the synthesis.
+        let mut poured_to = self.sample;
+        let mut done = 0;
+        while done < out.len() {
+            let span = self.span_at(out.len() - done);
+            if poured_to == self.sample {
+                poured_to +=
+                    self.pour_ahead(controls, constant, out.len() - done, span, on_unit) as u64;
+            }
+            let out = &mut out[done..done + span];
+            if self.synthesis.is_empty() {
+                out.fill(0.0);
+                if !settled {
+                    self.output.pass_silence(&controls.gain_db, ceiling, span);
+                }
+            } else {
+                self.synthesis.synthesize(self.sample, out);
+                // The pour may have flowed further ahead already.
+                self.active_until = self.active_until.max(self.sample + span as u64);
+                if !settled {
+                    self.output.apply(&controls.gain_db, ceiling, out);
+                }
+            }
+            self.advance_position(span);
+            done += span;
+        }
+        if settled {
+            self.output.apply_settled(out);
+        }
+    }
+
+    /// Steps the pour from the position, under the block's `constant` inputs, over at
+    /// least the `span` that starts there; returns how many samples it was stepped, at most
+    /// `block_left`. A plain run that covers the span is taken as far as it goes within the
+    /// block, cut at the end of a grid period (the pour is then ahead of the synthesis only by
+    /// whole spans); otherwise the span alone, as [`Engine::step_pour`] takes it.
+    fn pour_ahead(
+        &mut self,
+        controls: &Controls,
+        constant: bool,
+        block_left: usize,
+        span: usize,
+        on_unit: &mut impl FnMut(&UnitOnset, Voicing),
+    ) -> usize {
+        if self.rests_under(controls) {
+            // Nothing changes the pour's rest within a block of constant controls.
+            return block_left;
+        }
+        let reach = self.pour.plain_samples_left().min(block_left as u64) as usize;
+        if constant && reach >= span {
+            let ahead = if reach == block_left {
+                reach
+            } else {
+                reach - ((self.sample + reach as u64) % GRID as u64) as usize
+            };
+            let sanitized = &self.held_pour.sanitized;
+            if let Some(advanced) = self
+                .pour
+                .advance_plain(self.sample, ahead as u64, sanitized)
+            {
+                self.poured(advanced, true);
+                return ahead;
+            }
+        }
+        self.step_pour_under(controls, constant, span, on_unit);
+        span
     }
 
     /// Tells `on_unit` of the units that started in the last sample of the last block, at the
@@ -404,36 +510,64 @@ impl<S: Synthesis> Engine<S> {
         if self.rests_under(controls) {
             return;
         }
-        let constant = self.held_pour.inputs(controls, len);
+        let constant = self.held_pour.take(controls, len);
+        self.step_pour_under(controls, constant, len, on_unit);
+    }
+
+    /// [`Engine::step_pour`] of a span, under the held inputs if `constant` (they hold over
+    /// it), when the pour does not rest.
+    fn step_pour_under(
+        &mut self,
+        controls: &Controls,
+        constant: bool,
+        len: usize,
+        on_unit: &mut impl FnMut(&UnitOnset, Voicing),
+    ) {
+        if len == 0 {
+            // As a step over no sample leaves it: no last step to rest after.
+            self.resting_under = None;
+            return;
+        }
         // Most spans of a pour lie inside a plain run, where no unit starts: those take no
         // callback (and build none).
-        let plain = constant.and_then(|(_, sanitized)| {
-            self.pour.advance_plain(self.sample, len as u64, &sanitized)
-        });
+        let plain = if constant {
+            let sanitized = &self.held_pour.sanitized;
+            self.pour.advance_plain(self.sample, len as u64, sanitized)
+        } else {
+            None
+        };
         let advanced = match plain {
             Some(advanced) => advanced,
             None => self.advance_pour(controls, constant, len, on_unit),
         };
+        self.poured(advanced, constant);
+    }
+
+    /// What a step of the pour over at least one sample leaves for the engine: until when
+    /// liquid flowed, the last sample's outflow, and whether the pour now rests under the held
+    /// inputs (if they were `constant` over the step).
+    #[inline]
+    fn poured(&mut self, advanced: pour::Advanced, constant: bool) {
         if let Some(until) = advanced.flowed_until {
             self.active_until = until;
         }
-        let last_step = (len > 0).then_some(advanced.last);
-        if let Some(step) = last_step {
-            self.last_outflow = step;
+        let step = advanced.last;
+        self.last_outflow = step;
+        // Branches, not one select: the usual step flows, and then only the tag is written
+        // (a select built the whole Option, the held inputs copied, at every step).
+        if constant && step.amount_ml == 0.0 && !step.refilled {
+            self.resting_under = Some(self.held_pour.raw);
+        } else if self.resting_under.is_some() {
+            self.resting_under = None;
         }
-        self.resting_under = match last_step {
-            Some(step) if step.amount_ml == 0.0 && !step.refilled => constant.map(|(raw, _)| raw),
-            _ => None,
-        };
     }
 
-    /// The pour over a span in which units may start, under `constant` inputs (as given, and
-    /// brought into range) if they hold over the span: each unit is started in the synthesis and
-    /// told of.
+    /// The pour over a span in which units may start, under the held inputs if `constant`
+    /// (they hold over the span): each unit is started in the synthesis and told of.
     fn advance_pour(
         &mut self,
         controls: &Controls,
-        constant: Option<(ControlValues, ControlValues)>,
+        constant: bool,
         len: usize,
         on_unit: &mut impl FnMut(&UnitOnset, Voicing),
     ) -> pour::Advanced {
@@ -446,6 +580,7 @@ impl<S: Synthesis> Engine<S> {
             block_end,
             deferred,
             actuator,
+            held_pour,
             ..
         } = self;
         let (span_start, block_end) = (*span_start, *block_end);
@@ -477,15 +612,19 @@ impl<S: Synthesis> Engine<S> {
                 *free = Some((*onset, voicing));
             }
         };
-        match constant {
+        if constant {
             // Under constant controls the pour takes the span at once (plain samples in closed
             // form, the same numbers as one step per sample).
-            Some((_, sanitized)) => {
-                pour.advance(span_start, len as u64, &sanitized, &mut start_unit)
-            }
+            pour.advance(
+                span_start,
+                len as u64,
+                &held_pour.sanitized,
+                &mut start_unit,
+            )
+        } else {
             // Otherwise the levels of the span are worked out at once, and the rest stepped
             // sample by sample (the same numbers as `Pour::step`).
-            None => pour.advance_varying(span_start, controls, len, &mut start_unit),
+            pour.advance_varying(span_start, controls, len, &mut start_unit)
         }
     }
 

@@ -193,6 +193,30 @@ impl OutputStage {
         }
     }
 
+    /// Takes a block's targets when they hold over the whole of it (a constant gain lane, the
+    /// ceiling of one block) and says whether gain and ceiling are then settled: if so, no
+    /// sample of the block moves them, and [`OutputStage::apply_settled`] may take the whole
+    /// block at once, after its synthesis, in place of [`OutputStage::apply`] and
+    /// [`OutputStage::pass_silence`] span by span (those would only take the same targets
+    /// again).
+    #[inline]
+    pub fn begin_constant_block(&mut self, gain_db: f64, ceiling: f64) -> bool {
+        self.begin(gain_db, ceiling);
+        self.gain.is_settled() && self.ceiling.is_settled()
+    }
+
+    /// [`OutputStage::apply`] at a settled gain and ceiling (see
+    /// [`OutputStage::begin_constant_block`]): sample by sample the same operations, so a block
+    /// at once gives the bits and counts of its spans one by one; a silent span (zeros) stays
+    /// zeros.
+    #[inline]
+    pub fn apply_settled(&mut self, out: &mut [f32]) {
+        let ceiling = self.ceiling.value as f32;
+        if gain_and_flush(out, self.gain.value, ceiling) {
+            self.limit(out, ceiling);
+        }
+    }
+
     /// Output gain, then the guarantees of MODEL.md §6: finite, within the ceiling, no denormal.
     /// Counts what the limiter did, so that a check can look past it.
     #[inline]

@@ -296,6 +296,14 @@ impl Pour {
         advanced
     }
 
+    /// Samples left in the plain run under way (0 if none): how far ahead
+    /// [`Pour::advance_plain`] may take the pour at once, if the controls it was planned for
+    /// still hold.
+    #[inline]
+    pub fn plain_samples_left(&self) -> u64 {
+        self.plain.map_or(0, |run| run.samples_left)
+    }
+
     /// [`Pour::advance`] of a span that lies wholly inside the plain run under way, under the
     /// controls it was planned for (the usual span while a bottle pours): no unit starts in it,
     /// so it takes no callback, and V and g move in closed form. `None` where [`Pour::advance`]
