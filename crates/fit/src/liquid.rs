@@ -247,6 +247,7 @@ fn unit_decays(units: &[FittedUnit]) -> [Vec<f64>; 2] {
     })
 }
 
+/// Each mode's B (1/s) as the model writes it ([`unit_decays`]' medians).
 fn model_decays(units: &[FittedUnit]) -> [f64; 2] {
     unit_decays(units).map(|b| median(&b))
 }
@@ -372,9 +373,9 @@ fn unit_estimates(
 
 /// Each mode's glide (MODEL.md §5.2, §13): ρ and τ_g the medians over the units whose component
 /// in the mode glides, where those are at least half of the units ringing it; else no glide
-/// (ρ = 1), as a glide a few units show is no bottle's. A unit whose glide is slower than its ring is fitted
-/// steady, so a gliding bottle's units that glide are its ρ; counted as 1 they pulled its ρ
-/// towards 1 (a development draw's 1.41 to 1.31, with 18 of its 47 units steady).
+/// (ρ = 1), as a glide a few units show is no bottle's. A unit whose glide is slower than its
+/// ring is fitted steady, so a gliding bottle's units that glide are its ρ; counted as 1 they
+/// pulled its ρ towards 1 (a development draw's 1.41 to 1.31, with 18 of its 47 units steady).
 fn glides(units: &[FittedUnit]) -> [(f64, f64); 2] {
     [0, 1].map(|k| {
         let ringing = units
