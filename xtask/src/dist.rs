@@ -658,6 +658,16 @@ pub fn copy_tree(from: &Path, to: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Empties `folder` (made if missing): a folder made afresh each run, so that nothing an earlier
+/// run left (a failed one's half tree) joins this one's.
+pub fn fresh_folder(folder: &Path) -> anyhow::Result<()> {
+    if folder.exists() {
+        std::fs::remove_dir_all(folder)
+            .with_context(|| format!("emptying {}", folder.display()))?;
+    }
+    std::fs::create_dir_all(folder).with_context(|| format!("making {}", folder.display()))
+}
+
 /// The files (and symbolic links) directly in `folder`, sorted.
 fn files_of(folder: &Path) -> anyhow::Result<Vec<PathBuf>> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(folder)?
@@ -699,7 +709,7 @@ pub fn run_checked(command: &mut Command) -> anyhow::Result<()> {
 }
 
 /// The command's stdout; its stderr is shown only if it fails.
-fn output_of(command: &mut Command) -> anyhow::Result<String> {
+pub fn output_of(command: &mut Command) -> anyhow::Result<String> {
     let out = command
         .output()
         .with_context(|| format!("running {command:?}"))?;

@@ -111,10 +111,7 @@ pub fn build() -> anyhow::Result<PathBuf> {
     ])?;
     let wasm = target_dir().join(format!("{WASM_TARGET}/release/sake_glug_web.wasm"));
     let dist = Path::new(DIST);
-    if dist.exists() {
-        std::fs::remove_dir_all(dist)?;
-    }
-    std::fs::create_dir_all(dist)?;
+    crate::dist::fresh_folder(dist)?;
     let status = Command::new(&bindgen)
         .args([
             "--target",
@@ -155,19 +152,14 @@ pub fn build() -> anyhow::Result<PathBuf> {
 fn pack() -> anyhow::Result<PathBuf> {
     let out = std::path::absolute(target_dir().join("web"))?;
     std::fs::create_dir_all(&out)?;
-    let listing = Command::new("npm")
-        .current_dir(WEB)
-        .args(["pack", "--json", "--pack-destination"])
-        .arg(&out)
-        .output()
-        .context("running npm (Debian's `npm` package; .ci/run installs it)")?;
-    anyhow::ensure!(
-        listing.status.success(),
-        "npm pack failed ({}):\n{}",
-        listing.status,
-        String::from_utf8_lossy(&listing.stderr)
-    );
-    let listing: Value = serde_json::from_slice(&listing.stdout)?;
+    let listing = crate::dist::output_of(
+        Command::new("npm")
+            .current_dir(WEB)
+            .args(["pack", "--json", "--pack-destination"])
+            .arg(&out),
+    )
+    .context("npm pack (Debian's `npm` package; .ci/run installs it)")?;
+    let listing: Value = serde_json::from_str(&listing)?;
     let name = listing[0]["filename"]
         .as_str()
         .context("npm pack named no tarball")?;
@@ -305,10 +297,7 @@ pub fn test(tarball: &Path, cli: &Path) -> anyhow::Result<()> {
     // The tests' folders (the empty folder the tarball installs into, the CLI's renders), made
     // afresh each run.
     let work = std::path::absolute(target_dir().join("web/work"))?;
-    if work.exists() {
-        std::fs::remove_dir_all(&work)?;
-    }
-    std::fs::create_dir_all(&work)?;
+    crate::dist::fresh_folder(&work)?;
     let typescript = typescript()?;
     let status = Command::new("node")
         .current_dir(WEB)
@@ -384,24 +373,16 @@ pub fn figures(cli: &Path) -> anyhow::Result<Option<String>> {
 
     // The renders' folder (a minute's WAV file), made afresh each run as the tests' is.
     let work = std::path::absolute(target_dir().join("web/speed"))?;
-    if work.exists() {
-        std::fs::remove_dir_all(&work)?;
-    }
-    std::fs::create_dir_all(&work)?;
-    let out = Command::new("node")
-        .current_dir(WEB)
-        .arg("test/support/speed.mjs")
-        .env("SAKE_GLUG_CLI", std::path::absolute(cli)?)
-        .env("SAKE_GLUG_WORK", &work)
-        .output()
-        .context("running node (Debian's `nodejs`)")?;
-    anyhow::ensure!(
-        out.status.success(),
-        "timing the web package failed ({}):\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let speed: Value = serde_json::from_slice(&out.stdout)?;
+    crate::dist::fresh_folder(&work)?;
+    let out = crate::dist::output_of(
+        Command::new("node")
+            .current_dir(WEB)
+            .arg("test/support/speed.mjs")
+            .env("SAKE_GLUG_CLI", std::path::absolute(cli)?)
+            .env("SAKE_GLUG_WORK", &work),
+    )
+    .context("timing the web package (node: Debian's `nodejs`)")?;
+    let speed: Value = serde_json::from_str(&out)?;
     if let Some(missing) = speed["missing"].as_str() {
         println!("{GUIDE}: web-figures kept: Chromium is needed to time the page ({missing})");
         return Ok(None);

@@ -249,10 +249,7 @@ pub fn dist(built: &Built, out: &Path) -> anyhow::Result<Vec<PathBuf>> {
     let root = work.join(&stem);
     let notices = work.join("THIRD-PARTY.md");
     // A tree left by a packing that failed half way would add its files to this one.
-    if work.exists() {
-        std::fs::remove_dir_all(&work)?;
-    }
-    std::fs::create_dir_all(&work).with_context(|| format!("making {}", work.display()))?;
+    crate::dist::fresh_folder(&work)?;
     crate::dist::third_party(&notices, TARGET, &PRODUCTS)?;
     lay_out(built, &notices, &root)?;
     let zip = out.join(format!("{stem}.zip"));
