@@ -449,11 +449,13 @@ impl Audio {
         if out.is_empty() {
             return;
         }
-        if !ramped {
-            *last_tilt_deg = *held_tilt_deg;
-        } else if let Some(last) = out.len().checked_sub(1) {
-            *last_tilt_deg = Control::Tilt.range().sanitize(controls.tilt_deg.at(last));
-        }
+        *last_tilt_deg = if ramped {
+            Control::Tilt
+                .range()
+                .sanitize(controls.tilt_deg.at(out.len() - 1))
+        } else {
+            *held_tilt_deg
+        };
     }
 
     fn state(&self) -> SakeGlugState {
