@@ -169,13 +169,12 @@ fn unit_counts(units: &[FittedUnit]) -> [usize; 18] {
 }
 
 /// Each mode's (C − V_i, f_i) of the units whose volume is known, f_i as the model would have to
-/// ring to be heard where unit i is ([`own_hz`]).
+/// ring to be heard where unit i is (`own`, [`own_hz`]).
 fn pitch_points(
     units: &[FittedUnit],
     capacity_ml: f64,
-    glides_heard: bool,
+    own: &impl Fn(&FittedUnit, usize) -> f64,
 ) -> [Vec<(f64, f64)>; 2] {
-    let own = own_hz(units, glides_heard);
     [0, 1].map(|k| {
         units
             .iter()
@@ -201,10 +200,14 @@ fn heard_hz(unit: &FittedUnit, k: usize) -> f64 {
 /// bottle's, and a steady model is played at the f its units' fits end at. Where the units'
 /// glides are not the recordings' (`glides_heard` false: they explain under half of one), the
 /// units' own f too: the model is then fitted by listening, which hears the pitch itself, and the
-/// glides the units' fits traded for it would only move where that search starts.
-fn own_hz(units: &[FittedUnit], glides_heard: bool) -> impl Fn(&FittedUnit, usize) -> f64 {
-    let glide = glides(units);
-    let decay = model_decays(units);
+/// glides the units' fits traded for it would only move where that search starts. `glide` and
+/// `decay_per_s` are the model's ([`glides`], [`unit_decays`]' medians).
+fn own_hz(
+    glide: [(f64, f64); 2],
+    decay_per_s: [f64; 2],
+    glides_heard: bool,
+) -> impl Fn(&FittedUnit, usize) -> f64 {
+    let decay = decay_per_s;
     let factor = [0, 1].map(|k| {
         let (ratio, time_ms) = glide[k];
         (glides_heard
@@ -247,11 +250,6 @@ fn unit_decays(units: &[FittedUnit]) -> [Vec<f64>; 2] {
     })
 }
 
-/// Each mode's B (1/s) as the model writes it ([`unit_decays`]' medians).
-fn model_decays(units: &[FittedUnit]) -> [f64; 2] {
-    unit_decays(units).map(|b| median(&b))
-}
-
 /// The headspace law of a liquid's units (MODEL.md §5.1, §13) in a bottle whose pocket is
 /// `pocket_ml`.
 fn headspace_law(
@@ -260,7 +258,9 @@ fn headspace_law(
     pocket_ml: f64,
     glides_heard: bool,
 ) -> HeadspaceLaw {
-    let points = pitch_points(units, capacity_ml, glides_heard);
+    let decay = unit_decays(units).map(|b| median(&b));
+    let own = own_hz(glides(units), decay, glides_heard);
+    let points = pitch_points(units, capacity_ml, &own);
     fit_law([&points[0], &points[1]], pocket_ml)
 }
 
@@ -289,8 +289,11 @@ fn unit_estimates(
             .filter(|v| v.is_finite())
             .collect::<Vec<_>>()
     };
-    let points = pitch_points(units, capacity_ml, glides_heard);
-    let own = own_hz(units, glides_heard);
+    // The model's glides and decays, worked out once: the own f of every unit depends on them.
+    let glide = glides(units);
+    let b = unit_decays(units);
+    let own = own_hz(glide, [median(&b[0]), median(&b[1])], glides_heard);
+    let points = pitch_points(units, capacity_ml, &own);
     let law = fit_law([&points[0], &points[1]], pocket_ml);
     // Where a mode follows the headspace, its spread is the scatter around the law (as the
     // engine reads it), over the units whose volume places them on it.
@@ -312,7 +315,6 @@ fn unit_estimates(
         _ => median(&of(&|u| own(u, k))),
     });
     let exponent = law.modes.map(|mode| mode.map_or(f64::NAN, |m| m.exponent));
-    let b = unit_decays(units);
     // A spread over the modes with enough units to show one.
     let mean_over_modes = |values: &[Vec<f64>; 2], spread: &dyn Fn(&[f64]) -> f64| {
         let spreads: Vec<f64> = values
@@ -347,7 +349,6 @@ fn unit_estimates(
         Some(line) if line.slope > 0.0 => line.at(capacity_ml),
         _ => median(&of(&|u| u.fit.amplitude_sum())),
     };
-    let glide = glides(units);
     vec![
         quoted_hz[0],
         quoted_hz[1],
