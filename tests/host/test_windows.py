@@ -356,7 +356,7 @@ def test_uninstaller_removes_everything_it_installed(installed, before):
 
 def test_readme_names_this_versions_windows_artefacts():
     readme = (REPO / "README.md").read_text()
-    for artefact in (INSTALLER.name, ZIP.name):
+    for artefact in (INSTALLER.name, ZIP.name, WHEEL.name):
         assert artefact in readme, f"README.md's install section does not name {artefact}"
 
 
