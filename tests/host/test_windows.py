@@ -116,14 +116,19 @@ class Wine:
         return {path.relative_to(self.prefix).as_posix() for path in root.rglob("*")}
 
 
-@pytest.fixture(scope="module")
-def wine(tmp_path_factory):
-    # `cargo xtask test` builds it where MinGW-w64 and NSIS are installed (CI installs them).
+def require_release():
+    """Skips where the Windows release is not built, but fails under CI, which must build it:
+    `cargo xtask test` builds it where MinGW-w64 and NSIS are installed (CI installs them)."""
     if not INSTALLER.exists():
         missing = f"{INSTALLER} is not built: `cargo xtask dist windows --profile windows-test` builds it"
         if os.environ.get("CI"):
             pytest.fail(missing)
         pytest.skip(missing)
+
+
+@pytest.fixture(scope="module")
+def wine(tmp_path_factory):
+    require_release()
     need(WINE.exists(), "wine64", "wine64")
     need(shutil.which(MINGW_GCC), MINGW_GCC, "gcc-mingw-w64-x86-64")
     wine = Wine(tmp_path_factory.mktemp("wine") / "prefix")
@@ -371,11 +376,7 @@ WINDOWS_SYSTEM_DLLS = {"kernel32.dll", "ntdll.dll", "msvcrt.dll", "bcryptprimiti
 @pytest.fixture(scope="module")
 def wheel(tmp_path_factory):
     """The wheel's files, unpacked."""
-    if not INSTALLER.exists():
-        missing = f"{INSTALLER} is not built: `cargo xtask dist windows --profile windows-test` builds it"
-        if os.environ.get("CI"):
-            pytest.fail(missing)
-        pytest.skip(missing)
+    require_release()
     need(shutil.which(MINGW_OBJDUMP), MINGW_OBJDUMP, "binutils-mingw-w64-x86-64")
     assert WHEEL.exists(), f"{WHEEL.name} is not beside {INSTALLER.name}: `cargo xtask dist windows` writes it"
     unpacked = tmp_path_factory.mktemp("wheel")
