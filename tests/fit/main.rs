@@ -211,6 +211,21 @@ pub fn fit(path: &Path) -> SessionFit {
     fit_session(&session).expect("the session fits")
 }
 
+/// Mode k's pitch as `scene`'s model plays it where its ring's energy is centred, 1/(2B) after a
+/// glug's onset: its own f, moved by its glide (MODEL.md §5.2) there. A simulator's pitch as heard
+/// is judged against this, not against the own f a glide approaches.
+pub fn heard_hz(scene: &Scene, k: usize) -> f64 {
+    use sake_glug_engine::Constant;
+    let [hz, decay, ratio, time_ms] = [
+        [Constant::F1, Constant::F2],
+        [Constant::B1, Constant::B2],
+        [Constant::F1GlideRatio, Constant::F2GlideRatio],
+        [Constant::F1GlideTime, Constant::F2GlideTime],
+    ]
+    .map(|constants| (constants[k].spec().get)(&scene.config));
+    hz * (1.0 + (ratio - 1.0) * (-0.5 / decay / (1e-3 * time_ms)).exp())
+}
+
 /// The estimate of `key` for `liquid` (panics if there is none).
 pub fn estimate(fit: &SessionFit, liquid: usize, key: &str) -> f64 {
     fit.liquids[liquid]

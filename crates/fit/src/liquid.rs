@@ -29,6 +29,9 @@ const MIN_UNITS_FOR_SPREAD: usize = 3;
 /// A mode's decay is taken from the units that fitted it gliding where at least this many did
 /// (as few as a short mode's agreement asks for).
 const MIN_SWEPT_UNITS: usize = 3;
+/// A glide fewer than half a mode's units show is its bottle's only where at least this many
+/// agree on it (MODEL.md §13).
+const MIN_AGREEING_GLIDES: usize = 3;
 
 /// One liquid's model.
 #[derive(Debug, Clone)]
@@ -260,7 +263,7 @@ fn headspace_law(
     glides_heard: bool,
 ) -> HeadspaceLaw {
     let decay = unit_decays(units).map(|b| median(&b));
-    let own = own_hz(glides(units), decay, glides_heard);
+    let own = own_hz(glides(units, glides_heard), decay, glides_heard);
     let points = pitch_points(units, capacity_ml, &own);
     fit_law([&points[0], &points[1]], pocket_ml)
 }
@@ -291,7 +294,7 @@ fn unit_estimates(
             .collect::<Vec<_>>()
     };
     // The model's glides and decays, worked out once: the own f of every unit depends on them.
-    let glide = glides(units);
+    let glide = glides(units, glides_heard);
     let b = unit_decays(units);
     let own = own_hz(glide, [median(&b[0]), median(&b[1])], glides_heard);
     let points = pitch_points(units, capacity_ml, &own);
@@ -374,11 +377,15 @@ fn unit_estimates(
 }
 
 /// Each mode's glide (MODEL.md §5.2, §13): ρ and τ_g the medians over the units whose component
-/// in the mode glides, where those are at least half of the units ringing it; else no glide
-/// (ρ = 1), as a glide a few units show is no bottle's. A unit whose glide is slower than its
+/// in the mode glides, where those are at least half of the units ringing it, or, where the units'
+/// glides are the recordings' (`glides_heard`), at least [`MIN_AGREEING_GLIDES`] and a quarter of
+/// them that agree (their ln ρ's IQR under half its median's size); else no glide (ρ = 1), as a
+/// glide a few units show, each its own, is no bottle's. A unit whose glide is slower than its
 /// ring is fitted steady, so a gliding bottle's units that glide are its ρ; counted as 1 they
-/// pulled its ρ towards 1 (a development draw's 1.41 to 1.31, with 18 of its 47 units steady).
-fn glides(units: &[FittedUnit]) -> [(f64, f64); 2] {
+/// pulled its ρ towards 1 (a development draw's 1.41 to 1.31, with 18 of its 47 units steady),
+/// and where most of its units are steady, a glide its gliding units agree on is still its own
+/// (development draws 3009 and 1033: 7 of 22 units at ρ 1.17–1.20, 6–9 of 13 at 1.38–1.48).
+fn glides(units: &[FittedUnit], glides_heard: bool) -> [(f64, f64); 2] {
     [0, 1].map(|k| {
         let ringing = units
             .iter()
@@ -390,8 +397,15 @@ fn glides(units: &[FittedUnit]) -> [(f64, f64); 2] {
             .filter_map(|u| u.fit.glide[k])
             .collect();
         let times_ms: Vec<f64> = gliding.iter().map(|g| 1e3 * g.time_s).collect();
-        if 2 * gliding.len() >= ringing && !gliding.is_empty() {
-            let ratios: Vec<f64> = gliding.iter().map(|g| g.ratio).collect();
+        let ratios: Vec<f64> = gliding.iter().map(|g| g.ratio).collect();
+        let log_ratios: Vec<f64> = ratios.iter().map(|r| r.ln()).collect();
+        // Steady draws' stray glides scatter (ρ 0.54–1.03 over a development draw's units); a
+        // bottle's cluster within a few per cent.
+        let agree = glides_heard
+            && gliding.len() >= MIN_AGREEING_GLIDES
+            && 4 * gliding.len() >= ringing
+            && iqr(&log_ratios) < 0.5 * median(&log_ratios).abs();
+        if (2 * gliding.len() >= ringing || agree) && !gliding.is_empty() {
             (median(&ratios), median(&times_ms))
         } else {
             (1.0, median(&times_ms))
