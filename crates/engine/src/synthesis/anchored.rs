@@ -9,7 +9,7 @@
 
 use multiversion::multiversion;
 
-use super::bank::{Bank, BankComponent};
+use super::bank::{Bank, BankComponent, MAX_COMPONENTS};
 use super::component::{complex_exp, complex_mul, Component};
 
 /// Samples per grid period; the anchor advances in f64 once per period.
@@ -19,7 +19,7 @@ pub const GRID: usize = 64;
 const NEGLIGIBLE_POWER: f64 = 1e-7;
 /// The f64 anchor recursion is re-evaluated from the closed form this often, so nothing can
 /// drift however long a component rings (B = 0 rings for ever).
-const PERIODS_PER_DIRECT_ANCHOR: u32 = 1024;
+const PERIODS_PER_DIRECT_ANCHOR: u64 = 1024;
 /// A glide with less phase than this left to add (rad) is over: from then on a period's powers
 /// are the plain z^j, which leaves the samples within A·10⁻⁷ (−140 dB) of the closed form.
 const GLIDE_SETTLED_RADIANS: f64 = 1e-7;
@@ -27,106 +27,231 @@ const GLIDE_SETTLED_RADIANS: f64 = 1e-7;
 /// The default synthesis path: anchored components in f32, allocation-free after `new()`.
 pub type AnchoredF32 = Bank<AnchoredComponent>;
 
-/// One component on the default path: its f32 powers over a grid period and its anchor.
+/// One component on the default path: its f32 powers over a grid period, and what the bank's
+/// arrays ([`Anchors`]) take of it when it joins; the bank steps it from then on in its arrays.
 #[derive(Clone)]
 pub struct AnchoredComponent {
     powers_re: [f32; GRID],
     powers_im: [f32; GRID],
-    /// State at `anchor_sample`, the first sample of the period being rendered.
-    anchor: [f32; 2],
-    /// The same in f64, as it was worked out: what the level is read from.
-    anchor_f64: [f64; 2],
-    anchor_sample: u64,
-    /// State at the first sample of the next period.
-    next_anchor: [f64; 2],
+    /// State at the component's first sample.
+    first_anchor: [f64; 2],
+    /// State at the first sample of the period after the one it starts in.
+    first_next_anchor: [f64; 2],
     /// z^GRID in f64.
     period_step: [f64; 2],
     component: Component,
     /// The sample from which the component is silent (see [`Component::silent_from`]).
     silent_from: u64,
-    periods_since_direct: u32,
     /// The powers of each period carry the glide's phase (MODEL.md §5.2), refilled every period
     /// until the glide is over.
     gliding: bool,
+}
+
+/// Components a SIMD group of the anchors' step holds: AVX2's 4 f64 (two SSE2 pairs).
+const LANES: usize = 4;
+
+/// The anchored bank's per-period state, one entry per component in the bank's order (structure
+/// of arrays), so that a period's step of every component is one loop over plain f64 arrays, a
+/// SIMD group of components at a time ([`step_anchors`]). Entries from `len` on are not
+/// components; the step runs over them to the end of the last group, harmlessly.
+pub struct Anchors {
+    len: usize,
+    /// One allocation, so that the compiler knows the arrays apart.
+    lanes: Box<Lanes>,
+    /// The earliest `event_at`: before it, a period's step is the array loop alone.
+    first_event_at: u64,
+    period_sum: PeriodSum,
+}
+
+/// The arrays of [`Anchors`].
+struct Lanes {
+    /// State at the first sample of the period being rendered (or of the component, if it
+    /// starts later), in f32 for the synthesis.
+    anchor_re: [f32; MAX_COMPONENTS],
+    anchor_im: [f32; MAX_COMPONENTS],
+    /// The same in f64, as it was worked out: what the level is read from.
+    level_re: [f64; MAX_COMPONENTS],
+    level_im: [f64; MAX_COMPONENTS],
+    /// State at the first sample of the next period.
+    next_re: [f64; MAX_COMPONENTS],
+    next_im: [f64; MAX_COMPONENTS],
+    /// z^GRID.
+    step_re: [f64; MAX_COMPONENTS],
+    step_im: [f64; MAX_COMPONENTS],
+    anchor_sample: [u64; MAX_COMPONENTS],
+    /// The first period start at which the component needs more than the plain step
+    /// ([`AnchoredComponent::at_event`]): its silence, its next direct anchor, every period of a
+    /// glide, and the boundary it starts on.
+    event_at: [u64; MAX_COMPONENTS],
+    /// The period start at which the anchor is next worked out from the closed form.
+    direct_at: [u64; MAX_COMPONENTS],
+}
+
+const _: () = assert!(MAX_COMPONENTS.is_multiple_of(LANES));
+
+impl Default for Anchors {
+    /// Allocates, once: the bank never holds more than [`MAX_COMPONENTS`].
+    fn default() -> Self {
+        Self {
+            len: 0,
+            lanes: Box::new(Lanes {
+                anchor_re: [0.0; MAX_COMPONENTS],
+                anchor_im: [0.0; MAX_COMPONENTS],
+                level_re: [0.0; MAX_COMPONENTS],
+                level_im: [0.0; MAX_COMPONENTS],
+                next_re: [0.0; MAX_COMPONENTS],
+                next_im: [0.0; MAX_COMPONENTS],
+                step_re: [0.0; MAX_COMPONENTS],
+                step_im: [0.0; MAX_COMPONENTS],
+                anchor_sample: [0; MAX_COMPONENTS],
+                event_at: [0; MAX_COMPONENTS],
+                direct_at: [0; MAX_COMPONENTS],
+            }),
+            first_event_at: u64::MAX,
+            period_sum: PeriodSum::default(),
+        }
+    }
+}
+
+impl Anchors {
+    /// Appends `component`'s state at its start.
+    fn push(&mut self, component: &AnchoredComponent) {
+        self.len += 1;
+        self.set(self.len - 1, component);
+    }
+
+    /// Entry `index` from `component`'s state at its start.
+    fn set(&mut self, index: usize, component: &AnchoredComponent) {
+        let first_sample = component.component.first_sample();
+        self.set_anchor(index, component.first_anchor);
+        [self.lanes.next_re[index], self.lanes.next_im[index]] = component.first_next_anchor;
+        [self.lanes.step_re[index], self.lanes.step_im[index]] = component.period_step;
+        self.lanes.anchor_sample[index] = first_sample;
+        // The counter it replaces counted the periods stepped after the one it starts in: the
+        // 1024th is worked out from the closed form.
+        let first_period = (first_sample / GRID as u64 + 1) * GRID as u64;
+        self.lanes.direct_at[index] = first_period + (PERIODS_PER_DIRECT_ANCHOR - 1) * GRID as u64;
+        self.lanes.event_at[index] = if first_sample.is_multiple_of(GRID as u64) {
+            first_sample
+        } else {
+            component.next_event(self.lanes.direct_at[index])
+        };
+        self.first_event_at = self.first_event_at.min(self.lanes.event_at[index]);
+    }
+
+    fn set_anchor(&mut self, index: usize, state: [f64; 2]) {
+        [self.lanes.level_re[index], self.lanes.level_im[index]] = state;
+        self.lanes.anchor_re[index] = state[0] as f32;
+        self.lanes.anchor_im[index] = state[1] as f32;
+    }
+
+    /// Moves entry `from` to `to` (`to` < `from`, dropping what was there).
+    fn move_entry(&mut self, from: usize, to: usize) {
+        self.lanes.anchor_re[to] = self.lanes.anchor_re[from];
+        self.lanes.anchor_im[to] = self.lanes.anchor_im[from];
+        self.lanes.level_re[to] = self.lanes.level_re[from];
+        self.lanes.level_im[to] = self.lanes.level_im[from];
+        self.lanes.next_re[to] = self.lanes.next_re[from];
+        self.lanes.next_im[to] = self.lanes.next_im[from];
+        self.lanes.step_re[to] = self.lanes.step_re[from];
+        self.lanes.step_im[to] = self.lanes.step_im[from];
+        self.lanes.anchor_sample[to] = self.lanes.anchor_sample[from];
+        self.lanes.event_at[to] = self.lanes.event_at[from];
+        self.lanes.direct_at[to] = self.lanes.direct_at[from];
+    }
 }
 
 impl BankComponent for AnchoredComponent {
     fn start(component: Component) -> Self {
         let first_sample = component.first_sample();
         let grid = GRID as f64;
+        let next_period = (first_sample / GRID as u64 + 1) * GRID as u64;
         let mut anchored = Self {
             powers_re: [0.0; GRID],
             powers_im: [0.0; GRID],
-            anchor: [0.0; 2],
-            anchor_f64: [0.0; 2],
-            anchor_sample: first_sample,
-            next_anchor: [0.0; 2],
+            first_anchor: component.state_at(first_sample),
+            first_next_anchor: component.state_at(next_period),
             period_step: complex_exp(
                 -component.decay_per_sample * grid,
                 component.radians_per_sample * grid,
             ),
             component,
             silent_from: component.silent_from(),
-            periods_since_direct: 0,
             gliding: component.glide.is_some(),
         };
-        anchored.set_anchor(component.state_at(first_sample));
-        let next_period = (first_sample / GRID as u64 + 1) * GRID as u64;
-        anchored.next_anchor = component.state_at(next_period);
-        anchored.fill_powers();
+        anchored.fill_powers(first_sample);
         anchored
     }
 
     /// |anchor|² rounded to f32 (squared: only the order matters, and it saves a hypot), worked
     /// out only when the bank is full and a component is to be given up, not every period.
     fn level(&self) -> f64 {
-        let [re, im] = self.anchor_f64;
-        (re * re + im * im) as f32 as f64
+        squared_level(self.first_anchor)
     }
 
-    fn advance(&mut self, period_start: u64) -> bool {
-        if self.anchor_sample >= period_start {
-            // Started on this very boundary: its anchor already belongs to the new period.
-            return true;
+    fn level_in(_: &[Self], anchors: &Anchors, index: usize) -> f64 {
+        squared_level([anchors.lanes.level_re[index], anchors.lanes.level_im[index]])
+    }
+
+    fn joined(anchors: &mut Anchors, components: &[Self]) {
+        anchors.push(components.last().expect("a component joined"));
+    }
+
+    fn replaced(anchors: &mut Anchors, components: &[Self], index: usize) {
+        anchors.set(index, &components[index]);
+        // A component replaced in the middle of the bank: the period's sum is not its own.
+        anchors.period_sum.period_start = None;
+    }
+
+    fn cleared(anchors: &mut Anchors) {
+        anchors.len = 0;
+        anchors.first_event_at = u64::MAX;
+        anchors.period_sum.period_start = None;
+    }
+
+    fn advance_all(components: &mut Vec<Self>, anchors: &mut Anchors, period_start: u64) {
+        step_anchors(anchors, period_start);
+        if period_start < anchors.first_event_at {
+            return;
         }
-        if period_start >= self.silent_from {
-            return false;
-        }
-        self.set_anchor(self.next_anchor);
-        self.anchor_sample = period_start;
-        let following = period_start + GRID as u64;
-        if self.component.glide.is_some() {
-            // A glide's phase is no fixed rotation a period: each anchor is the closed form's.
-            self.next_anchor = self.component.state_at(following);
-            if self.gliding {
-                self.fill_powers();
+        // Some component needs more than the plain step just taken: each one that does puts it
+        // right, and the silent ones are dropped, the others keeping their order (`retain_mut`
+        // visits them in order, once each).
+        let mut first_event_at = u64::MAX;
+        let mut index = 0;
+        let mut kept = 0;
+        components.retain_mut(|component| {
+            let sounds = period_start < anchors.lanes.event_at[index]
+                || component.at_event(anchors, index, period_start);
+            if sounds {
+                if kept != index {
+                    anchors.move_entry(index, kept);
+                }
+                first_event_at = first_event_at.min(anchors.lanes.event_at[kept]);
+                kept += 1;
             }
-            return true;
-        }
-        self.periods_since_direct += 1;
-        self.next_anchor = if self.periods_since_direct == PERIODS_PER_DIRECT_ANCHOR {
-            self.periods_since_direct = 0;
-            self.component.state_at(following)
-        } else {
-            complex_mul(self.next_anchor, self.period_step)
-        };
-        true
+            index += 1;
+            sounds
+        });
+        anchors.len = kept;
+        anchors.first_event_at = first_event_at;
     }
 
-    type PeriodSum = PeriodSum;
+    type Shared = Anchors;
 
-    fn write_all(
-        components: &mut [Self],
-        period_sum: &mut PeriodSum,
-        span_start: u64,
-        out: &mut [f32],
-    ) {
+    fn write_all(components: &mut [Self], anchors: &mut Anchors, span_start: u64, out: &mut [f32]) {
+        let period_sum = &mut anchors.period_sum;
         if let Ok(period) = <&mut [f32; GRID]>::try_from(&mut *out) {
-            if components
+            if anchors.lanes.anchor_sample[..anchors.len]
                 .iter()
-                .all(|component| component.anchor_sample == span_start)
+                .all(|&anchor_sample| anchor_sample == span_start)
             {
-                sum_period(components, period);
+                sum_period(
+                    components,
+                    &anchors.lanes.anchor_re[..],
+                    &anchors.lanes.anchor_im[..],
+                    period,
+                );
                 return;
             }
         }
@@ -138,19 +263,31 @@ impl BankComponent for AnchoredComponent {
         if period_sum.period_start != Some(period_start) {
             // They lead the bank: a component joins at its end, and one that starts at a
             // period's first sample joined in the period before.
-            let leading = components
+            let leading = anchors.lanes.anchor_sample[..anchors.len]
                 .iter()
-                .take_while(|component| component.anchor_sample == period_start)
+                .take_while(|&&anchor_sample| anchor_sample == period_start)
                 .count();
-            sum_period(&components[..leading], &mut period_sum.samples);
+            sum_period(
+                &components[..leading],
+                &anchors.lanes.anchor_re[..],
+                &anchors.lanes.anchor_im[..],
+                &mut period_sum.samples,
+            );
             period_sum.components = leading;
             period_sum.period_start = Some(period_start);
         }
         let offset = (span_start - period_start) as usize;
         out.copy_from_slice(&period_sum.samples[offset..offset + out.len()]);
-        let started_since = &components[period_sum.components..];
-        if !started_since.is_empty() {
-            add_each(started_since, span_start, out);
+        let since = period_sum.components;
+        if since < components.len() {
+            add_each(
+                &components[since..],
+                &anchors.lanes.anchor_re[since..anchors.len],
+                &anchors.lanes.anchor_im[since..anchors.len],
+                &anchors.lanes.anchor_sample[since..anchors.len],
+                span_start,
+                out,
+            );
         }
     }
 }
@@ -177,21 +314,59 @@ impl Default for PeriodSum {
     }
 }
 
+/// |state|² rounded to f32: see [`AnchoredComponent::level`].
+fn squared_level([re, im]: [f64; 2]) -> f64 {
+    (re * re + im * im) as f32 as f64
+}
+
+/// Every component of the bank to the period starting at `period_start` by the plain step: the
+/// anchor becomes the next one, and the next one is multiplied by z^GRID (the f64 products and
+/// sums of `complex_mul`, in its order). The arrays are taken [`LANES`] components at a time,
+/// each group a few SIMD instructions: SSE2 pairs on x86-64's baseline, AVX2 where the processor
+/// has it. Each lane does the same IEEE operations (Rust never fuses a product into a sum), so
+/// the anchors are the same bits on every path and as one component at a time. A component
+/// that needs more puts its entry right afterwards ([`AnchoredComponent::at_event`]).
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
+fn step_anchors(anchors: &mut Anchors, period_start: u64) {
+    let groups = anchors.len.div_ceil(LANES);
+    let lanes = &mut *anchors.lanes;
+    let (anchor_re, _) = lanes.anchor_re.as_chunks_mut::<LANES>();
+    let (anchor_im, _) = lanes.anchor_im.as_chunks_mut::<LANES>();
+    let (level_re, _) = lanes.level_re.as_chunks_mut::<LANES>();
+    let (level_im, _) = lanes.level_im.as_chunks_mut::<LANES>();
+    let (next_re, _) = lanes.next_re.as_chunks_mut::<LANES>();
+    let (next_im, _) = lanes.next_im.as_chunks_mut::<LANES>();
+    let (step_re, _) = lanes.step_re.as_chunks::<LANES>();
+    let (step_im, _) = lanes.step_im.as_chunks::<LANES>();
+    let (anchor_sample, _) = lanes.anchor_sample.as_chunks_mut::<LANES>();
+    for group in 0..groups {
+        let (re, im) = (next_re[group], next_im[group]);
+        let (z_re, z_im) = (step_re[group], step_im[group]);
+        anchor_re[group] = re.map(|re| re as f32);
+        anchor_im[group] = im.map(|im| im as f32);
+        level_re[group] = re;
+        level_im[group] = im;
+        next_re[group] = std::array::from_fn(|k| re[k] * z_re[k] - im[k] * z_im[k]);
+        next_im[group] = std::array::from_fn(|k| re[k] * z_im[k] + im[k] * z_re[k]);
+        anchor_sample[group] = [period_start; LANES];
+    }
+}
+
 impl AnchoredComponent {
     /// Adds this component's samples for `out`, which starts at absolute sample `span_start` and
     /// lies within one grid period.
     #[inline]
-    fn synthesize(&self, span_start: u64, out: &mut [f32]) {
-        let first = self.anchor_sample.max(span_start);
+    fn synthesize(&self, anchor: [f32; 2], anchor_sample: u64, span_start: u64, out: &mut [f32]) {
+        let first = anchor_sample.max(span_start);
         let offset = (first - span_start) as usize;
         if offset >= out.len() {
             return;
         }
         let out = &mut out[offset..];
-        let power = (first - self.anchor_sample) as usize;
+        let power = (first - anchor_sample) as usize;
         let re = &self.powers_re[power..power + out.len()];
         let im = &self.powers_im[power..power + out.len()];
-        let [anchor_re, anchor_im] = self.anchor;
+        let [anchor_re, anchor_im] = anchor;
         for ((y, &z_re), &z_im) in out.iter_mut().zip(re).zip(im) {
             *y += anchor_re * z_im + anchor_im * z_re;
         }
@@ -201,23 +376,58 @@ impl AnchoredComponent {
     /// period's first sample (it did not start within the period): the same sums as
     /// [`AnchoredComponent::synthesize`], with the length known to the compiler.
     #[inline]
-    fn synthesize_period(&self, out: &mut [f32; GRID]) {
-        let [anchor_re, anchor_im] = self.anchor;
+    fn synthesize_period(&self, [anchor_re, anchor_im]: [f32; 2], out: &mut [f32; GRID]) {
         for ((y, &z_re), &z_im) in out.iter_mut().zip(&self.powers_re).zip(&self.powers_im) {
             *y += anchor_re * z_im + anchor_im * z_re;
         }
     }
 
-    /// The first sample of the period being rendered, or of the component if it starts later.
-    fn set_anchor(&mut self, state: [f64; 2]) {
-        self.anchor = [state[0] as f32, state[1] as f32];
-        self.anchor_f64 = state;
+    /// The period start from which this component, past its first boundary, needs more than the
+    /// plain step: every period while it has a glide, else its silence or its next direct anchor.
+    fn next_event(&self, direct_at: u64) -> u64 {
+        if self.component.glide.is_some() {
+            0
+        } else {
+            self.silent_from.min(direct_at)
+        }
+    }
+
+    /// Puts entry `index` right after the plain step to the period starting at `period_start`,
+    /// which reached its `event_at`; false once the component is silent.
+    fn at_event(&mut self, anchors: &mut Anchors, index: usize, period_start: u64) -> bool {
+        let following = period_start + GRID as u64;
+        if self.component.first_sample() == period_start {
+            // Started on this very boundary: its anchor already belonged to the new period.
+            anchors.set_anchor(index, self.first_anchor);
+            [anchors.lanes.next_re[index], anchors.lanes.next_im[index]] = self.first_next_anchor;
+            anchors.lanes.event_at[index] = self.next_event(anchors.lanes.direct_at[index]);
+            return true;
+        }
+        if period_start >= self.silent_from {
+            return false;
+        }
+        if self.component.glide.is_some() {
+            // A glide's phase is no fixed rotation a period: each anchor is the closed form's.
+            [anchors.lanes.next_re[index], anchors.lanes.next_im[index]] =
+                self.component.state_at(following);
+            if self.gliding {
+                self.fill_powers(period_start);
+            }
+            return true;
+        }
+        if period_start >= anchors.lanes.direct_at[index] {
+            [anchors.lanes.next_re[index], anchors.lanes.next_im[index]] =
+                self.component.state_at(following);
+            anchors.lanes.direct_at[index] += PERIODS_PER_DIRECT_ANCHOR * GRID as u64;
+        }
+        anchors.lanes.event_at[index] = self.next_event(anchors.lanes.direct_at[index]);
+        true
     }
 
     /// z^j for the period that starts at `anchor_sample`, times the glide's phase over it while
     /// the component glides: from the anchor, the glide adds K_a·(1 − r^j), K_a the phase left
     /// to add at the anchor and r = e^(−1/T).
-    fn fill_powers(&mut self) {
+    fn fill_powers(&mut self, anchor_sample: u64) {
         let step = self.component.step();
         // |z^j| = e^(−dj) falls below NEGLIGIBLE_POWER from j = ln(1/NEGLIGIBLE_POWER)/d on;
         // counted up front rather than with a hypot per power, which made starts costly.
@@ -229,7 +439,7 @@ impl AnchoredComponent {
         };
         let glide = match self.component.glide {
             Some(glide) if self.gliding => {
-                let elapsed = self.component.samples_since_onset(self.anchor_sample);
+                let elapsed = self.component.samples_since_onset(anchor_sample);
                 let left = glide.phase_left_at(elapsed);
                 self.gliding = left.abs() >= GLIDE_SETTLED_RADIANS;
                 self.gliding
@@ -272,10 +482,15 @@ impl AnchoredComponent {
 /// The period is held in registers (64 f32: 8 AVX2 or 4 AVX-512 registers), so each component
 /// costs its multiplications and additions and no loads and stores of the output.
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
-fn sum_period(components: &[AnchoredComponent], out: &mut [f32; GRID]) {
+fn sum_period(
+    components: &[AnchoredComponent],
+    anchor_re: &[f32],
+    anchor_im: &[f32],
+    out: &mut [f32; GRID],
+) {
     let mut sum = [0.0; GRID];
-    for component in components {
-        component.synthesize_period(&mut sum);
+    for ((component, &re), &im) in components.iter().zip(anchor_re).zip(anchor_im) {
+        component.synthesize_period([re, im], &mut sum);
     }
     *out = sum;
 }
@@ -283,8 +498,20 @@ fn sum_period(components: &[AnchoredComponent], out: &mut [f32; GRID]) {
 /// Adds each component's samples into `out`, which starts at absolute sample `span_start` and
 /// lies within one grid period, in the bank's order; compiled as [`sum_period`] is.
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
-fn add_each(components: &[AnchoredComponent], span_start: u64, out: &mut [f32]) {
-    for component in components {
-        component.synthesize(span_start, out);
+fn add_each(
+    components: &[AnchoredComponent],
+    anchor_re: &[f32],
+    anchor_im: &[f32],
+    anchor_sample: &[u64],
+    span_start: u64,
+    out: &mut [f32],
+) {
+    for (((component, &re), &im), &sample) in components
+        .iter()
+        .zip(anchor_re)
+        .zip(anchor_im)
+        .zip(anchor_sample)
+    {
+        component.synthesize([re, im], sample, span_start, out);
     }
 }
