@@ -54,8 +54,9 @@ def run(command, **options):
 
 
 def the_wheel():
-    wheels = sorted(DIST.glob(f"sake_glug-{VERSION}-*.whl"))
-    assert len(wheels) == 1, f"one wheel of {VERSION} expected in {DIST}, found {wheels}"
+    # The Linux one: `cargo xtask dist windows` writes its win_amd64 wheel beside it.
+    wheels = sorted(DIST.glob(f"sake_glug-{VERSION}-*linux*.whl"))
+    assert len(wheels) == 1, f"one Linux wheel of {VERSION} expected in {DIST}, found {wheels}"
     return wheels[0]
 
 

@@ -6,8 +6,12 @@ workspace's version and adds its `bin` to the PATH; the installed `sake-glug.exe
 format of several scenes byte for byte as the Linux CLI writes them (Ogg Vorbis, whose C encoder
 rounds as the platform's maths library does, decodes to the same length within -80 dB); a C program cross-compiled
 against the installed header, import library and DLL writes the Linux CLI's (and so the Linux
-library's) samples bit for bit; the installed standalone app opens its editor (under Xvfb) and quits when its window is
-closed (the shipped release's: the windows-test build of `cargo xtask test` has no app); the uninstaller then leaves `Program Files` as it was and the PATH as it was.
+library's) samples bit for bit; the installed standalone app opens its editor (under Xvfb) and
+quits when its window is closed; the uninstaller then leaves `Program Files` as it was and the
+PATH as it was. The Python wheel beside them is checked as files only (no Windows CPython can be
+had here to import it, under Wine or elsewhere): its tag is win_amd64 for abi3, it holds the
+package's Python files and its extension module, a DLL that exports the module's PyInit_ and links
+only Windows' own DLLs and python3.dll.
 
 Needs the installer that `cargo xtask test` builds (`cargo xtask dist windows --profile
 windows-test`, in target/dist-windows-test; SAKE_GLUG_WINDOWS_DIST names another folder, such as
@@ -44,6 +48,8 @@ VERSION = tomllib.loads((REPO / "Cargo.toml").read_text())["workspace"]["package
 STEM = f"sake-glug-{VERSION}-windows-x86_64"
 INSTALLER = DIST / f"{STEM}-setup.exe"
 ZIP = DIST / f"{STEM}.zip"
+# abi3 (python/Cargo.toml): one wheel for every CPython from 3.8 on, linked to python3.dll.
+WHEEL = DIST / f"sake_glug-{VERSION}-cp38-abi3-win_amd64.whl"
 # Debian's wine64 installs no `wine64` on PATH: the loader is here.
 WINE = Path("/usr/lib/wine/wine64")
 WINESERVER = Path("/usr/lib/wine/wineserver")
@@ -110,14 +116,19 @@ class Wine:
         return {path.relative_to(self.prefix).as_posix() for path in root.rglob("*")}
 
 
-@pytest.fixture(scope="module")
-def wine(tmp_path_factory):
-    # `cargo xtask test` builds it where MinGW-w64 and NSIS are installed (CI installs them).
+def require_release():
+    """Skips where the Windows release is not built, but fails under CI, which must build it:
+    `cargo xtask test` builds it where MinGW-w64 and NSIS are installed (CI installs them)."""
     if not INSTALLER.exists():
         missing = f"{INSTALLER} is not built: `cargo xtask dist windows --profile windows-test` builds it"
         if os.environ.get("CI"):
             pytest.fail(missing)
         pytest.skip(missing)
+
+
+@pytest.fixture(scope="module")
+def wine(tmp_path_factory):
+    require_release()
     need(WINE.exists(), "wine64", "wine64")
     need(shutil.which(MINGW_GCC), MINGW_GCC, "gcc-mingw-w64-x86-64")
     wine = Wine(tmp_path_factory.mktemp("wine") / "prefix")
@@ -156,18 +167,6 @@ def zip_tree():
     return {name.removeprefix(f"{STEM}/") for name in names}
 
 
-APP = "bin/sake-glug-standalone.exe"
-
-
-def has_app():
-    """Whether the release holds the standalone app: the shipped one must; the windows-test build
-    (`cargo xtask test`'s) leaves it out (docs/testing.md: its cold build would not fit CI's budget)."""
-    if APP in zip_tree():
-        return True
-    assert DIST == TEST_DIST, f"{ZIP} has no {APP}: only cargo xtask test's build may leave it out"
-    return False
-
-
 def installed_place(inside):
     """Where the installer puts a file of the zip's tree, as the tree's README says."""
     first, _, rest = inside.partition("/")
@@ -194,7 +193,7 @@ def test_installer_puts_each_file_where_windows_hosts_and_users_look(installed, 
     clap = installed.prefix / COMMON_FILES / "CLAP/Sake Glug.clap"
     assert "GetPluginFactory" in exports(vst3)
     assert "clap_entry" in exports(clap)
-    for program in ["sake-glug.exe", "sake_glug.dll"] + (["sake-glug-standalone.exe"] if has_app() else []):
+    for program in ["sake-glug.exe", "sake-glug-standalone.exe", "sake_glug.dll"]:
         assert (installed.prefix / INSTALL_DIR / "bin" / program).is_file(), program
     # No test-only file reaches a user: the ProcessPrng stand-in is the prefix's, not the release's.
     assert not any(path.lower().endswith("bcryptprimitives.dll") for path in new_files)
@@ -209,7 +208,7 @@ def test_installer_registers_its_version_and_the_path(installed, before):
 
 
 def test_every_product_reports_the_workspaces_version(installed):
-    for program in ["sake-glug.exe"] + (["sake-glug-standalone.exe"] if has_app() else []):
+    for program in ["sake-glug.exe", "sake-glug-standalone.exe"]:
         done = installed.run(installed.prefix / INSTALL_DIR / "bin" / program, "--version")
         assert done.returncode == 0, done.stderr.decode(errors="replace")
         assert done.stdout.decode().split() == [program.removesuffix(".exe"), VERSION]
@@ -326,9 +325,6 @@ def close_window(display, window_id):
 
 
 def test_standalone_app_opens_its_editor_and_quits_when_it_is_closed(installed, display):
-    if not has_app():
-        pytest.skip(f"{ZIP} has no standalone app: the windows-test build leaves it out; "
-                    "`cargo xtask dist windows` and SAKE_GLUG_WINDOWS_DIST=target/dist test the release's")
     pytest.importorskip("Xlib", reason="python-xlib (tests/host/requirements.txt)")
     app = installed.prefix / INSTALL_DIR / "bin/sake-glug-standalone.exe"
     process = subprocess.Popen([str(WINE), str(app), "--backend", "dummy"],
@@ -365,5 +361,66 @@ def test_uninstaller_removes_everything_it_installed(installed, before):
 
 def test_readme_names_this_versions_windows_artefacts():
     readme = (REPO / "README.md").read_text()
-    for artefact in (INSTALLER.name, ZIP.name):
+    for artefact in (INSTALLER.name, ZIP.name, WHEEL.name):
         assert artefact in readme, f"README.md's install section does not name {artefact}"
+
+
+# The DLLs a Windows 10 or later has in its system folder that a Rust program built with MinGW-w64
+# may link (the C runtime msvcrt.dll among them); with python3.dll, all the wheel's module may
+# need. A MinGW runtime DLL (libgcc_s_seh-1.dll, libwinpthread-1.dll) or a versioned
+# python3X.dll would make it fail to load on a user's machine.
+WINDOWS_SYSTEM_DLLS = {"kernel32.dll", "ntdll.dll", "msvcrt.dll", "bcryptprimitives.dll", "advapi32.dll",
+                       "userenv.dll", "ws2_32.dll", "bcrypt.dll", "user32.dll", "shell32.dll", "ole32.dll"}
+
+
+@pytest.fixture(scope="module")
+def wheel(tmp_path_factory):
+    """The wheel's files, unpacked."""
+    require_release()
+    need(shutil.which(MINGW_OBJDUMP), MINGW_OBJDUMP, "binutils-mingw-w64-x86-64")
+    assert WHEEL.exists(), f"{WHEEL.name} is not beside {INSTALLER.name}: `cargo xtask dist windows` writes it"
+    unpacked = tmp_path_factory.mktemp("wheel")
+    with zipfile.ZipFile(WHEEL) as archive:
+        archive.extractall(unpacked)
+    return unpacked
+
+
+def test_wheel_is_tagged_for_64_bit_windows_and_every_cpython_from_3_8(wheel):
+    info = wheel / f"sake_glug-{VERSION}.dist-info"
+    fields = [line.partition(": ") for line in (info / "WHEEL").read_text().splitlines()]
+    assert [value for key, _, value in fields if key == "Tag"] == ["cp38-abi3-win_amd64"]
+    assert ("Root-Is-Purelib", ": ", "false") in fields
+    metadata = (info / "METADATA").read_text().splitlines()
+    assert f"Version: {VERSION}" in metadata and "Name: sake_glug" in metadata
+
+
+def test_wheel_holds_the_packages_python_files_and_its_extension_module(wheel):
+    import base64
+    import hashlib
+
+    package = {path.relative_to(wheel).as_posix() for path in (wheel / "sake_glug").rglob("*") if path.is_file()}
+    # The Python files are the repository's, as the Linux wheel has them; the module is a .pyd.
+    tracked = run(["git", "ls-files", "sake_glug"], cwd=REPO / "python").split()
+    assert package == set(tracked) | {"sake_glug/_sake_glug.pyd"}, sorted(package)
+    for name in tracked:
+        assert (wheel / name).read_bytes() == (REPO / "python" / name).read_bytes(), name
+    # pip refuses a wheel whose RECORD does not match its files.
+    record = (wheel / f"sake_glug-{VERSION}.dist-info/RECORD").read_text().splitlines()
+    listed = {}
+    for line in record:
+        name, digest, _ = line.rsplit(",", 2)
+        listed[name] = digest
+    for name in package:
+        digest = base64.urlsafe_b64encode(hashlib.sha256((wheel / name).read_bytes()).digest()).rstrip(b"=")
+        assert listed.get(name) == f"sha256={digest.decode()}", name
+
+
+def test_wheels_module_exports_its_init_and_links_only_windows_and_python3(wheel):
+    module = wheel / "sake_glug/_sake_glug.pyd"
+    table = run([MINGW_OBJDUMP, "-p", str(module)])
+    assert "PyInit__sake_glug" in exports(module)
+    linked = {name.lower() for name in re.findall(r"^\s*DLL Name: (\S+)\s*$", table, re.MULTILINE)}
+    assert "python3.dll" in linked, linked
+    # api-ms-win-*: Windows' API sets, which every Windows 10 resolves to its own DLLs.
+    foreign = {name for name in linked - WINDOWS_SYSTEM_DLLS - {"python3.dll"} if not name.startswith("api-ms-win-")}
+    assert not foreign, f"the module links DLLs that Windows does not have: {sorted(foreign)}"

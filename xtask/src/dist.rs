@@ -42,8 +42,9 @@ pub struct Built {
 }
 
 impl Built {
-    /// The products' files under the target directory `target`; the wheel is the one of this
-    /// version in target/wheels.
+    /// The products' files under the target directory `target`; the wheel is the Linux one of
+    /// this version in target/wheels (a Windows wheel that maturin was told to write there is not
+    /// taken for it).
     pub fn under(target: &Path) -> anyhow::Result<Self> {
         let release = target.join("release");
         let wheels = target.join("wheels");
@@ -54,7 +55,11 @@ impl Built {
             .filter(|path| {
                 path.file_name()
                     .and_then(|name| name.to_str())
-                    .is_some_and(|name| name.starts_with(&prefix) && name.ends_with(".whl"))
+                    .is_some_and(|name| {
+                        name.starts_with(&prefix)
+                            && name.ends_with(".whl")
+                            && name.contains("linux")
+                    })
             })
             .max_by_key(|path| path.metadata().and_then(|m| m.modified()).ok())
             .with_context(|| format!("no {prefix}*.whl in {}", wheels.display()))?;

@@ -39,10 +39,11 @@
 //! - `cargo xtask dist`: the release in target/dist/ (the Debian package, the tarball with its
 //!   install.sh, the wheel, THIRD-PARTY.md), packed from the release builds that `cargo xtask
 //!   test` makes (built first if they are not; see dist.rs).
-//! - `cargo xtask dist windows [--profile windows-test]`: the Windows installer and zip in
-//!   target/dist/, cross-built with MinGW-w64 (windows.rs); with the `windows-test` profile
-//!   (built without link-time optimisation and without the standalone app, as `cargo xtask
-//!   test` builds it for its Wine tests), in target/dist-windows-test/.
+//! - `cargo xtask dist windows [--profile windows-test]`: the Windows installer and zip, and the
+//!   Python package's win_amd64 wheel, in target/dist/, cross-built with MinGW-w64 (windows.rs;
+//!   the wheel by maturin from the virtual environment); with the `windows-test` profile (built
+//!   without link-time optimisation, as `cargo xtask test` builds it for its Wine tests), in
+//!   target/dist-windows-test/.
 //!
 //! Each product is built with only its features: the bundles with `editor` (which brings
 //! `plugin`), the command line with `cli`, the standalone app with `standalone`, so none compiles
@@ -244,20 +245,39 @@ fn xtask() -> nice_plug_xtask::Result<()> {
     }
 }
 
-/// The Windows installer and zip of `profile`, built and packed (windows.rs).
+/// The Windows installer and zip of `profile`, built and packed (windows.rs), and the wheel
+/// beside them; says how long the wheel's build took (docs/testing.md).
 fn windows_dist(profile: &str) -> nice_plug_xtask::Result<()> {
-    let app = windows::App::of(profile);
-    windows::build(profile, app)?;
+    windows::build(profile)?;
+    let started = std::time::Instant::now();
+    let wheels = windows::wheel_dir(profile);
+    // Emptied first: only this build's wheel is taken.
+    dist::fresh_folder(&wheels)?;
+    maturin_build(&[
+        "--profile",
+        profile,
+        "--target",
+        windows::TARGET,
+        "--out",
+        &wheels.to_string_lossy(),
+    ])?;
+    println!(
+        "windows: the wheel built with the {profile} profile in {:.0} s",
+        started.elapsed().as_secs_f64()
+    );
     let out = windows::dist_dir(profile);
-    for artefact in windows::dist(&windows::Built::here(profile, app)?, &out)? {
-        println!("dist: {}", artefact.display());
+    for artefact in windows::dist(&windows::Built::here(profile)?, &out)? {
+        println!(
+            "dist: {} ({} bytes)",
+            artefact.display(),
+            artefact.metadata()?.len()
+        );
     }
     Ok(())
 }
 
 /// The Windows release that tests/host/test_windows.py runs under Wine, in the faster-built
-/// profile and without the standalone app (CI's cold build of it costs more time than CI's
-/// budget has; docs/testing.md). Where MinGW-w64, NSIS or the Rust target are missing, skipped with a line naming
+/// profile. Where MinGW-w64, NSIS or the Rust target are missing, skipped with a line naming
 /// what to install (the module is then skipped too), as the host tests skip an optional tool,
 /// but under CI (`$CI` set), which must run it, an error.
 fn windows_test_dist() -> nice_plug_xtask::Result<()> {
@@ -366,10 +386,16 @@ fn build_c_library() -> nice_plug_xtask::Result<()> {
 /// The Python package as a manylinux wheel in <target dir>/wheels, built by maturin from the
 /// virtual environment (one release build, in the workspace's target directory).
 fn build_wheel() -> nice_plug_xtask::Result<()> {
+    maturin_build(&["--release"])
+}
+
+/// The Python package built into a wheel by maturin from the virtual environment, `how` saying
+/// its profile (and target, and folder, where not the host's and target/wheels).
+fn maturin_build(how: &[&str]) -> nice_plug_xtask::Result<()> {
     let python = venv(PYTHON_REQUIREMENTS)?;
     run_in_venv(
         &maturin_of(&python),
-        &["build", "--release", "-m", "python/Cargo.toml"],
+        &[&["build", "-m", "python/Cargo.toml"], how].concat(),
     )
 }
 

@@ -9,7 +9,9 @@
 //! uninstaller deletes the files the installer wrote, listed one by one in the script from the
 //! same tree, and only the folders that are then empty. `/S` runs either silently.
 //!
-//! No Python wheel is made for Windows: no Windows CPython can be had from here to test one.
+//! Beside them, the Python package as a `win_amd64` wheel (abi3, CPython 3.8 on), built by maturin
+//! as the Linux wheel is: PyO3 links `python3.dll` by raw-dylib, so no Windows Python is needed to
+//! build it (none can be had here to run it either; docs/testing.md).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -28,9 +30,11 @@ const PUBLISHER: &str = "The Sake Glug authors";
 /// The tree's folders that go under `%CommonProgramFiles%` rather than the install folder.
 const PLUGIN_FOLDERS: [&str; 2] = ["CLAP", "VST3"];
 /// What the cross-build and the packing run, and the Debian package of each.
-const TOOLS: [(&str, &str); 4] = [
+const TOOLS: [(&str, &str); 5] = [
     ("x86_64-w64-mingw32-gcc", "gcc-mingw-w64-x86-64"),
     ("x86_64-w64-mingw32-strip", "binutils-mingw-w64-x86-64"),
+    // rustc makes the import library of PyO3's raw-dylib link to python3.dll with it.
+    ("x86_64-w64-mingw32-dlltool", "binutils-mingw-w64-x86-64"),
     ("makensis", "nsis"),
     ("zip", "zip"),
 ];
@@ -98,7 +102,9 @@ fn cargo_build(profile: &str, what: &[&str]) -> anyhow::Result<()> {
 
 /// The packages of the Windows products, each run of their build names them all: cargo unifies
 /// the features of their shared crates over the packages a run names, so both runs build those
-/// crates alike and the second compiles again only what `standalone` changes.
+/// crates alike and the second compiles again only what `standalone` changes. (maturin's run for
+/// the wheel names the Python package alone, and compiles the crates it shares with these again
+/// with its own features.)
 const PACKAGES: [&str; 6] = [
     "--package",
     "sake-glug-plugin",
@@ -108,31 +114,14 @@ const PACKAGES: [&str; 6] = [
     "sake-glug-c",
 ];
 
-/// Whether a Windows build makes the standalone app: the release does; the `windows-test` build
-/// (`cargo xtask test`'s) does not, to keep CI's cold build within its budget (docs/testing.md).
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum App {
-    Built,
-    Left,
-}
-
-impl App {
-    pub fn of(profile: &str) -> Self {
-        if profile == TEST_PROFILE {
-            Self::Left
-        } else {
-            Self::Built
-        }
-    }
-}
-
-/// Builds the Windows products with `profile`, in two cargo runs. The first makes the plugin
-/// with its editor, the command line with `ogg` and the C library; the plugin's DLL is laid out
-/// as its CLAP and VST3 bundles at once. The second, with `App::Built`, makes the standalone app,
-/// with the plugin's `standalone` feature, and replaces the DLL: cargo unifies a package's
-/// features within a run, so one run would give the plugin nice-plug's tracing-subscriber, which
-/// installs a global logger and panic hook in every host that loads it.
-pub fn build(profile: &str, app: App) -> anyhow::Result<()> {
+/// Builds the Windows products but the wheel with `profile`, in two cargo runs. The first makes
+/// the plugin with its editor, the command line with `ogg` and the C library; the plugin's DLL is
+/// laid out as its CLAP and VST3 bundles at once. The second makes the standalone app, with the
+/// plugin's `standalone` feature, and replaces the DLL: cargo unifies a package's features within
+/// a run, so one run would give the plugin nice-plug's tracing-subscriber, which installs a
+/// global logger and panic hook in every host that loads it. Says how long each run took (on
+/// CI's two cores the second costs minutes: docs/testing.md).
+pub fn build(profile: &str) -> anyhow::Result<()> {
     require_tools("the Windows build")?;
     let started = std::time::Instant::now();
     cargo_build(
@@ -143,27 +132,37 @@ pub fn build(profile: &str, app: App) -> anyhow::Result<()> {
         &profile_dir(profile).join("sake_glug_plugin.dll"),
         &bundled_dir(profile),
     )?;
-    if app == App::Built {
-        cargo_build(
-            profile,
+    let first = started.elapsed().as_secs_f64();
+    cargo_build(
+        profile,
+        &[
+            &PACKAGES[..],
             &[
-                &PACKAGES[..],
-                &[
-                    "--bin",
-                    "sake-glug-standalone",
-                    "--features",
-                    "sake-glug-plugin/standalone",
-                ],
-            ]
-            .concat(),
-        )?;
-    }
+                "--bin",
+                "sake-glug-standalone",
+                "--features",
+                "sake-glug-plugin/standalone",
+            ],
+        ]
+        .concat(),
+    )?;
+    let total = started.elapsed().as_secs_f64();
     println!(
-        "windows: built with the {profile} profile in {:.0} s",
-        started.elapsed().as_secs_f64()
+        "windows: built with the {profile} profile in {total:.0} s \
+         (the app's run {:.0} s of it)",
+        total - first
     );
     Ok(())
 }
+
+/// Where maturin writes the Windows wheel of `profile`: a folder of its own, not target/wheels,
+/// where `cargo xtask dist` takes the newest wheel for the Linux release.
+pub fn wheel_dir(profile: &str) -> PathBuf {
+    profile_dir(profile).join("wheels")
+}
+
+/// The win_amd64 wheel's file name ends so (abi3, so one wheel for every CPython from 3.8 on).
+const WHEEL_TAG: &str = "-cp38-abi3-win_amd64.whl";
 
 /// The plugin's DLL as Windows hosts want it: `Sake Glug.clap` (CLAP has no bundle on Windows)
 /// and `Sake Glug.vst3/Contents/x86_64-win/Sake Glug.vst3` (Steinberg's bundle layout), as
@@ -183,38 +182,38 @@ fn bundle_plugin(library: &Path, bundled: &Path) -> anyhow::Result<()> {
 /// What the Windows build made.
 pub struct Built {
     cli: PathBuf,
-    /// None where the build left the app out.
-    standalone: Option<PathBuf>,
+    standalone: PathBuf,
     clap: PathBuf,
     vst3: PathBuf,
     library: PathBuf,
     import_library: PathBuf,
+    wheel: PathBuf,
 }
 
 impl Built {
-    /// What `build(profile, app)` made. An app left by an earlier build is not taken.
-    pub fn here(profile: &str, app: App) -> anyhow::Result<Self> {
+    /// What `build(profile)` and maturin made.
+    pub fn here(profile: &str) -> anyhow::Result<Self> {
         let release = profile_dir(profile);
         let bundled = bundled_dir(profile);
+        let wheel = wheel_dir(profile).join(format!("sake_glug-{VERSION}{WHEEL_TAG}"));
         let built = Self {
             cli: release.join("sake-glug.exe"),
-            standalone: (app == App::Built).then(|| release.join("sake-glug-standalone.exe")),
+            standalone: release.join("sake-glug-standalone.exe"),
             clap: bundled.join(format!("{PLUGIN}.clap")),
             vst3: bundled.join(format!("{PLUGIN}.vst3")),
             library: release.join("sake_glug.dll"),
             import_library: release.join("libsake_glug.dll.a"),
+            wheel,
         };
         for path in [
-            Some(&built.cli),
-            built.standalone.as_ref(),
-            Some(&built.clap),
-            Some(&built.vst3),
-            Some(&built.library),
-            Some(&built.import_library),
-        ]
-        .into_iter()
-        .flatten()
-        {
+            &built.cli,
+            &built.standalone,
+            &built.clap,
+            &built.vst3,
+            &built.library,
+            &built.import_library,
+            &built.wheel,
+        ] {
             anyhow::ensure!(
                 path.exists(),
                 "{} is missing: the Windows build did not make it",
@@ -227,7 +226,7 @@ impl Built {
 
 /// The Windows products, for their THIRD-PARTY.md: the command line has no `audio` here (its
 /// study and measurement play through JACK and ALSA).
-const PRODUCTS: [crate::dist::Product; 3] = [
+const PRODUCTS: [crate::dist::Product; 4] = [
     ("The command line, `sake-glug.exe`", "Cargo.toml", "ogg"),
     (
         "The plugin (CLAP, VST3) and the standalone app, `sake-glug-standalone.exe`",
@@ -239,10 +238,11 @@ const PRODUCTS: [crate::dist::Product; 3] = [
         "crates/capi/Cargo.toml",
         "",
     ),
+    ("The Python package, `sake_glug`", "python/Cargo.toml", ""),
 ];
 
-/// Writes the Windows installer and zip into `out` (beside the Linux release). Returns their
-/// paths.
+/// Writes the Windows installer and zip into `out` (beside the Linux release), and copies the
+/// wheel there beside them. Returns their paths.
 pub fn dist(built: &Built, out: &Path) -> anyhow::Result<Vec<PathBuf>> {
     let stem = format!("sake-glug-{VERSION}-{ARCH}");
     let work = out.join("windows-work");
@@ -274,7 +274,9 @@ pub fn dist(built: &Built, out: &Path) -> anyhow::Result<Vec<PathBuf>> {
             .arg(&script),
     )?;
     std::fs::remove_dir_all(&work)?;
-    Ok(vec![installer, zip])
+    let wheel = out.join(built.wheel.file_name().context("the wheel has a name")?);
+    copy(&built.wheel, &wheel)?;
+    Ok(vec![installer, zip, wheel])
 }
 
 /// The one tree both artefacts hold: the install folder's contents at its root, the plugins in
@@ -282,9 +284,7 @@ pub fn dist(built: &Built, out: &Path) -> anyhow::Result<Vec<PathBuf>> {
 fn lay_out(built: &Built, notices: &Path, root: &Path) -> anyhow::Result<()> {
     let bin = root.join("bin");
     copy_stripped(&built.cli, &bin.join("sake-glug.exe"))?;
-    if let Some(standalone) = &built.standalone {
-        copy_stripped(standalone, &bin.join("sake-glug-standalone.exe"))?;
-    }
+    copy_stripped(&built.standalone, &bin.join("sake-glug-standalone.exe"))?;
     // The C library's DLL beside the programs: on the PATH with them, and found there by a
     // program that has it beside itself or on its PATH.
     copy_stripped(&built.library, &bin.join("sake_glug.dll"))?;

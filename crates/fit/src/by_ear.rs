@@ -320,6 +320,16 @@ fn render_as_recorded(table: &toml::Table, made: &AsRecorded) -> Option<Vec<f32>
     render_table(table.clone(), made).ok()
 }
 
+/// Whether the units' `estimates` set any constant the listening fit fits: where they set none
+/// (too few units for any), their model is the default bottle.
+pub(crate) fn units_set_some(estimates: &[Estimate]) -> bool {
+    knobs().iter().any(|knob| {
+        estimates
+            .iter()
+            .any(|e| e.key == knob.key && e.in_model && e.value.is_finite())
+    })
+}
+
 /// What the listening fit did for one liquid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ListeningFit {
@@ -343,12 +353,7 @@ pub(crate) fn fit_by_listening(
     // set none of the constants it fits (too few units for any): their model is then the default
     // bottle, which describes no recording.
     let knobs = knobs();
-    let units_set_some = knobs.iter().any(|knob| {
-        estimates
-            .iter()
-            .any(|e| e.key == knob.key && e.in_model && e.value.is_finite())
-    });
-    if units_set_some && recordings.iter().all(|r| r.explained >= LOW_EXPLAINED) {
+    if units_set_some(estimates) && recordings.iter().all(|r| r.explained >= LOW_EXPLAINED) {
         return None;
     }
     let base: toml::Table = toml::from_str(model_toml).ok()?;

@@ -156,6 +156,21 @@ pub enum FitError {
         /// The reasons they were rejected, each with its count.
         reasons: String,
     },
+    /// Too few units for any constant of the glug, and no model fitted by listening sounds nearer
+    /// the recordings than the default bottle: writing that bottle would be a made-up result.
+    #[error(
+        "{what}: the paper's model describes {used} of its {detected} detected unit(s), too few \
+         for any constant of its glugs, and no model fitted by listening sounds nearer the \
+         recordings than the default bottle: no model is written"
+    )]
+    NothingNearer {
+        /// The liquid.
+        what: String,
+        /// Units the model describes.
+        used: usize,
+        /// Units detected.
+        detected: usize,
+    },
     /// An output file could not be written (nothing was: every file is written all or none).
     #[error("cannot write {}: {message}", shown(path))]
     Write {

@@ -2,8 +2,9 @@
 //! recordings, its pocket and timing from their intervals, its pour time from the rate at 135°,
 //! each estimate checked by the honesty rules of [`Estimate`].
 
-use super::by_ear::{fit_by_listening, ListeningFit};
+use super::by_ear::{fit_by_listening, units_set_some, ListeningFit};
 use super::curves::FittedCurves;
+use super::error::FitError;
 use super::estimate::MIN_UNITS_FOR_MODEL;
 use super::estimate::{range_of, Estimate};
 use super::headspace::{fit_law, HeadspaceLaw};
@@ -468,7 +469,10 @@ fn amplitude_law(units: &[FittedUnit]) -> Option<Line> {
 }
 
 /// Fits the model of one liquid.
-pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> LiquidFit {
+pub(crate) fn fit_liquid(
+    inputs: &LiquidInputs,
+    warnings: &mut Vec<String>,
+) -> Result<LiquidFit, FitError> {
     let LiquidInputs {
         liquid,
         capacity_ml,
@@ -569,11 +573,21 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
         )
     };
     let mut model = model_toml(&estimates, &kept_default);
+    let units_set = units_set_some(&estimates);
     let listening = if !units.is_empty() {
         fit_by_listening(&model, &mut estimates, recordings, capacity_ml)
     } else {
         None
     };
+    // With no constant from the units and none by listening, the model would be the default
+    // bottle: a model of no recording, which is refused as one of none would be.
+    if !units_set && listening.is_none() {
+        return Err(FitError::NothingNearer {
+            what: format!("liquid `{liquid}`"),
+            used: units.len(),
+            detected,
+        });
+    }
     if let Some(listening) = &listening {
         warnings.push(format!(
             "liquid `{liquid}`: the units' model did not sound like its recordings, so {} were \
@@ -583,7 +597,7 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
         kept_default = kept_at_default(&estimates, inputs.curves);
         model = model_toml(&estimates, &kept_default);
     }
-    LiquidFit {
+    Ok(LiquidFit {
         listening,
         liquid: liquid.to_owned(),
         units: units.len(),
@@ -593,7 +607,7 @@ pub(crate) fn fit_liquid(inputs: &LiquidInputs, warnings: &mut Vec<String>) -> L
         kept_default,
         model_toml: model,
         amplitude_law: law,
-    }
+    })
 }
 
 /// The lowest and highest V_i of the units the model was fitted from, if any has a volume: what

@@ -97,7 +97,7 @@ pub fn fit_session(session: &FitSession) -> Result<SessionFit, FitError> {
             rates: &rates[liquid],
             modes: modes[liquid],
         };
-        liquids.push(fit_liquid(&inputs, &mut warnings));
+        liquids.push(fit_liquid(&inputs, &mut warnings)?);
     }
     Ok(SessionFit {
         session: session.clone(),
