@@ -50,41 +50,51 @@ pub struct AnchoredComponent {
 /// Components a SIMD group of the anchors' step holds: AVX2's 4 f64 (two SSE2 pairs).
 const LANES: usize = 4;
 
-/// The anchored bank's per-period state, one entry per component in the bank's order (structure
-/// of arrays), so that a period's step of every component is one loop over plain f64 arrays, a
-/// SIMD group of components at a time ([`step_anchors`]). Entries from `len` on are not
-/// components; the step runs over them to the end of the last group, harmlessly.
+/// The anchored bank's per-period state, one entry per component in the bank's order, kept as
+/// arrays of [`LANES`] entries ([`Group`]), so that a period's step of every component is one
+/// loop over plain f64 arrays, a SIMD group of components at a time ([`step_anchors`]). Entry `i`
+/// is lane `i % LANES` of group `i / LANES`. Entries from `len` on are not components; the step
+/// runs over them to the end of the last group, harmlessly.
 pub struct Anchors {
     len: usize,
-    /// One allocation, so that the compiler knows the arrays apart.
-    lanes: Box<Lanes>,
+    /// One allocation; a bank of n components touches only the first ⌈n / LANES⌉ groups, one
+    /// contiguous run of memory.
+    groups: Box<[Group; GROUPS]>,
     /// The earliest `event_at`: before it, a period's step is the array loop alone.
     first_event_at: u64,
     period_sum: PeriodSum,
 }
 
-/// The arrays of [`Anchors`].
-struct Lanes {
+/// Groups of [`LANES`] entries in [`Anchors`].
+const GROUPS: usize = MAX_COMPONENTS / LANES;
+
+/// The state of [`LANES`] entries of [`Anchors`], each field an array of one SIMD group (structure
+/// of arrays within the group, the groups one after another: a group is 5 cache lines, where
+/// whole arrays of [`MAX_COMPONENTS`] put a few components' state on some 20 lines over 5 pages,
+/// which a thousand C-library handles in 64-frame calls paid for in cache and TLB misses).
+#[derive(Clone, Copy)]
+#[repr(C, align(64))]
+struct Group {
     /// State at the first sample of the period being rendered (or of the component, if it
     /// starts later), in f32 for the synthesis.
-    anchor_re: [f32; MAX_COMPONENTS],
-    anchor_im: [f32; MAX_COMPONENTS],
+    anchor_re: [f32; LANES],
+    anchor_im: [f32; LANES],
     /// The same in f64, as it was worked out: what the level is read from.
-    level_re: [f64; MAX_COMPONENTS],
-    level_im: [f64; MAX_COMPONENTS],
+    level_re: [f64; LANES],
+    level_im: [f64; LANES],
     /// State at the first sample of the next period.
-    next_re: [f64; MAX_COMPONENTS],
-    next_im: [f64; MAX_COMPONENTS],
+    next_re: [f64; LANES],
+    next_im: [f64; LANES],
     /// z^GRID.
-    step_re: [f64; MAX_COMPONENTS],
-    step_im: [f64; MAX_COMPONENTS],
-    anchor_sample: [u64; MAX_COMPONENTS],
+    step_re: [f64; LANES],
+    step_im: [f64; LANES],
+    anchor_sample: [u64; LANES],
     /// The first period start at which the component needs more than the plain step
     /// ([`AnchoredComponent::at_event`]): its silence, its next direct anchor, every period of a
     /// glide, and the boundary it starts on.
-    event_at: [u64; MAX_COMPONENTS],
+    event_at: [u64; LANES],
     /// The period start at which the anchor is next worked out from the closed form.
-    direct_at: [u64; MAX_COMPONENTS],
+    direct_at: [u64; LANES],
 }
 
 const _: () = assert!(MAX_COMPONENTS.is_multiple_of(LANES));
@@ -94,19 +104,21 @@ impl Default for Anchors {
     fn default() -> Self {
         Self {
             len: 0,
-            lanes: Box::new(Lanes {
-                anchor_re: [0.0; MAX_COMPONENTS],
-                anchor_im: [0.0; MAX_COMPONENTS],
-                level_re: [0.0; MAX_COMPONENTS],
-                level_im: [0.0; MAX_COMPONENTS],
-                next_re: [0.0; MAX_COMPONENTS],
-                next_im: [0.0; MAX_COMPONENTS],
-                step_re: [0.0; MAX_COMPONENTS],
-                step_im: [0.0; MAX_COMPONENTS],
-                anchor_sample: [0; MAX_COMPONENTS],
-                event_at: [0; MAX_COMPONENTS],
-                direct_at: [0; MAX_COMPONENTS],
-            }),
+            groups: Box::new(
+                [Group {
+                    anchor_re: [0.0; LANES],
+                    anchor_im: [0.0; LANES],
+                    level_re: [0.0; LANES],
+                    level_im: [0.0; LANES],
+                    next_re: [0.0; LANES],
+                    next_im: [0.0; LANES],
+                    step_re: [0.0; LANES],
+                    step_im: [0.0; LANES],
+                    anchor_sample: [0; LANES],
+                    event_at: [0; LANES],
+                    direct_at: [0; LANES],
+                }; GROUPS],
+            ),
             first_event_at: u64::MAX,
             period_sum: PeriodSum::default(),
         }
@@ -124,40 +136,76 @@ impl Anchors {
     fn set(&mut self, index: usize, component: &AnchoredComponent) {
         let first_sample = component.component.first_sample();
         self.set_anchor(index, component.first_anchor);
-        [self.lanes.next_re[index], self.lanes.next_im[index]] = component.first_next_anchor;
-        [self.lanes.step_re[index], self.lanes.step_im[index]] = component.period_step;
-        self.lanes.anchor_sample[index] = first_sample;
+        let (group, lane) = self.entry_mut(index);
+        [group.next_re[lane], group.next_im[lane]] = component.first_next_anchor;
+        [group.step_re[lane], group.step_im[lane]] = component.period_step;
+        group.anchor_sample[lane] = first_sample;
         // The counter it replaces counted the periods stepped after the one it starts in: the
         // 1024th is worked out from the closed form.
         let first_period = (first_sample / GRID as u64 + 1) * GRID as u64;
-        self.lanes.direct_at[index] = first_period + (PERIODS_PER_DIRECT_ANCHOR - 1) * GRID as u64;
-        self.lanes.event_at[index] = if first_sample.is_multiple_of(GRID as u64) {
+        group.direct_at[lane] = first_period + (PERIODS_PER_DIRECT_ANCHOR - 1) * GRID as u64;
+        group.event_at[lane] = if first_sample.is_multiple_of(GRID as u64) {
             first_sample
         } else {
-            component.next_event(self.lanes.direct_at[index])
+            component.next_event(group.direct_at[lane])
         };
-        self.first_event_at = self.first_event_at.min(self.lanes.event_at[index]);
+        let event_at = group.event_at[lane];
+        self.first_event_at = self.first_event_at.min(event_at);
     }
 
     fn set_anchor(&mut self, index: usize, state: [f64; 2]) {
-        [self.lanes.level_re[index], self.lanes.level_im[index]] = state;
-        self.lanes.anchor_re[index] = state[0] as f32;
-        self.lanes.anchor_im[index] = state[1] as f32;
+        let (group, lane) = self.entry_mut(index);
+        [group.level_re[lane], group.level_im[lane]] = state;
+        group.anchor_re[lane] = state[0] as f32;
+        group.anchor_im[lane] = state[1] as f32;
+    }
+
+    /// Entry `index`: its group, and its lane in the group.
+    #[inline]
+    fn entry(&self, index: usize) -> (&Group, usize) {
+        (&self.groups[index / LANES], index % LANES)
+    }
+
+    /// The same, to change.
+    #[inline]
+    fn entry_mut(&mut self, index: usize) -> (&mut Group, usize) {
+        (&mut self.groups[index / LANES], index % LANES)
     }
 
     /// Moves entry `from` to `to` (`to` < `from`, dropping what was there).
     fn move_entry(&mut self, from: usize, to: usize) {
-        self.lanes.anchor_re[to] = self.lanes.anchor_re[from];
-        self.lanes.anchor_im[to] = self.lanes.anchor_im[from];
-        self.lanes.level_re[to] = self.lanes.level_re[from];
-        self.lanes.level_im[to] = self.lanes.level_im[from];
-        self.lanes.next_re[to] = self.lanes.next_re[from];
-        self.lanes.next_im[to] = self.lanes.next_im[from];
-        self.lanes.step_re[to] = self.lanes.step_re[from];
-        self.lanes.step_im[to] = self.lanes.step_im[from];
-        self.lanes.anchor_sample[to] = self.lanes.anchor_sample[from];
-        self.lanes.event_at[to] = self.lanes.event_at[from];
-        self.lanes.direct_at[to] = self.lanes.direct_at[from];
+        let groups = &mut *self.groups;
+        let (from_group, from) = (from / LANES, from % LANES);
+        let (to_group, to) = (to / LANES, to % LANES);
+        macro_rules! move_fields {
+            ($($field:ident),*) => {
+                $(groups[to_group].$field[to] = groups[from_group].$field[from];)*
+            };
+        }
+        move_fields!(
+            anchor_re,
+            anchor_im,
+            level_re,
+            level_im,
+            next_re,
+            next_im,
+            step_re,
+            step_im,
+            anchor_sample,
+            event_at,
+            direct_at
+        );
+    }
+
+    /// How many entries from the first are anchored at `sample`.
+    #[inline]
+    fn leading_at(&self, sample: u64) -> usize {
+        (0..self.len)
+            .take_while(|&index| {
+                let (group, lane) = self.entry(index);
+                group.anchor_sample[lane] == sample
+            })
+            .count()
     }
 }
 
@@ -190,7 +238,8 @@ impl BankComponent for AnchoredComponent {
     }
 
     fn level_in(_: &[Self], anchors: &Anchors, index: usize) -> f64 {
-        squared_level([anchors.lanes.level_re[index], anchors.lanes.level_im[index]])
+        let (group, lane) = anchors.entry(index);
+        squared_level([group.level_re[lane], group.level_im[lane]])
     }
 
     fn joined(anchors: &mut Anchors, components: &[Self]) {
@@ -221,13 +270,13 @@ impl BankComponent for AnchoredComponent {
         let mut index = 0;
         let mut kept = 0;
         components.retain_mut(|component| {
-            let sounds = period_start < anchors.lanes.event_at[index]
+            let sounds = period_start < anchors.entry(index).0.event_at[index % LANES]
                 || component.at_event(anchors, index, period_start);
             if sounds {
                 if kept != index {
                     anchors.move_entry(index, kept);
                 }
-                first_event_at = first_event_at.min(anchors.lanes.event_at[kept]);
+                first_event_at = first_event_at.min(anchors.entry(kept).0.event_at[kept % LANES]);
                 kept += 1;
             }
             index += 1;
@@ -240,18 +289,9 @@ impl BankComponent for AnchoredComponent {
     type Shared = Anchors;
 
     fn write_all(components: &mut [Self], anchors: &mut Anchors, span_start: u64, out: &mut [f32]) {
-        let period_sum = &mut anchors.period_sum;
         if let Ok(period) = <&mut [f32; GRID]>::try_from(&mut *out) {
-            if anchors.lanes.anchor_sample[..anchors.len]
-                .iter()
-                .all(|&anchor_sample| anchor_sample == span_start)
-            {
-                sum_period(
-                    components,
-                    &anchors.lanes.anchor_re[..],
-                    &anchors.lanes.anchor_im[..],
-                    period,
-                );
+            if anchors.leading_at(span_start) == anchors.len {
+                sum_period(components, &anchors.groups[..], period);
                 return;
             }
         }
@@ -260,31 +300,28 @@ impl BankComponent for AnchoredComponent {
         // period once, in registers, and each span of the period takes its part of that sum, then
         // adds the components that started since.
         let period_start = span_start / GRID as u64 * GRID as u64;
-        if period_sum.period_start != Some(period_start) {
+        if anchors.period_sum.period_start != Some(period_start) {
             // They lead the bank: a component joins at its end, and one that starts at a
             // period's first sample joined in the period before.
-            let leading = anchors.lanes.anchor_sample[..anchors.len]
-                .iter()
-                .take_while(|&&anchor_sample| anchor_sample == period_start)
-                .count();
+            let leading = anchors.leading_at(period_start);
+            let period_sum = &mut anchors.period_sum;
             sum_period(
                 &components[..leading],
-                &anchors.lanes.anchor_re[..],
-                &anchors.lanes.anchor_im[..],
+                &anchors.groups[..],
                 &mut period_sum.samples,
             );
             period_sum.components = leading;
             period_sum.period_start = Some(period_start);
         }
+        let period_sum = &anchors.period_sum;
         let offset = (span_start - period_start) as usize;
         out.copy_from_slice(&period_sum.samples[offset..offset + out.len()]);
         let since = period_sum.components;
         if since < components.len() {
             add_each(
-                &components[since..],
-                &anchors.lanes.anchor_re[since..anchors.len],
-                &anchors.lanes.anchor_im[since..anchors.len],
-                &anchors.lanes.anchor_sample[since..anchors.len],
+                &components[since..anchors.len],
+                &anchors.groups[..],
+                since,
                 span_start,
                 out,
             );
@@ -329,26 +366,16 @@ fn squared_level([re, im]: [f64; 2]) -> f64 {
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
 fn step_anchors(anchors: &mut Anchors, period_start: u64) {
     let groups = anchors.len.div_ceil(LANES);
-    let lanes = &mut *anchors.lanes;
-    let (anchor_re, _) = lanes.anchor_re.as_chunks_mut::<LANES>();
-    let (anchor_im, _) = lanes.anchor_im.as_chunks_mut::<LANES>();
-    let (level_re, _) = lanes.level_re.as_chunks_mut::<LANES>();
-    let (level_im, _) = lanes.level_im.as_chunks_mut::<LANES>();
-    let (next_re, _) = lanes.next_re.as_chunks_mut::<LANES>();
-    let (next_im, _) = lanes.next_im.as_chunks_mut::<LANES>();
-    let (step_re, _) = lanes.step_re.as_chunks::<LANES>();
-    let (step_im, _) = lanes.step_im.as_chunks::<LANES>();
-    let (anchor_sample, _) = lanes.anchor_sample.as_chunks_mut::<LANES>();
-    for group in 0..groups {
-        let (re, im) = (next_re[group], next_im[group]);
-        let (z_re, z_im) = (step_re[group], step_im[group]);
-        anchor_re[group] = re.map(|re| re as f32);
-        anchor_im[group] = im.map(|im| im as f32);
-        level_re[group] = re;
-        level_im[group] = im;
-        next_re[group] = std::array::from_fn(|k| re[k] * z_re[k] - im[k] * z_im[k]);
-        next_im[group] = std::array::from_fn(|k| re[k] * z_im[k] + im[k] * z_re[k]);
-        anchor_sample[group] = [period_start; LANES];
+    for group in &mut anchors.groups[..groups] {
+        let (re, im) = (group.next_re, group.next_im);
+        let (z_re, z_im) = (group.step_re, group.step_im);
+        group.anchor_re = re.map(|re| re as f32);
+        group.anchor_im = im.map(|im| im as f32);
+        group.level_re = re;
+        group.level_im = im;
+        group.next_re = std::array::from_fn(|k| re[k] * z_re[k] - im[k] * z_im[k]);
+        group.next_im = std::array::from_fn(|k| re[k] * z_im[k] + im[k] * z_re[k]);
+        group.anchor_sample = [period_start; LANES];
     }
 }
 
@@ -399,28 +426,28 @@ impl AnchoredComponent {
         if self.component.first_sample() == period_start {
             // Started on this very boundary: its anchor already belonged to the new period.
             anchors.set_anchor(index, self.first_anchor);
-            [anchors.lanes.next_re[index], anchors.lanes.next_im[index]] = self.first_next_anchor;
-            anchors.lanes.event_at[index] = self.next_event(anchors.lanes.direct_at[index]);
+            let (group, lane) = anchors.entry_mut(index);
+            [group.next_re[lane], group.next_im[lane]] = self.first_next_anchor;
+            group.event_at[lane] = self.next_event(group.direct_at[lane]);
             return true;
         }
         if period_start >= self.silent_from {
             return false;
         }
+        let (group, lane) = anchors.entry_mut(index);
         if self.component.glide.is_some() {
             // A glide's phase is no fixed rotation a period: each anchor is the closed form's.
-            [anchors.lanes.next_re[index], anchors.lanes.next_im[index]] =
-                self.component.state_at(following);
+            [group.next_re[lane], group.next_im[lane]] = self.component.state_at(following);
             if self.gliding {
                 self.fill_powers(period_start);
             }
             return true;
         }
-        if period_start >= anchors.lanes.direct_at[index] {
-            [anchors.lanes.next_re[index], anchors.lanes.next_im[index]] =
-                self.component.state_at(following);
-            anchors.lanes.direct_at[index] += PERIODS_PER_DIRECT_ANCHOR * GRID as u64;
+        if period_start >= group.direct_at[lane] {
+            [group.next_re[lane], group.next_im[lane]] = self.component.state_at(following);
+            group.direct_at[lane] += PERIODS_PER_DIRECT_ANCHOR * GRID as u64;
         }
-        anchors.lanes.event_at[index] = self.next_event(anchors.lanes.direct_at[index]);
+        group.event_at[lane] = self.next_event(group.direct_at[lane]);
         true
     }
 
@@ -482,15 +509,16 @@ impl AnchoredComponent {
 /// The period is held in registers (64 f32: 8 AVX2 or 4 AVX-512 registers), so each component
 /// costs its multiplications and additions and no loads and stores of the output.
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
-fn sum_period(
-    components: &[AnchoredComponent],
-    anchor_re: &[f32],
-    anchor_im: &[f32],
-    out: &mut [f32; GRID],
-) {
+fn sum_period(components: &[AnchoredComponent], groups: &[Group], out: &mut [f32; GRID]) {
     let mut sum = [0.0; GRID];
-    for ((component, &re), &im) in components.iter().zip(anchor_re).zip(anchor_im) {
-        component.synthesize_period([re, im], &mut sum);
+    for (components, group) in components.chunks(LANES).zip(groups) {
+        for ((component, &re), &im) in components
+            .iter()
+            .zip(&group.anchor_re)
+            .zip(&group.anchor_im)
+        {
+            component.synthesize_period([re, im], &mut sum);
+        }
     }
     *out = sum;
 }
@@ -500,18 +528,18 @@ fn sum_period(
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
 fn add_each(
     components: &[AnchoredComponent],
-    anchor_re: &[f32],
-    anchor_im: &[f32],
-    anchor_sample: &[u64],
+    groups: &[Group],
+    first: usize,
     span_start: u64,
     out: &mut [f32],
 ) {
-    for (((component, &re), &im), &sample) in components
-        .iter()
-        .zip(anchor_re)
-        .zip(anchor_im)
-        .zip(anchor_sample)
-    {
-        component.synthesize([re, im], sample, span_start, out);
+    for (index, component) in (first..).zip(components) {
+        let (group, lane) = (&groups[index / LANES], index % LANES);
+        component.synthesize(
+            [group.anchor_re[lane], group.anchor_im[lane]],
+            group.anchor_sample[lane],
+            span_start,
+            out,
+        );
     }
 }
