@@ -22,22 +22,33 @@ pub const STARTS_PER_SECOND: f64 = 6000.0;
 
 /// A component as one synthesis path renders it: what its [`Bank`] holds.
 pub trait BankComponent: Sized {
-    /// What the path keeps between the spans of one grid period (the anchored path: the period
-    /// summed over the components that sound from its start, so that a period cut into small
-    /// spans is summed once); `()` for none. The bank starts it afresh whenever its components
-    /// change other than by one joining at the end.
-    type PeriodSum: Default;
+    /// What the path keeps beside its components, in the bank's order (the anchored path: their
+    /// per-period state as arrays, and the period summed over the components that sound from its
+    /// start); `()` for none. Made once, when the bank is (it may allocate); the bank tells it of
+    /// every change to its components through the hooks below, so it is never made again.
+    type Shared: Default;
     /// The component from its first sample on.
     fn start(component: Component) -> Self;
-    /// Any measure that orders components by loudness.
+    /// Any measure that orders components by loudness, of one not yet in a bank.
     fn level(&self) -> f64;
-    /// Moves to the grid period starting at `period_start`; false once the component is silent.
-    fn advance(&mut self, period_start: u64) -> bool;
+    /// The same measure, of `components[index]` in a bank.
+    fn level_in(components: &[Self], _shared: &Self::Shared, index: usize) -> f64 {
+        components[index].level()
+    }
+    /// The last of `components` has just joined the bank.
+    fn joined(_shared: &mut Self::Shared, _components: &[Self]) {}
+    /// `components[index]` has just been replaced by a new one.
+    fn replaced(_shared: &mut Self::Shared, _components: &[Self], _index: usize) {}
+    /// Every component has been dropped.
+    fn cleared(_shared: &mut Self::Shared) {}
+    /// Moves every component to the grid period starting at `period_start`, dropping the silent
+    /// ones and keeping the others in their order.
+    fn advance_all(components: &mut Vec<Self>, shared: &mut Self::Shared, period_start: u64);
     /// Writes the sum of every component of a bank, in its order and from +0, to `out`, which
     /// starts at absolute sample `span_start` and lies within one grid period.
     fn write_all(
         components: &mut [Self],
-        period_sum: &mut Self::PeriodSum,
+        shared: &mut Self::Shared,
         span_start: u64,
         out: &mut [f32],
     );
@@ -75,7 +86,7 @@ impl StartBudget {
 /// A synthesis path: the sounding components of kind `C`, allocation-free after `new()`.
 pub struct Bank<C: BankComponent> {
     sounding: Vec<C>,
-    period_sum: C::PeriodSum,
+    shared: C::Shared,
     sample_rate: f64,
     /// Components given up because the bank was full or the start budget was spent (both
     /// components of a unit refused by the budget count).
@@ -89,7 +100,7 @@ impl<C: BankComponent> Synthesis for Bank<C> {
     fn new(sample_rate: f64) -> Self {
         Self {
             sounding: Vec::with_capacity(MAX_COMPONENTS),
-            period_sum: C::PeriodSum::default(),
+            shared: C::Shared::default(),
             sample_rate,
             given_up: 0,
             budget: StartBudget::FULL,
@@ -99,7 +110,7 @@ impl<C: BankComponent> Synthesis for Bank<C> {
 
     fn clear(&mut self) {
         self.sounding.clear();
-        self.period_sum = C::PeriodSum::default();
+        C::cleared(&mut self.shared);
         self.given_up = 0;
         self.budget = StartBudget::FULL;
     }
@@ -141,12 +152,11 @@ impl<C: BankComponent> Synthesis for Bank<C> {
 
     #[inline]
     fn synthesize(&mut self, span_start: u64, out: &mut [f32]) {
-        C::write_all(&mut self.sounding, &mut self.period_sum, span_start, out);
+        C::write_all(&mut self.sounding, &mut self.shared, span_start, out);
     }
 
     fn advance(&mut self, period_start: u64) {
-        self.sounding
-            .retain_mut(|component| component.advance(period_start));
+        C::advance_all(&mut self.sounding, &mut self.shared, period_start);
     }
 }
 
@@ -156,20 +166,19 @@ impl<C: BankComponent> Bank<C> {
     fn insert(&mut self, new: C) -> bool {
         if self.sounding.len() < MAX_COMPONENTS {
             self.sounding.push(new);
+            C::joined(&mut self.shared, &self.sounding);
             self.peak_len = self.peak_len.max(self.sounding.len());
             return true;
         }
         self.given_up += 1;
-        let weakest = self
-            .sounding
-            .iter_mut()
-            .min_by(|a, b| a.level().total_cmp(&b.level()))
+        let level = |index| C::level_in(&self.sounding, &self.shared, index);
+        let weakest = (0..self.sounding.len())
+            .min_by(|&a, &b| level(a).total_cmp(&level(b)))
             .expect("a full bank is not empty");
-        let louder = weakest.level() < new.level();
+        let louder = level(weakest) < new.level();
         if louder {
-            *weakest = new;
-            // A component replaced in the middle of the bank: the period's sum is not its own.
-            self.period_sum = C::PeriodSum::default();
+            self.sounding[weakest] = new;
+            C::replaced(&mut self.shared, &self.sounding, weakest);
         }
         louder
     }

@@ -67,17 +67,11 @@ impl<T: Float> BankComponent for RecursiveComponent<T> {
         self.state.norm().to_f64().unwrap_or(0.0)
     }
 
-    fn advance(&mut self, period_start: u64) -> bool {
-        if period_start >= self.silent_from {
-            return false;
-        }
-        if period_start.is_multiple_of(REANCHOR_SAMPLES) && self.next_sample == period_start {
-            self.anchor_at(period_start);
-        }
-        true
-    }
+    type Shared = ();
 
-    type PeriodSum = ();
+    fn advance_all(components: &mut Vec<Self>, _: &mut (), period_start: u64) {
+        components.retain_mut(|component| component.advance(period_start));
+    }
 
     fn write_all(components: &mut [Self], _: &mut (), span_start: u64, out: &mut [f32]) {
         // The span's sum in the path's own precision, before it meets the f32 output.
@@ -94,6 +88,17 @@ impl<T: Float> BankComponent for RecursiveComponent<T> {
 }
 
 impl<T: Float> RecursiveComponent<T> {
+    /// Moves to the grid period starting at `period_start`; false once the component is silent.
+    fn advance(&mut self, period_start: u64) -> bool {
+        if period_start >= self.silent_from {
+            return false;
+        }
+        if period_start.is_multiple_of(REANCHOR_SAMPLES) && self.next_sample == period_start {
+            self.anchor_at(period_start);
+        }
+        true
+    }
+
     /// Sets the state from the closed form at `sample`.
     fn anchor_at(&mut self, sample: u64) {
         self.state = to_complex(self.component.state_at(sample));
