@@ -982,6 +982,16 @@ fn a_glide_its_gliding_units_agree_on_is_the_bottles() {
     assert_draws_pass(&[3009, 1033], &[0, 8]);
 }
 
+/// Draws 3049 and 3058 of the development set: a cavity gliding 1.8-fold into a pitch that falls as
+/// the bottle empties, 18 of 46 and 5 of 20 units fitted steady. A steady unit's pitch lies
+/// between where the glide starts and its own f, so only the units fitted gliding place the
+/// model's f (MODEL.md §13, Estimates): f1 comes within tolerance, where the steady units, taken
+/// as heard, pulled it low (232 Hz for 249, 88 for 93).
+#[test]
+fn a_gliding_cavitys_pitch_is_placed_by_its_units_that_glide() {
+    assert_draws_pass(&[3049, 3058], &[0]);
+}
+
 /// Draw 3042 of the development set: a steady cavity at 322 Hz and a bubble mode at 825 Hz, both
 /// in each of its 27 units, and hum at 50 Hz in two units' fits. The two modes are the liquid's
 /// (MODEL.md §13, the bottle's two modes), where the hum, left in the split, widened f1's group

@@ -184,6 +184,7 @@ fn pitch_points(
             .iter()
             .filter(|u| u.volume_ml.is_finite() && u.fit.frequency_hz[k].is_finite())
             .map(|u| (capacity_ml - u.volume_ml, own(u, k)))
+            .filter(|(_, hz)| hz.is_finite())
             .collect()
     })
 }
@@ -207,11 +208,14 @@ fn heard_hz(unit: &FittedUnit, k: usize) -> f64 {
 /// glides the units' fits traded for it would only move where that search starts. `glide` and
 /// `decay_per_s` are the model's ([`glides`], [`unit_decays`]' medians).
 fn own_hz(
+    units: &[FittedUnit],
     glide: [(f64, f64); 2],
     decay_per_s: [f64; 2],
     glides_heard: bool,
 ) -> impl Fn(&FittedUnit, usize) -> f64 {
     let decay = decay_per_s;
+    let enough_gliding = [0, 1]
+        .map(|k| units.iter().filter(|u| u.fit.glide[k].is_some()).count() >= MIN_AGREEING_GLIDES);
     let factor = [0, 1].map(|k| {
         let (ratio, time_ms) = glide[k];
         (glides_heard
@@ -227,6 +231,12 @@ fn own_hz(
         })
     });
     move |unit, k| match factor[k] {
+        // A unit fitted steady in a gliding mode read a pitch between the glide's start and its
+        // own f, wherever its window began (a development draw's 177 Hz between gliding
+        // neighbours heard at 223 and 189): where enough units glide, it places no f.
+        Some(_) if enough_gliding[k] && unit.fit.glide[k].is_none() && !unit.fit.swept[k] => {
+            f64::NAN
+        }
         Some(factor) => heard_hz(unit, k) / factor,
         None => unit.fit.frequency_hz[k],
     }
@@ -263,7 +273,7 @@ fn headspace_law(
     glides_heard: bool,
 ) -> HeadspaceLaw {
     let decay = unit_decays(units).map(|b| median(&b));
-    let own = own_hz(glides(units, glides_heard), decay, glides_heard);
+    let own = own_hz(units, glides(units, glides_heard), decay, glides_heard);
     let points = pitch_points(units, capacity_ml, &own);
     fit_law([&points[0], &points[1]], pocket_ml)
 }
@@ -296,7 +306,7 @@ fn unit_estimates(
     // The model's glides and decays, worked out once: the own f of every unit depends on them.
     let glide = glides(units, glides_heard);
     let b = unit_decays(units);
-    let own = own_hz(glide, [median(&b[0]), median(&b[1])], glides_heard);
+    let own = own_hz(units, glide, [median(&b[0]), median(&b[1])], glides_heard);
     let points = pitch_points(units, capacity_ml, &own);
     let law = fit_law([&points[0], &points[1]], pocket_ml);
     // Where a mode follows the headspace, its spread is the scatter around the law (as the
