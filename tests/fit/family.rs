@@ -244,12 +244,6 @@ impl Fitted {
     fn constant(&self, constant: Constant) -> f64 {
         (constant.spec().get)(&self.scene.config)
     }
-
-    /// Mode k's pitch where its ring's energy is centred, 1/(2B) after a unit's onset: its own
-    /// f, moved by its glide (MODEL.md §5.2) there.
-    fn heard_hz(&self, k: usize) -> f64 {
-        super::heard_hz(&self.scene, k)
-    }
 }
 
 /// One constant judged: its truth in the simulator, its value in the fitted model, its tolerance
@@ -286,7 +280,7 @@ const MEASURES: [Measure; 9] = [
               truth and in the model alike (a glide slower than the ring never reaches the mode's \
               own f: no listener, and no fit, hears that)",
         truth: |s| s.cavity_hz[0] * s.cavity_glide.factor(0.5 / s.cavity_decay),
-        model: |m| m.heard_hz(0),
+        model: |m| super::heard_hz(&m.scene, 0),
     },
     Measure {
         name: "f2 (Hz)",
@@ -295,7 +289,7 @@ const MEASURES: [Measure; 9] = [
         why: "the bubble mode's pitch, heard as f1's (the truth's decay the median of the \
               glugs' drawn decays)",
         truth: |s| s.bubble_hz[0] * s.bubble_glide.factor(0.5 / median(&s.bubble_decay)),
-        model: |m| m.heard_hz(1),
+        model: |m| super::heard_hz(&m.scene, 1),
     },
     Measure {
         name: "B1 (/s)",

@@ -72,7 +72,7 @@ const GROUPS: usize = MAX_COMPONENTS / LANES;
 /// of arrays within the group, the groups one after another: a group is 5 cache lines, where
 /// whole arrays of [`MAX_COMPONENTS`] put a few components' state on some 20 lines over 5 pages,
 /// which a thousand C-library handles in 64-frame calls paid for in cache and TLB misses).
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Default)]
 #[repr(C, align(64))]
 struct Group {
     /// State at the first sample of the period being rendered (or of the component, if it
@@ -104,21 +104,7 @@ impl Default for Anchors {
     fn default() -> Self {
         Self {
             len: 0,
-            groups: Box::new(
-                [Group {
-                    anchor_re: [0.0; LANES],
-                    anchor_im: [0.0; LANES],
-                    level_re: [0.0; LANES],
-                    level_im: [0.0; LANES],
-                    next_re: [0.0; LANES],
-                    next_im: [0.0; LANES],
-                    step_re: [0.0; LANES],
-                    step_im: [0.0; LANES],
-                    anchor_sample: [0; LANES],
-                    event_at: [0; LANES],
-                    direct_at: [0; LANES],
-                }; GROUPS],
-            ),
+            groups: Box::new([Group::default(); GROUPS]),
             first_event_at: u64::MAX,
             period_sum: PeriodSum::default(),
         }
@@ -270,13 +256,15 @@ impl BankComponent for AnchoredComponent {
         let mut index = 0;
         let mut kept = 0;
         components.retain_mut(|component| {
-            let sounds = period_start < anchors.entry(index).0.event_at[index % LANES]
+            let (group, lane) = anchors.entry(index);
+            let sounds = period_start < group.event_at[lane]
                 || component.at_event(anchors, index, period_start);
             if sounds {
                 if kept != index {
                     anchors.move_entry(index, kept);
                 }
-                first_event_at = first_event_at.min(anchors.entry(kept).0.event_at[kept % LANES]);
+                let (group, lane) = anchors.entry(kept);
+                first_event_at = first_event_at.min(group.event_at[lane]);
                 kept += 1;
             }
             index += 1;
@@ -320,7 +308,7 @@ impl BankComponent for AnchoredComponent {
         if since < components.len() {
             add_each(
                 &components[since..anchors.len],
-                &anchors.groups[..],
+                anchors,
                 since,
                 span_start,
                 out,
@@ -528,13 +516,13 @@ fn sum_period(components: &[AnchoredComponent], groups: &[Group], out: &mut [f32
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
 fn add_each(
     components: &[AnchoredComponent],
-    groups: &[Group],
+    anchors: &Anchors,
     first: usize,
     span_start: u64,
     out: &mut [f32],
 ) {
     for (index, component) in (first..).zip(components) {
-        let (group, lane) = (&groups[index / LANES], index % LANES);
+        let (group, lane) = anchors.entry(index);
         component.synthesize(
             [group.anchor_re[lane], group.anchor_im[lane]],
             group.anchor_sample[lane],
