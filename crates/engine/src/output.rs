@@ -250,7 +250,7 @@ impl OutputStage {
     /// its part. False, leaving `out` as it was, where the limiter has more to do in the period
     /// (then the block is applied on its own). The same bits: [`gain_and_flush`] works sample by
     /// sample, and a period with no sample past the ceiling has none in any part of it.
-    #[inline]
+    #[inline(always)]
     pub fn apply_settled_from(
         &mut self,
         sum: &[f32; GRID],

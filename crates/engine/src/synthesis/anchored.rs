@@ -304,7 +304,7 @@ impl BankComponent for AnchoredComponent {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn period_sum<'a>(
         components: &'a [Self],
         anchors: &'a mut Anchors,
@@ -319,11 +319,17 @@ impl BankComponent for AnchoredComponent {
 
 impl Anchors {
     /// Works out [`PeriodSum`] for the period starting at `period_start`, unless it holds it.
-    #[inline]
+    #[inline(always)]
     fn sum_period_from(&mut self, components: &[AnchoredComponent], period_start: u64) {
-        if self.period_sum.period_start == Some(period_start) {
-            return;
+        // The check in line: every call of a short block makes it, one a period does the sum.
+        if self.period_sum.period_start != Some(period_start) {
+            self.sum_period_anew(components, period_start);
         }
+    }
+
+    /// [`Anchors::sum_period_from`] of a period not yet summed.
+    #[inline(never)]
+    fn sum_period_anew(&mut self, components: &[AnchoredComponent], period_start: u64) {
         // They lead the bank: a component joins at its end, and one that starts at a period's
         // first sample joined in the period before.
         let leading = self.leading_at(period_start);

@@ -163,7 +163,7 @@ impl<C: BankComponent> Synthesis for Bank<C> {
         C::write_all(&mut self.sounding, &mut self.shared, span_start, out);
     }
 
-    #[inline]
+    #[inline(always)]
     fn period_sum(&mut self, span_start: u64) -> Option<(&[f32; GRID], u64)> {
         C::period_sum(&self.sounding, &mut self.shared, span_start)
     }
