@@ -12,5 +12,6 @@ mod onsets;
 mod output_ramps;
 mod pour_spans;
 mod reference_match;
+mod unchanged_blocks;
 mod units;
 mod work_skipped;

@@ -85,6 +85,9 @@ struct Audio {
     /// Whether any of `ramps` is under way: kept as the ramps change, so that the usual call
     /// checks one flag rather than each control's ramp.
     ramping: bool,
+    /// The engine's last block was rendered under `held_lanes` as they are: the next may tell
+    /// it that nothing changed ([`Engine::process_unchanged`]).
+    held_unchanged: bool,
     /// θ of `held`, brought into range: the tilt of a call without a ramp, worked out when a
     /// control call changes it, not at every call.
     held_tilt_deg: f64,
@@ -185,6 +188,7 @@ impl SakeGlug {
                 held_lanes: Controls::constant(held),
                 ramps: PerControl::splat(None),
                 ramping: false,
+                held_unchanged: false,
                 held_tilt_deg: Control::Tilt.range().sanitize(held.tilt_deg),
                 lanes: PerControl::from_fn(|_| vec![0.0; SPAN].into_boxed_slice()),
                 mono: vec![0.0; SPAN].into_boxed_slice(),
@@ -343,6 +347,7 @@ impl Audio {
             self.apply(command);
         }
         self.held_lanes = Controls::constant(self.held);
+        self.held_unchanged = false;
         self.held_tilt_deg = Control::Tilt.range().sanitize(self.held.tilt_deg);
         self.ramping = self.ramps.iter().any(|(_, ramp)| ramp.is_some());
     }
@@ -401,6 +406,7 @@ impl Audio {
             held_lanes,
             ramps,
             ramping,
+            held_unchanged,
             held_tilt_deg,
             lanes,
             units,
@@ -435,17 +441,20 @@ impl Audio {
             *ramping = ramps.iter().any(|(_, ramp)| ramp.is_some());
             &ramp_lanes
         };
-        engine.process_observed(
-            controls,
-            out,
-            &mut |onset, voicing| match units.get_mut(*kept) {
-                Some(unit) => {
-                    *unit = unit_of(onset, voicing, call_start);
-                    *kept += 1;
-                }
-                None => *lost = lost.saturating_add(1),
-            },
-        );
+        let mut keep = |onset: &UnitOnset, voicing| match units.get_mut(*kept) {
+            Some(unit) => {
+                *unit = unit_of(onset, voicing, call_start);
+                *kept += 1;
+            }
+            None => *lost = lost.saturating_add(1),
+        };
+        if !ramped && *held_unchanged {
+            engine.process_unchanged(controls, out, &mut keep);
+        } else {
+            engine.process_observed(controls, out, &mut keep);
+        }
+        // Only a block under `held_lanes` leaves the engine's last controls the held ones.
+        *held_unchanged = !ramped;
         if out.is_empty() {
             return;
         }

@@ -76,6 +76,10 @@ pub struct Engine<S: Synthesis = AnchoredF32> {
     actuator: Option<ActuatorResponse>,
     /// The pour's inputs of the last span that held them constant.
     held_pour: HeldPour,
+    /// The last block was taken whole under constant controls ([`Engine::process_constant`])
+    /// and nothing but rendering has touched the engine since: the pour's inputs and the
+    /// output's targets it took are in force, for [`Engine::process_unchanged`].
+    constant_block_taken: bool,
 }
 
 /// The inputs that drove the pour over the last span that held them constant: as given, and
@@ -154,6 +158,7 @@ impl<S: Synthesis> Engine<S> {
             deferred: [None; MAX_ONSETS_PER_SAMPLE as usize],
             actuator: None,
             held_pour: HeldPour::default(),
+            constant_block_taken: false,
         };
         engine.reset();
         engine
@@ -173,6 +178,7 @@ impl<S: Synthesis> Engine<S> {
     pub fn set_config(&mut self, config: ModelConfig) {
         self.pour.set_config(config);
         self.resting_under = None;
+        self.constant_block_taken = false;
     }
 
     /// Compensates the units that start from now on for `actuator` (`None`: plays the model's
@@ -180,6 +186,7 @@ impl<S: Synthesis> Engine<S> {
     /// Allocation-free: a host may call it between blocks.
     pub fn set_actuator(&mut self, actuator: Option<ActuatorResponse>) {
         self.actuator = actuator;
+        self.constant_block_taken = false;
     }
 
     /// The actuator the units are compensated for, if any.
@@ -210,12 +217,14 @@ impl<S: Synthesis> Engine<S> {
         };
         self.deferred = [None; MAX_ONSETS_PER_SAMPLE as usize];
         self.output.reset();
+        self.constant_block_taken = false;
     }
 
     /// MODEL.md §8 refill: sounding units ring on, the generator goes on.
     pub fn refill(&mut self) {
         self.pour.refill();
         self.resting_under = None;
+        self.constant_block_taken = false;
     }
 
     /// The residual volume V (ml).
@@ -318,6 +327,7 @@ impl<S: Synthesis> Engine<S> {
         out: &mut [f32],
         on_unit: &mut impl FnMut(&UnitOnset, Voicing),
     ) {
+        self.constant_block_taken = false;
         if out.is_empty() {
             return;
         }
@@ -410,6 +420,65 @@ impl<S: Synthesis> Engine<S> {
         if settled {
             self.output.apply_settled(out);
         }
+        self.constant_block_taken = true;
+    }
+
+    /// [`Engine::process_observed`] of a block under the very controls of the last block, every
+    /// lane a constant, the caller knowing that none changed (the C library rebuilds its
+    /// controls only when a control call comes). A block within one grid period, inside the
+    /// pour's plain run, at a settled gain and ceiling (nearly every small block of the C
+    /// library) skips what [`Engine::process_constant`] would find the same: the controls'
+    /// comparison, the output's targets taken again, the walk over spans. The same samples,
+    /// units and state: it takes the pour's closed form and the synthesis as that would, and the
+    /// output stage's one pass.
+    pub fn process_unchanged(
+        &mut self,
+        controls: &Controls,
+        out: &mut [f32],
+        on_unit: &mut impl FnMut(&UnitOnset, Voicing),
+    ) {
+        if !(self.constant_block_taken && self.take_steady_span(out)) {
+            self.process_observed(controls, out, on_unit);
+        }
+    }
+
+    /// [`Engine::process_unchanged`]'s block, if it is one that needs nothing but the plain
+    /// run, the synthesis and the settled output stage; false, having changed nothing, if not.
+    #[inline]
+    fn take_steady_span(&mut self, out: &mut [f32]) -> bool {
+        let len = out.len();
+        let offset = (self.sample % GRID as u64) as usize;
+        if len == 0
+            || offset + len > GRID
+            || self.deferred[0].is_some()
+            || self.resting_under.is_some()
+            || !self.output.is_settled()
+        {
+            return false;
+        }
+        let sanitized = &self.held_pour.sanitized;
+        let Some(advanced) = self.pour.advance_plain(self.sample, len as u64, sanitized) else {
+            return false;
+        };
+        self.poured(advanced, true);
+        if self.synthesis.is_empty() {
+            out.fill(0.0);
+        } else {
+            // A block shorter than a period takes its part of the period's sum through the
+            // output stage, worked out once for the period.
+            let from_period = len < GRID
+                && match self.synthesis.period_sum(self.sample) {
+                    Some((sum, number)) => self.output.apply_settled_from(sum, number, offset, out),
+                    None => false,
+                };
+            if !from_period {
+                self.synthesis.synthesize(self.sample, out);
+                self.output.apply_settled(out);
+            }
+            self.active_until = self.active_until.max(self.sample + len as u64);
+        }
+        self.advance_position(len);
+        true
     }
 
     /// Steps the pour from the position, under the block's `constant` inputs, over at

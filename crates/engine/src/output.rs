@@ -8,6 +8,7 @@ use multiversion::multiversion;
 use super::amplitude::db_to_gain;
 use super::config::{CEILING, OUTPUT_RAMP_S};
 use super::controls::{Control, Lane};
+use super::synthesis::GRID;
 
 /// A value that goes to each new target in a straight line of `len` samples.
 ///
@@ -99,6 +100,20 @@ pub(super) struct OutputStage {
     /// are, with no ramp from whatever came before (a bounce starts from silence).
     fresh: bool,
     pub limiter: LimiterCounts,
+    /// A synthesis period's sum through the settled gain and the flush, for the short blocks
+    /// that each take a part of it ([`OutputStage::apply_settled_from`]).
+    gained: GainedPeriod,
+}
+
+/// [`gain_and_flush`] of a whole period's sum, kept with what it was worked out from.
+#[derive(Debug, Clone)]
+struct GainedPeriod {
+    /// The sum's number (see `Synthesis::period_sum`), and the bits of the gain and the ceiling.
+    key: Option<(u64, u64, u64)>,
+    /// No sample of the period is NaN, infinite or past the ceiling: the limiter does nothing
+    /// more to any part of it.
+    within: bool,
+    samples: [f32; GRID],
 }
 
 impl OutputStage {
@@ -113,6 +128,11 @@ impl OutputStage {
             ceiling: Ramp::settled_at(1.0, ramp_len),
             fresh: true,
             limiter: LimiterCounts::default(),
+            gained: GainedPeriod {
+                key: None,
+                within: false,
+                samples: [0.0; GRID],
+            },
         }
     }
 
@@ -202,6 +222,13 @@ impl OutputStage {
     #[inline]
     pub fn begin_constant_block(&mut self, gain_db: f64, ceiling: f64) -> bool {
         self.begin(gain_db, ceiling);
+        self.is_settled()
+    }
+
+    /// Whether gain and ceiling have reached their targets: a block under the targets last
+    /// taken moves neither.
+    #[inline]
+    pub fn is_settled(&self) -> bool {
         self.gain.is_settled() && self.ceiling.is_settled()
     }
 
@@ -215,6 +242,42 @@ impl OutputStage {
         if gain_and_flush(out, self.gain.value, ceiling) {
             self.limit(out, ceiling);
         }
+    }
+
+    /// [`OutputStage::apply_settled`] of the samples `sum[offset..offset + out.len()]`, written to
+    /// `out`, where `sum` is a synthesis period's sum numbered `number`: the whole period goes
+    /// through the gain and the flush once, and each short block of it (a 16-frame call) copies
+    /// its part. False, leaving `out` as it was, where the limiter has more to do in the period
+    /// (then the block is applied on its own). The same bits: [`gain_and_flush`] works sample by
+    /// sample, and a period with no sample past the ceiling has none in any part of it.
+    #[inline(always)]
+    pub fn apply_settled_from(
+        &mut self,
+        sum: &[f32; GRID],
+        number: u64,
+        offset: usize,
+        out: &mut [f32],
+    ) -> bool {
+        let key = (
+            number,
+            self.gain.value.to_bits(),
+            self.ceiling.value.to_bits(),
+        );
+        let gained = &mut self.gained;
+        if gained.key != Some(key) {
+            gained.key = Some(key);
+            gained.samples = *sum;
+            gained.within = !gain_and_flush(
+                &mut gained.samples,
+                self.gain.value,
+                self.ceiling.value as f32,
+            );
+        }
+        if !gained.within {
+            return false;
+        }
+        out.copy_from_slice(&gained.samples[offset..offset + out.len()]);
+        true
     }
 
     /// Output gain, then the guarantees of MODEL.md §6: finite, within the ceiling, no denormal.

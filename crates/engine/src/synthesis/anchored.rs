@@ -288,19 +288,7 @@ impl BankComponent for AnchoredComponent {
         // period once, in registers, and each span of the period takes its part of that sum, then
         // adds the components that started since.
         let period_start = span_start / GRID as u64 * GRID as u64;
-        if anchors.period_sum.period_start != Some(period_start) {
-            // They lead the bank: a component joins at its end, and one that starts at a
-            // period's first sample joined in the period before.
-            let leading = anchors.leading_at(period_start);
-            let period_sum = &mut anchors.period_sum;
-            sum_period(
-                &components[..leading],
-                &anchors.groups[..],
-                &mut period_sum.samples,
-            );
-            period_sum.components = leading;
-            period_sum.period_start = Some(period_start);
-        }
+        anchors.sum_period_from(components, period_start);
         let period_sum = &anchors.period_sum;
         let offset = (span_start - period_start) as usize;
         out.copy_from_slice(&period_sum.samples[offset..offset + out.len()]);
@@ -315,6 +303,46 @@ impl BankComponent for AnchoredComponent {
             );
         }
     }
+
+    #[inline(always)]
+    fn period_sum<'a>(
+        components: &'a [Self],
+        anchors: &'a mut Anchors,
+        span_start: u64,
+    ) -> Option<(&'a [f32; GRID], u64)> {
+        anchors.sum_period_from(components, span_start / GRID as u64 * GRID as u64);
+        let period_sum = &anchors.period_sum;
+        (period_sum.components == anchors.len)
+            .then_some((&period_sum.samples, period_sum.generation))
+    }
+}
+
+impl Anchors {
+    /// Works out [`PeriodSum`] for the period starting at `period_start`, unless it holds it.
+    #[inline(always)]
+    fn sum_period_from(&mut self, components: &[AnchoredComponent], period_start: u64) {
+        // The check in line: every call of a short block makes it, one a period does the sum.
+        if self.period_sum.period_start != Some(period_start) {
+            self.sum_period_anew(components, period_start);
+        }
+    }
+
+    /// [`Anchors::sum_period_from`] of a period not yet summed.
+    #[inline(never)]
+    fn sum_period_anew(&mut self, components: &[AnchoredComponent], period_start: u64) {
+        // They lead the bank: a component joins at its end, and one that starts at a period's
+        // first sample joined in the period before.
+        let leading = self.leading_at(period_start);
+        let period_sum = &mut self.period_sum;
+        sum_period(
+            &components[..leading],
+            &self.groups[..],
+            &mut period_sum.samples,
+        );
+        period_sum.components = leading;
+        period_sum.period_start = Some(period_start);
+        period_sum.generation = period_sum.generation.wrapping_add(1);
+    }
 }
 
 /// The sum over one grid period of the components that sound from its first sample: see
@@ -327,6 +355,9 @@ pub struct PeriodSum {
     period_start: Option<u64>,
     /// How many components lead the bank in the sum.
     components: usize,
+    /// Counts the sums worked out: tells a sum from the one before (see
+    /// [`Synthesis::period_sum`](super::Synthesis::period_sum)).
+    generation: u64,
 }
 
 impl Default for PeriodSum {
@@ -335,6 +366,7 @@ impl Default for PeriodSum {
             samples: [0.0; GRID],
             period_start: None,
             components: 0,
+            generation: 0,
         }
     }
 }

@@ -4,7 +4,7 @@
 //! component is rendered.
 
 use super::component::Component;
-use super::Synthesis;
+use super::{Synthesis, GRID};
 use crate::pour::UnitOnset;
 
 /// More components than this never sound at once. Past it, a new component replaces the weakest
@@ -52,6 +52,14 @@ pub trait BankComponent: Sized {
         span_start: u64,
         out: &mut [f32],
     );
+    /// [`Synthesis::period_sum`] of a bank: `None` on a path that keeps no sum.
+    fn period_sum<'a>(
+        _components: &'a [Self],
+        _shared: &'a mut Self::Shared,
+        _span_start: u64,
+    ) -> Option<(&'a [f32; GRID], u64)> {
+        None
+    }
 }
 
 /// The start budget of MODEL.md §11: a bucket of at most [`START_BURST_UNITS`] units that refills
@@ -153,6 +161,11 @@ impl<C: BankComponent> Synthesis for Bank<C> {
     #[inline]
     fn synthesize(&mut self, span_start: u64, out: &mut [f32]) {
         C::write_all(&mut self.sounding, &mut self.shared, span_start, out);
+    }
+
+    #[inline(always)]
+    fn period_sum(&mut self, span_start: u64) -> Option<(&[f32; GRID], u64)> {
+        C::period_sum(&self.sounding, &mut self.shared, span_start)
     }
 
     fn advance(&mut self, period_start: u64) {

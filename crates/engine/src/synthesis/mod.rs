@@ -45,6 +45,14 @@ pub trait Synthesis {
     /// Writes the sum of every component, from +0 in the bank's order, to `out` (whatever it
     /// held), which starts at absolute sample `span_start` and lies within one grid period.
     fn synthesize(&mut self, span_start: u64, out: &mut [f32]);
+    /// The sum of every component over the grid period that `span_start` lies in, when what
+    /// [`Synthesis::synthesize`] writes for any span of the period from there is exactly its
+    /// part (no component started since the period's first sample), with a number that is
+    /// another whenever the sum is worked out again; `None` otherwise, or on a path that keeps
+    /// no such sum.
+    fn period_sum(&mut self, _span_start: u64) -> Option<(&[f32; GRID], u64)> {
+        None
+    }
     /// Steps every component to the period starting at `period_start`, dropping silent ones.
     fn advance(&mut self, period_start: u64);
 }
