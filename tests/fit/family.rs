@@ -7,8 +7,8 @@
 //! **held-out** set, run once, at the end. Each prints its table (per draw the truth, the model's
 //! value and a pass or a miss per constant; per constant the share within tolerance and the
 //! draws that miss) and holds docs/fit.md's block to it; the development set is also held to the
-//! goal, each constant within its tolerance in at least 90 % of the draws. Its 180 fits take
-//! 25–45 minutes on 2 cores and the held-out set's 60 take 8–15, so both are `#[ignore]`d,
+//! goal, each constant within its tolerance in at least 90 % of the draws. Its 240 fits take
+//! 35–60 minutes on 2 cores and the held-out set's 60 take 8–15, so both are `#[ignore]`d,
 //! outside CI; `cargo xtask docs family` writes the development block:
 //!
 //! ```sh
@@ -36,12 +36,13 @@ use super::emptying::{
 use super::{add_noise, glug_rms, write_wav};
 
 /// The development set: tune the fit on these draws only. 1001–1060 were the first held-out set,
-/// run once at e092597d (docs/fit.md at 480fbdd5), and 3001–3060 the third, run once at 3c3e0c43
-/// (docs/fit.md there); each has been seen since.
-pub const DEVELOPMENT_SEEDS: [Range<u64>; 3] = [1..61, 1001..1061, 3001..3061];
+/// run once at e092597d (docs/fit.md at 480fbdd5), 3001–3060 the third, run once at 3c3e0c43
+/// (docs/fit.md there), and 4001–4060 the fourth, run once at 544a2369 (docs/fit.md there); each
+/// has been seen since.
+pub const DEVELOPMENT_SEEDS: [Range<u64>; 4] = [1..61, 1001..1061, 3001..3061, 4001..4061];
 /// The held-out set: run once, at the end, and reported whatever it shows. Seeds 2001–2060, a
 /// set before it, were run once with a candidate fit kept off main (docs/fit.md) and are seen.
-pub const HELD_OUT_SEEDS: Range<u64> = 4001..4061;
+pub const HELD_OUT_SEEDS: Range<u64> = 5001..5061;
 /// The issue's goal: each constant within its tolerance in this share of the draws.
 const GOAL_SHARE: f64 = 0.9;
 
@@ -586,7 +587,7 @@ fn short_of_goal(outcomes: &[Outcome]) -> Vec<String> {
 
 /// The development set meets the goal, and docs/fit.md reports it as the fit gives it.
 #[test]
-#[ignore = "180 fits, 25–45 minutes on 2 cores: run outside CI, by `cargo xtask docs family`"]
+#[ignore = "240 fits, 35–60 minutes on 2 cores: run outside CI, by `cargo xtask docs family`"]
 fn the_development_family_is_fitted_within_tolerance() {
     let command = "cargo xtask docs family";
     if let Some(outcomes) = run_family(
@@ -993,6 +994,15 @@ fn a_gliding_cavitys_pitch_is_placed_by_its_units_that_glide() {
 #[test]
 fn a_bright_mode_beside_two_units_hum_is_kept() {
     assert_draws_pass(&[3042], &[1, 3, 4]);
+}
+
+/// Draw 3038 of the development set: a cavity gliding 1.9-fold into 280 Hz that carries 89 % of
+/// the amplitude, and a bubble mode heard at 754 Hz decaying at 226 /s, 25 dB under it in each of
+/// the 45 units and in none found by a unit's own fit. The residues every unit's fit left early,
+/// summed, show it (MODEL.md §13, the short mode), where f2 was kept at its default 300 Hz.
+#[test]
+fn a_bubble_mode_under_each_units_noise_is_found_in_their_sum() {
+    assert_draws_pass(&[3038], &[1, 3, 4]);
 }
 
 /// Fits each development draw of `seeds` and fails with the rows of those that miss any of

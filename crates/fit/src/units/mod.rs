@@ -25,7 +25,8 @@ use sake_glug_engine::{Constant, Range};
 
 use super::listen::glug_onsets;
 use super::onsets::detect_onsets;
-use super::spectrum::{own_peaks, Spectrum};
+use super::spectrum::{own_peaks, pooled_peak_above, HeldLines, Spectrum};
+use super::stats;
 pub use modes::{local_split, Modes};
 use window::{Span, Window};
 
@@ -638,67 +639,38 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
         &glug_onsets(samples, fs),
         fs,
     );
-    let mut residual = samples.to_vec();
-    // Per unit kept, where a short mode was found: its place in `detected`, and the unit without
-    // and with it.
-    let mut short_modes: Vec<Option<(usize, UnitFit, UnitFit)>> = Vec::new();
-    let mut units = Vec::with_capacity(onsets.len());
-    let mut detected = Vec::with_capacity(onsets.len());
     let strides = Strides::for_highest(start_hz[1], fs);
-    for (index, &onset) in onsets.iter().enumerate() {
-        let first = onset.saturating_sub((BEFORE_ONSET_S * fs) as usize);
-        let next = onsets.get(index + 1).copied().unwrap_or(samples.len());
-        let end = next
-            .saturating_sub((BEFORE_NEXT_S * fs) as usize)
-            .min(onset + (LONGEST_WINDOW_S * fs) as usize)
-            .min(samples.len());
-        let onset_s = onset as f64 / fs;
-        if end < first + ((SHORTEST_WINDOW_S + BEFORE_ONSET_S) * fs) as usize {
-            detected.push(DetectedUnit {
-                onset_s,
-                fit: None,
-                rejection: Some(Rejection::TooShort {
-                    span_s: end.saturating_sub(onset) as f64 / fs,
-                }),
-            });
-            continue;
-        }
-        let span = Span::of(&residual, (first, end), onset, fs, &held);
-        match fit_one_way(&span, start_hz, strides) {
-            Ok(unit) => {
-                let with_short = second_mode::with_second_mode(&span, unit);
-                short_modes.push(with_short.map(|both| (detected.len(), unit, both)));
-                let unit = with_short.unwrap_or(unit);
-                subtract(&mut residual, &unit, fs);
-                units.push(unit);
-                detected.push(DetectedUnit {
-                    onset_s,
-                    fit: Some(unit),
-                    rejection: None,
-                });
-            }
-            Err(failure) => {
-                let (rejection, fit) = *failure;
-                detected.push(DetectedUnit {
-                    onset_s,
-                    fit,
-                    rejection: Some(rejection),
-                });
+    let fit_with =
+        |pooled_hz| InTurn::fit(samples, &onsets, fs, &held, start_hz, strides, pooled_hz);
+    let mut in_turn = fit_with(None);
+    // Where no unit's own early residue showed a short mode units enough agree on, the residues of
+    // every unit summed may (MODEL.md §13): a bubble mode 20–30 dB under a cavity carrying most of
+    // the amplitude lies under each unit's noise but rings near one pitch in all of them. It is
+    // sought above every unit's main mode, glide included: below lie the misfits of a glide's
+    // start, which the sum gathers too, and which units may agree on as a short mode.
+    let highest_main_hz = in_turn.main_hz.iter().copied().fold(0.0, f64::max);
+    let lowest_hz = highest_main_hz * modes::SEPARATE_MODES;
+    if in_turn.agreed_hz.iter().all(|&hz| hz < lowest_hz)
+        && in_turn.early_left.len() >= second_mode::MIN_AGREEING_UNITS
+    {
+        if let Some(pooled_hz) = pooled_peak_above(&in_turn.early_left, fs, lowest_hz, &held) {
+            let pooled = fit_with(Some(pooled_hz));
+            // Kept where its units agree on the pitch the sum showed: a pair fit drawn back to
+            // the short mode the first fitting found, below, is that one again.
+            let agreed_on_sum = !pooled.agreed_hz.is_empty()
+                && (stats::median(&pooled.agreed_hz) / pooled_hz - 1.0).abs()
+                    <= second_mode::AGREEING_PITCH;
+            if agreed_on_sum {
+                in_turn = pooled;
             }
         }
     }
-    // A short mode too few units agree on is left out of every unit (MODEL.md §13).
-    let found: Vec<Option<f64>> = short_modes
-        .iter()
-        .map(|short| short.and_then(|(_, _, both)| both.components[1].map(|c| c.heard_hz)))
-        .collect();
-    let agreed = second_mode::agreed(&found, units.len());
-    for ((unit, short), agreed) in units.iter_mut().zip(&short_modes).zip(agreed) {
-        if let (Some((index, without, _)), false) = (short, agreed) {
-            *unit = *without;
-            detected[*index].fit = Some(*without);
-        }
-    }
+    let InTurn {
+        units,
+        detected,
+        residual,
+        ..
+    } = in_turn;
     let energy = |signal: &[f32]| signal.iter().map(|&y| f64::from(y).powi(2)).sum::<f64>();
     let explained = 1.0 - energy(&residual) / energy(samples).max(1e-300);
     RecordingUnits {
@@ -708,6 +680,117 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
         one_peak,
         spectrum,
         explained,
+    }
+}
+
+/// The units of a recording fitted in turn, each from what the units before it left.
+struct InTurn {
+    units: Vec<UnitFit>,
+    detected: Vec<DetectedUnit>,
+    residual: Vec<f32>,
+    /// The pitches (Hz) of the short modes units enough agreed on (MODEL.md §13).
+    agreed_hz: Vec<f64>,
+    /// What each unit kept with nothing fitted above its stronger component left early…
+    early_left: Vec<Vec<f64>>,
+    /// …and the highest pitch of that component: where its glide starts, or where it is heard
+    /// (Hz).
+    main_hz: Vec<f64>,
+}
+
+impl InTurn {
+    fn fit(
+        samples: &[f32],
+        onsets: &[usize],
+        fs: f64,
+        held: &HeldLines,
+        start_hz: [f64; 2],
+        strides: Strides,
+        pooled_hz: Option<f64>,
+    ) -> Self {
+        let mut residual = samples.to_vec();
+        // Per unit kept, where a short mode was found: its place in `detected`, and the unit without
+        // and with it.
+        let mut short_modes: Vec<Option<(usize, UnitFit, UnitFit)>> = Vec::new();
+        let mut units = Vec::with_capacity(onsets.len());
+        let mut detected = Vec::with_capacity(onsets.len());
+        let (mut early_left, mut main_hz) = (Vec::new(), Vec::new());
+        for (index, &onset) in onsets.iter().enumerate() {
+            let first = onset.saturating_sub((BEFORE_ONSET_S * fs) as usize);
+            let next = onsets.get(index + 1).copied().unwrap_or(samples.len());
+            let end = next
+                .saturating_sub((BEFORE_NEXT_S * fs) as usize)
+                .min(onset + (LONGEST_WINDOW_S * fs) as usize)
+                .min(samples.len());
+            let onset_s = onset as f64 / fs;
+            if end < first + ((SHORTEST_WINDOW_S + BEFORE_ONSET_S) * fs) as usize {
+                detected.push(DetectedUnit {
+                    onset_s,
+                    fit: None,
+                    rejection: Some(Rejection::TooShort {
+                        span_s: end.saturating_sub(onset) as f64 / fs,
+                    }),
+                });
+                continue;
+            }
+            let span = Span::of(&residual, (first, end), onset, fs, held);
+            match fit_one_way(&span, start_hz, strides) {
+                Ok(unit) => {
+                    if let (Some(left), Some(main)) =
+                        (second_mode::early_left(&span, &unit), unit.stronger())
+                    {
+                        early_left.push(left);
+                        // A glide's misfit lies between where it starts and its own f.
+                        let start_hz = main.glide.map_or(main.heard_hz, |glide| {
+                            main.heard_hz.max(main.frequency_hz * glide.ratio)
+                        });
+                        main_hz.push(start_hz);
+                    }
+                    let with_short = second_mode::with_second_mode(&span, unit, pooled_hz);
+                    short_modes.push(with_short.map(|both| (detected.len(), unit, both)));
+                    let unit = with_short.unwrap_or(unit);
+                    subtract(&mut residual, &unit, fs);
+                    units.push(unit);
+                    detected.push(DetectedUnit {
+                        onset_s,
+                        fit: Some(unit),
+                        rejection: None,
+                    });
+                }
+                Err(failure) => {
+                    let (rejection, fit) = *failure;
+                    detected.push(DetectedUnit {
+                        onset_s,
+                        fit,
+                        rejection: Some(rejection),
+                    });
+                }
+            }
+        }
+        // A short mode too few units agree on is left out of every unit (MODEL.md §13).
+        let found: Vec<Option<f64>> = short_modes
+            .iter()
+            .map(|short| short.and_then(|(_, _, both)| both.components[1].map(|c| c.heard_hz)))
+            .collect();
+        let agreed = second_mode::agreed(&found, units.len());
+        let agreed_hz: Vec<f64> = found
+            .iter()
+            .zip(&agreed)
+            .filter_map(|(hz, &agrees)| hz.filter(|_| agrees))
+            .collect();
+        for ((unit, short), agreed) in units.iter_mut().zip(&short_modes).zip(agreed) {
+            if let (Some((index, without, _)), false) = (short, agreed) {
+                *unit = *without;
+                detected[*index].fit = Some(*without);
+            }
+        }
+        InTurn {
+            units,
+            detected,
+            residual,
+            agreed_hz,
+            early_left,
+            main_hz,
+        }
     }
 }
 

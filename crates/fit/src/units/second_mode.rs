@@ -33,17 +33,17 @@ const MIN_EARLY_GAIN: f64 = 0.05;
 const SPAN_SLACK: f64 = 0.02;
 
 /// A short mode is the bottle's if at least this many units ring it…
-const MIN_AGREEING_UNITS: usize = 3;
+pub(super) const MIN_AGREEING_UNITS: usize = 3;
 /// …and at least this share of the units kept…
 const MIN_AGREEING_SHARE: f64 = 0.15;
 /// …within this share of their median pitch: a bubble's size, and so its pitch, varies from glug
 /// to glug (a real bottle's by 15 %), while what noise lends a fit lies anywhere above the mode.
-const AGREEING_PITCH: f64 = 0.25;
+pub(super) const AGREEING_PITCH: f64 = 0.25;
 
-/// `unit`, with the short mode its fit left out where there is one (`Some`: the unit with it).
-pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
-    // The unit's stronger component, if nothing it fitted lies above it (a weaker one below is
-    // replaced: a low blob an eq. 1 started at hum or the room gives, not the bright mode).
+/// What `unit`'s fit left of its first [`EARLY_S`], where the short mode would ring, if the
+/// unit has fitted nothing above its stronger component (a weaker one below is replaced: a low
+/// blob an eq. 1 started at hum or the room gives, not the bright mode).
+pub(super) fn early_left(span: &Span, unit: &UnitFit) -> Option<Vec<f64>> {
     let main = *unit.stronger()?;
     if unit.fitted().any(|c| c.heard_hz > main.heard_hz) {
         return None;
@@ -53,12 +53,28 @@ pub(super) fn with_second_mode(span: &Span, unit: UnitFit) -> Option<UnitFit> {
     let left: Vec<f64> = (from..to)
         .map(|n| span.samples[n] - unit.value_at((span.first + n) as f64 / span.fs))
         .collect();
-    if left.len() < 16 {
-        return None;
-    }
+    (left.len() >= 16).then_some(left)
+}
+
+/// `unit`, with the short mode its fit left out where there is one (`Some`: the unit with it),
+/// sought from the strongest peak of what the fit left early, or from `pooled_hz` where that is
+/// given (the peak of what every unit's fit left, [`pooled_peak`]).
+pub(super) fn with_second_mode(
+    span: &Span,
+    unit: UnitFit,
+    pooled_hz: Option<f64>,
+) -> Option<UnitFit> {
+    let main = *unit.stronger()?;
+    let left = early_left(span, &unit)?;
+    let from = (span.onset - span.first).min(span.samples.len());
+    let to = from + left.len();
     // The short mode sought lies above the unit's own; below it lie hum and the skirts of the
     // long mode's misfit.
-    let (short_hz, _) = own_peak_above(&left, span.fs, main.heard_hz * SEPARATE_MODES, &span.held)?;
+    let short_hz = match pooled_hz {
+        Some(hz) if hz >= main.heard_hz * SEPARATE_MODES => hz,
+        Some(_) => return None,
+        None => own_peak_above(&left, span.fs, main.heard_hz * SEPARATE_MODES, &span.held)?.0,
+    };
     let strides = Strides::for_highest(short_hz.max(main.heard_hz), span.fs);
     let poles = eq1::pencil_poles(&left, strides.pencil, span.fs);
     let short = eq1::nearest_pole(&poles, short_hz).unwrap_or((short_hz, SHORT_DECAY_GUESS_PER_S));
