@@ -312,6 +312,25 @@ impl Spectrum {
         }
     }
 
+    /// The spectra of short stretches ([`Spectrum::of_span`]) summed, of those as long as the
+    /// longest (zero-padded alike, so their bins agree); none of no stretches.
+    fn summed(spans: &[Vec<f64>], sample_rate: f64) -> Option<Self> {
+        let longest = spans.iter().map(Vec::len).max()?;
+        let mut sum: Option<Spectrum> = None;
+        for span in spans.iter().filter(|span| span.len() == longest) {
+            let one = Spectrum::of_span(span, sample_rate);
+            match sum.as_mut() {
+                Some(sum) => sum
+                    .power
+                    .iter_mut()
+                    .zip(&one.power)
+                    .for_each(|(s, p)| *s += p),
+                None => sum = Some(one),
+            }
+        }
+        sum
+    }
+
     /// The frequency (Hz) at which a bin lies.
     pub fn hz(&self, bin: usize) -> f64 {
         bin as f64 * self.bin_hz
@@ -338,32 +357,19 @@ pub fn own_peak_above(
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
-/// The peak at or above `lowest_hz` of many short stretches' spectra summed (those as long as
-/// the longest: each a Hann window, zero-padded alike) that stands furthest above the sum's own
-/// median within [`NOISE_NEIGHBOURHOOD`] of it (Hz), none at one of `held`'s lines. A mode too
-/// weak to stand out of any one stretch's noise stands out of the sum where it rings near one
-/// pitch in each, as noise does not; the sum's strongest peak may still be a broad hump of
-/// noise that is not white (a room, a microphone), which stands less far above what lies near it.
+/// The peak at or above `lowest_hz` of many short stretches' spectra summed
+/// ([`Spectrum::summed`]) that stands furthest above the sum's own median within
+/// [`NOISE_NEIGHBOURHOOD`] of it (Hz), none at one of `held`'s lines. A mode too weak to stand out
+/// of any one stretch's noise stands out of the sum where it rings near one pitch in each, as
+/// noise does not; the sum's strongest peak may still be a broad hump of noise that is not white
+/// (a room, a microphone), which stands less far above what lies near it.
 pub fn pooled_peak_above(
     spans: &[Vec<f64>],
     sample_rate: f64,
     lowest_hz: f64,
     held: &HeldLines,
 ) -> Option<f64> {
-    let longest = spans.iter().map(Vec::len).max()?;
-    let mut pooled: Option<Spectrum> = None;
-    for span in spans.iter().filter(|span| span.len() == longest) {
-        let one = Spectrum::of_span(span, sample_rate);
-        match pooled.as_mut() {
-            Some(sum) => sum
-                .power
-                .iter_mut()
-                .zip(&one.power)
-                .for_each(|(s, p)| *s += p),
-            None => pooled = Some(one),
-        }
-    }
-    let pooled = pooled?;
+    let pooled = Spectrum::summed(spans, sample_rate)?;
     pooled
         .maxima_above(lowest_hz, held)
         .map(|(hz, power)| {
@@ -481,14 +487,7 @@ mod tests {
         let pooled = pooled_peak_above(&spans, fs, 400.0, &held).unwrap();
         // The premise: the sum's strongest peak is the hump, so a peak taken by its height alone
         // would be the hump's.
-        let mut sum = Spectrum::of_span(&spans[0], fs);
-        for span in &spans[1..] {
-            let one = Spectrum::of_span(span, fs);
-            sum.power
-                .iter_mut()
-                .zip(&one.power)
-                .for_each(|(s, p)| *s += p);
-        }
+        let sum = Spectrum::summed(&spans, fs).unwrap();
         let strongest = sum
             .maxima_above(400.0, &held)
             .max_by(|a, b| a.1.total_cmp(&b.1));

@@ -643,11 +643,12 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
     let fit_with =
         |pooled_hz| InTurn::fit(samples, &onsets, fs, &held, start_hz, strides, pooled_hz);
     let mut in_turn = fit_with(None);
-    // Where no unit's own early residue showed a short mode units enough agree on, the residues of
-    // every unit summed may (MODEL.md §13): a bubble mode 20–30 dB under a cavity carrying most of
-    // the amplitude lies under each unit's noise but rings near one pitch in all of them. It is
-    // sought above every unit's main mode, glide included: below lie the misfits of a glide's
-    // start, which the sum gathers too, and which units may agree on as a short mode.
+    // Where no unit's own early residue showed a short mode units enough agree on above the long
+    // mode, the residues of every unit summed may (MODEL.md §13): a bubble mode 20–30 dB under a
+    // cavity carrying most of the amplitude lies under each unit's noise but rings near one pitch
+    // in all of them. It is sought above every unit's main mode, glide included: below lie the
+    // misfits of a glide's start, which the sum gathers too, and which units may agree on as a
+    // short mode.
     let highest_main_hz = in_turn.main_hz.iter().copied().fold(0.0, f64::max);
     let lowest_hz = highest_main_hz * modes::SEPARATE_MODES;
     if in_turn.agreed_hz.iter().all(|&hz| hz < lowest_hz)
@@ -655,8 +656,9 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
     {
         if let Some(pooled_hz) = pooled_peak_above(&in_turn.early_left, fs, lowest_hz, &held) {
             let pooled = fit_with(Some(pooled_hz));
-            // Kept where its units agree on the pitch the sum showed: a pair fit drawn back to
-            // the short mode the first fitting found, below, is that one again.
+            // Kept where its units agree on the pitch the sum showed; where they agree on another
+            // (pair fits drawn back to the short mode the first fitting found, under the sum's
+            // search), the first fitting stands.
             let agreed_on_sum = !pooled.agreed_hz.is_empty()
                 && (stats::median(&pooled.agreed_hz) / pooled_hz - 1.0).abs()
                     <= second_mode::AGREEING_PITCH;
@@ -708,8 +710,8 @@ impl InTurn {
         pooled_hz: Option<f64>,
     ) -> Self {
         let mut residual = samples.to_vec();
-        // Per unit kept, where a short mode was found: its place in `detected`, and the unit without
-        // and with it.
+        // Per unit kept, where a short mode was found: its place in `detected`, and the unit
+        // without and with it.
         let mut short_modes: Vec<Option<(usize, UnitFit, UnitFit)>> = Vec::new();
         let mut units = Vec::with_capacity(onsets.len());
         let mut detected = Vec::with_capacity(onsets.len());
