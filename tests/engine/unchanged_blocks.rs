@@ -44,7 +44,7 @@ fn render(blocks: &[usize], unchanged: bool) -> Rendered {
         units: Vec::new(),
         volumes: Vec::new(),
     };
-    let mut keep = |onset: &UnitOnset, voicing: Voicing, units: &mut Vec<[u64; 3]>| {
+    let keep = |onset: &UnitOnset, voicing: Voicing, units: &mut Vec<[u64; 3]>| {
         units.push([
             onset.sample,
             onset.fraction.to_bits(),
