@@ -58,7 +58,7 @@ pub(super) fn early_left(span: &Span, unit: &UnitFit) -> Option<Vec<f64>> {
 
 /// `unit`, with the short mode its fit left out where there is one (`Some`: the unit with it),
 /// sought from the strongest peak of what the fit left early, or from `pooled_hz` where that is
-/// given (the peak of what every unit's fit left, [`pooled_peak`]).
+/// given (the peak of what every unit's fit left, [`crate::spectrum::pooled_peak_above`]).
 pub(super) fn with_second_mode(
     span: &Span,
     unit: UnitFit,
