@@ -737,17 +737,18 @@ impl InTurn {
             let span = Span::of(&residual, (first, end), onset, fs, held);
             match fit_one_way(&span, start_hz, strides) {
                 Ok(unit) => {
-                    if let (Some(left), Some(main)) =
-                        (second_mode::early_left(&span, &unit), unit.stronger())
-                    {
-                        early_left.push(left);
+                    let early = second_mode::early_left(&span, &unit);
+                    let with_short = early.as_ref().and_then(|early| {
+                        second_mode::with_second_mode(&span, unit, early, pooled_hz)
+                    });
+                    if let (Some(early), Some(main)) = (early, unit.stronger()) {
+                        early_left.push(early.samples);
                         // A glide's misfit lies between where it starts and its own f.
                         let start_hz = main.glide.map_or(main.heard_hz, |glide| {
                             main.heard_hz.max(main.frequency_hz * glide.ratio)
                         });
                         main_hz.push(start_hz);
                     }
-                    let with_short = second_mode::with_second_mode(&span, unit, pooled_hz);
                     short_modes.push(with_short.map(|both| (detected.len(), unit, both)));
                     let unit = with_short.unwrap_or(unit);
                     subtract(&mut residual, &unit, fs);

@@ -40,43 +40,51 @@ const MIN_AGREEING_SHARE: f64 = 0.15;
 /// to glug (a real bottle's by 15 %), while what noise lends a fit lies anywhere above the mode.
 pub(super) const AGREEING_PITCH: f64 = 0.25;
 
-/// What `unit`'s fit left of its first [`EARLY_S`], where the short mode would ring, if the
-/// unit has fitted nothing above its stronger component (a weaker one below is replaced: a low
-/// blob an eq. 1 started at hum or the room gives, not the bright mode).
-pub(super) fn early_left(span: &Span, unit: &UnitFit) -> Option<Vec<f64>> {
+/// What a unit's fit left of its first [`EARLY_S`], where the short mode would ring.
+pub(super) struct EarlyLeft {
+    /// Where it starts in the unit's span (samples).
+    from: usize,
+    pub samples: Vec<f64>,
+}
+
+/// What `unit`'s fit left of its first [`EARLY_S`], if the unit has fitted nothing above its
+/// stronger component (a weaker one below is replaced: a low blob an eq. 1 started at hum or the
+/// room gives, not the bright mode).
+pub(super) fn early_left(span: &Span, unit: &UnitFit) -> Option<EarlyLeft> {
     let main = *unit.stronger()?;
     if unit.fitted().any(|c| c.heard_hz > main.heard_hz) {
         return None;
     }
     let from = (span.onset - span.first).min(span.samples.len());
     let to = (from + (EARLY_S * span.fs) as usize).min(span.samples.len());
-    let left: Vec<f64> = (from..to)
+    let samples: Vec<f64> = (from..to)
         .map(|n| span.samples[n] - unit.value_at((span.first + n) as f64 / span.fs))
         .collect();
-    (left.len() >= 16).then_some(left)
+    (samples.len() >= 16).then_some(EarlyLeft { from, samples })
 }
 
 /// `unit`, with the short mode its fit left out where there is one (`Some`: the unit with it),
-/// sought from the strongest peak of what the fit left early, or from `pooled_hz` where that is
-/// given (the peak of what every unit's fit left, [`crate::spectrum::pooled_peak_above`]).
+/// sought in what its fit left early (`early`, of [`early_left`]) from the strongest peak there,
+/// or from `pooled_hz` where that is given (the peak of what every unit's fit left,
+/// [`crate::spectrum::pooled_peak_above`]).
 pub(super) fn with_second_mode(
     span: &Span,
     unit: UnitFit,
+    early: &EarlyLeft,
     pooled_hz: Option<f64>,
 ) -> Option<UnitFit> {
     let main = *unit.stronger()?;
-    let left = early_left(span, &unit)?;
-    let from = (span.onset - span.first).min(span.samples.len());
+    let (left, from) = (&early.samples, early.from);
     let to = from + left.len();
     // The short mode sought lies above the unit's own; below it lie hum and the skirts of the
     // long mode's misfit.
     let short_hz = match pooled_hz {
         Some(hz) if hz >= main.heard_hz * SEPARATE_MODES => hz,
         Some(_) => return None,
-        None => own_peak_above(&left, span.fs, main.heard_hz * SEPARATE_MODES, &span.held)?.0,
+        None => own_peak_above(left, span.fs, main.heard_hz * SEPARATE_MODES, &span.held)?.0,
     };
     let strides = Strides::for_highest(short_hz.max(main.heard_hz), span.fs);
-    let poles = eq1::pencil_poles(&left, strides.pencil, span.fs);
+    let poles = eq1::pencil_poles(left, strides.pencil, span.fs);
     let short = eq1::nearest_pole(&poles, short_hz).unwrap_or((short_hz, SHORT_DECAY_GUESS_PER_S));
     let window = span.window(strides.fit);
     let left_early = left.iter().map(|y| y * y).sum::<f64>();
