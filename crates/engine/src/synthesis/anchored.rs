@@ -287,8 +287,7 @@ impl BankComponent for AnchoredComponent {
         // starts: the components that sound from the period's start are summed over the whole
         // period once, in registers, and each span of the period takes its part of that sum, then
         // adds the components that started since.
-        let period_start = span_start / GRID as u64 * GRID as u64;
-        anchors.sum_period_from(components, period_start);
+        let period_start = anchors.sum_period_from(components, span_start);
         let period_sum = &anchors.period_sum;
         let offset = (span_start - period_start) as usize;
         out.copy_from_slice(&period_sum.samples[offset..offset + out.len()]);
@@ -310,7 +309,7 @@ impl BankComponent for AnchoredComponent {
         anchors: &'a mut Anchors,
         span_start: u64,
     ) -> Option<(&'a [f32; GRID], u64)> {
-        anchors.sum_period_from(components, span_start / GRID as u64 * GRID as u64);
+        anchors.sum_period_from(components, span_start);
         let period_sum = &anchors.period_sum;
         (period_sum.components == anchors.len)
             .then_some((&period_sum.samples, period_sum.generation))
@@ -318,13 +317,16 @@ impl BankComponent for AnchoredComponent {
 }
 
 impl Anchors {
-    /// Works out [`PeriodSum`] for the period starting at `period_start`, unless it holds it.
+    /// Works out [`PeriodSum`] for the period `span_start` lies in, unless it holds it; that
+    /// period's first sample.
     #[inline(always)]
-    fn sum_period_from(&mut self, components: &[AnchoredComponent], period_start: u64) {
+    fn sum_period_from(&mut self, components: &[AnchoredComponent], span_start: u64) -> u64 {
+        let period_start = span_start / GRID as u64 * GRID as u64;
         // The check in line: every call of a short block makes it, one a period does the sum.
         if self.period_sum.period_start != Some(period_start) {
             self.sum_period_anew(components, period_start);
         }
+        period_start
     }
 
     /// [`Anchors::sum_period_from`] of a period not yet summed.
