@@ -7,8 +7,8 @@
 //! **held-out** set, run once, at the end. Each prints its table (per draw the truth, the model's
 //! value and a pass or a miss per constant; per constant the share within tolerance and the
 //! draws that miss) and holds docs/fit.md's block to it; the development set is also held to the
-//! goal, each constant within its tolerance in at least 90 % of the draws. Its 240 fits take
-//! 35–60 minutes on 2 cores and the held-out set's 60 take 8–15, so both are `#[ignore]`d,
+//! goal, each constant within its tolerance in at least 90 % of the draws. Its 300 fits take
+//! 45–75 minutes on 2 cores and the held-out set's 60 take 8–15, so both are `#[ignore]`d,
 //! outside CI; `cargo xtask docs family` writes the development block:
 //!
 //! ```sh
@@ -37,12 +37,13 @@ use super::{add_noise, glug_rms, write_wav};
 
 /// The development set: tune the fit on these draws only. 1001–1060 were the first held-out set,
 /// run once at e092597d (docs/fit.md at 480fbdd5), 3001–3060 the third, run once at 3c3e0c43
-/// (docs/fit.md there), and 4001–4060 the fourth, run once at 544a2369 (docs/fit.md there); each
-/// has been seen since.
-pub const DEVELOPMENT_SEEDS: [Range<u64>; 4] = [1..61, 1001..1061, 3001..3061, 4001..4061];
+/// (docs/fit.md there), 4001–4060 the fourth, run once at 544a2369 (docs/fit.md there), and
+/// 5001–5060 the fifth, run once at a1c7e5be (docs/fit.md there); each has been seen since.
+pub const DEVELOPMENT_SEEDS: [Range<u64>; 5] =
+    [1..61, 1001..1061, 3001..3061, 4001..4061, 5001..5061];
 /// The held-out set: run once, at the end, and reported whatever it shows. Seeds 2001–2060, a
 /// set before it, were run once with a candidate fit kept off main (docs/fit.md) and are seen.
-pub const HELD_OUT_SEEDS: Range<u64> = 5001..5061;
+pub const HELD_OUT_SEEDS: Range<u64> = 6001..6061;
 /// The issue's goal: each constant within its tolerance in this share of the draws.
 const GOAL_SHARE: f64 = 0.9;
 
@@ -587,7 +588,7 @@ fn short_of_goal(outcomes: &[Outcome]) -> Vec<String> {
 
 /// The development set meets the goal, and docs/fit.md reports it as the fit gives it.
 #[test]
-#[ignore = "240 fits, 35–60 minutes on 2 cores: run outside CI, by `cargo xtask docs family`"]
+#[ignore = "300 fits, 45–75 minutes on 2 cores: run outside CI, by `cargo xtask docs family`"]
 fn the_development_family_is_fitted_within_tolerance() {
     let command = "cargo xtask docs family";
     if let Some(outcomes) = run_family(

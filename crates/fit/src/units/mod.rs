@@ -654,7 +654,13 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
     if in_turn.agreed_hz.iter().all(|&hz| hz < lowest_hz)
         && in_turn.early_left.len() >= second_mode::MIN_AGREEING_UNITS
     {
-        if let Some(pooled_hz) = pooled_peak_above(&in_turn.early_left, fs, lowest_hz, &held) {
+        if let Some(pooled_hz) = pooled_peak_above(
+            &in_turn.early_left,
+            fs,
+            lowest_hz,
+            second_mode::SHORT_DECAY_GUESS_PER_S,
+            &held,
+        ) {
             let pooled = fit_with(Some(pooled_hz));
             // Kept where its units agree on the pitch the sum showed; where they agree on another
             // (pair fits drawn back to the short mode the first fitting found, under the sum's

@@ -19,8 +19,9 @@ use crate::spectrum::own_peak_above;
 
 /// The early part of a unit where a short mode is sought (s).
 const EARLY_S: f64 = 0.04;
-/// A short mode's decay where the pencil gives none (1/s): −60 dB in 46 ms.
-const SHORT_DECAY_GUESS_PER_S: f64 = 150.0;
+/// A short mode's decay where the pencil gives none, and the decay its search is matched to
+/// (1/s): −60 dB in 46 ms.
+pub(super) const SHORT_DECAY_GUESS_PER_S: f64 = 150.0;
 /// The share of what the unit's fit left of the unit's first [`EARLY_S`] that the pair must
 /// explain. A short mode carries little of a 150 ms span's energy (a tenth of the amplitude of a
 /// long mode, decaying ten times faster, is 0.1 % of it) but a share of what is left early;
@@ -81,7 +82,16 @@ pub(super) fn with_second_mode(
     let short_hz = match pooled_hz {
         Some(hz) if hz >= main.heard_hz * SEPARATE_MODES => hz,
         Some(_) => return None,
-        None => own_peak_above(left, span.fs, main.heard_hz * SEPARATE_MODES, &span.held)?.0,
+        None => {
+            own_peak_above(
+                left,
+                span.fs,
+                main.heard_hz * SEPARATE_MODES,
+                SHORT_DECAY_GUESS_PER_S,
+                &span.held,
+            )?
+            .0
+        }
     };
     let strides = Strides::for_highest(short_hz.max(main.heard_hz), span.fs);
     let poles = eq1::pencil_poles(left, strides.pencil, span.fs);
