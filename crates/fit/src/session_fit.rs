@@ -108,14 +108,16 @@ pub fn fit_session(session: &FitSession) -> Result<SessionFit, FitError> {
     })
 }
 
-/// Puts the components of every unit of `members` in the modes their frequencies show.
+/// Puts the components of every unit of `members` in the modes the pitches they are heard at
+/// show: the pitch `UnitFit::assign` then puts each in a mode by, where a glide slower than
+/// its ring leaves a component's own f a guess (MODEL.md §13, the bottle's two modes).
 fn assign_modes(recordings: &mut [RecordingFit], members: &[usize]) -> Modes {
-    let frequencies: Vec<f64> = members
+    let pitches: Vec<f64> = members
         .iter()
         .flat_map(|&i| recordings[i].units.iter())
-        .flat_map(|u| u.fit.fitted().map(|c| c.frequency_hz).collect::<Vec<_>>())
+        .flat_map(|u| u.fit.fitted().map(|c| c.heard_hz).collect::<Vec<_>>())
         .collect();
-    let modes = Modes::of(&frequencies);
+    let modes = Modes::of(&pitches);
     for &i in members {
         let recording = &mut recordings[i];
         for unit in &mut recording.units {
