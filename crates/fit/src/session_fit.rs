@@ -115,7 +115,7 @@ fn assign_modes(recordings: &mut [RecordingFit], members: &[usize]) -> Modes {
     let pitches: Vec<f64> = members
         .iter()
         .flat_map(|&i| recordings[i].units.iter())
-        .flat_map(|u| u.fit.fitted().map(|c| c.heard_hz).collect::<Vec<_>>())
+        .flat_map(|u| u.fit.fitted().map(|c| c.heard_hz))
         .collect();
     let modes = Modes::of(&pitches);
     for &i in members {
