@@ -168,7 +168,8 @@ fn refusal_missed(name: &str) -> Option<String> {
         Err(
             error @ (FitError::NoUnitDescribed { .. }
             | FitError::NoGlugs { .. }
-            | FitError::NothingNearer { .. }),
+            | FitError::NothingNearer { .. }
+            | FitError::NoModelNearer { .. }),
         ) => {
             let message = error.to_string();
             eprintln!("{name}: {message}");

@@ -245,6 +245,8 @@ fn knobs() -> [Knob; 6] {
 
 /// One recording as the listening fit hears it.
 struct Target {
+    /// The recording's name, as its error messages give it.
+    name: String,
     made: AsRecorded,
     /// Its glugs (the pitch fall is read over as many).
     glugs: usize,
@@ -330,6 +332,21 @@ pub(crate) fn units_set_some(estimates: &[Estimate]) -> bool {
     })
 }
 
+/// What listening came to for one liquid.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum ByEar {
+    /// The units' model stands: it sounds like every recording, the units explain enough of
+    /// them, or too little of them is heard to judge it by.
+    UnitsKept,
+    /// Constants fitted by listening, the model they make nearer than the default bottle on every
+    /// measure.
+    Fitted(ListeningFit),
+    /// Neither the units' model nor any the searches ended at sounds nearer the recordings than
+    /// the default bottle on every measure: what the nearest of them missed, recording by
+    /// recording.
+    NothingNearer { missed: String },
+}
+
 /// What the listening fit did for one liquid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ListeningFit {
@@ -341,45 +358,71 @@ pub struct ListeningFit {
 
 /// Fits the constants of [`knobs`] by listening, where the units' model (`model_toml`, with its
 /// `estimates`) does not sound like `recordings`: the estimates it sets are marked as its own.
-/// None where the units' model already sounds like every recording (or nothing can be heard).
 pub(crate) fn fit_by_listening(
     model_toml: &str,
     estimates: &mut Vec<Estimate>,
     recordings: &[&RecordingFit],
     capacity_ml: f64,
-) -> Option<ListeningFit> {
+) -> ByEar {
     // Where the units explain at least half of every recording, the model is theirs: the
     // listening fit is for the recordings the paper's units describe poorly. Unless the units
     // set none of the constants it fits (too few units for any): their model is then the default
     // bottle, which describes no recording.
-    let knobs = knobs();
     if units_set_some(estimates) && recordings.iter().all(|r| r.explained >= LOW_EXPLAINED) {
-        return None;
+        return ByEar::UnitsKept;
     }
-    let base: toml::Table = toml::from_str(model_toml).ok()?;
-    let targets = targets_of(recordings, capacity_ml)?;
+    let (Ok(base), Some(targets)) = (
+        toml::from_str::<toml::Table>(model_toml),
+        targets_of(recordings, capacity_ml),
+    ) else {
+        return ByEar::UnitsKept;
+    };
     if targets.iter().all(|t| t.glugs < 2) {
-        return None;
+        return ByEar::UnitsKept;
     }
-    let units_value = |key: &str| value_in(&base, key).unwrap_or_else(|| default_of(key));
-    let bounds = search_bounds(&knobs, &targets);
+    fit_to_targets(&base, estimates, &targets)
+}
+
+/// [`fit_by_listening`] once the recordings are heard (`targets`) and the units' model (`base`)
+/// is parsed.
+fn fit_to_targets(base: &toml::Table, estimates: &mut Vec<Estimate>, targets: &[Target]) -> ByEar {
+    let knobs = knobs();
+    let units_value = |key: &str| value_in(base, key).unwrap_or_else(|| default_of(key));
+    let bounds = search_bounds(&knobs, targets);
     let search = Search {
-        base: &base,
+        base,
         knobs: &knobs,
         bounds: &bounds,
-        targets: &targets,
+        targets,
     };
-    let units_cost = search.cost_of(&base)?;
-    if sounds_like_every_recording(&base, &targets, NO_FARTHER) {
-        return None;
+    if sounds_like_every_recording(base, targets, NO_FARTHER) {
+        return ByEar::UnitsKept;
     }
-    let starts = starting_points(&knobs, &bounds, &targets, &units_value);
+    let Some(units_cost) = search.cost_of(base) else {
+        return ByEar::NothingNearer {
+            missed: "the units' model does not render".to_owned(),
+        };
+    };
+    let starts = starting_points(&knobs, &bounds, targets, &units_value);
     let pour_key = Control::PourTime.quantity().scene_key;
     let units_pour_s = units_value(pour_key);
-    let (pour_s, x, cost) = best_of_searches(&search, starts, units_pour_s)?;
-    if cost >= units_cost {
-        return None;
-    }
+    // The units' model missed at least one measure on some recording (above), so a search's end
+    // that a listener takes for nearer on every one is kept whatever its cost; where none is, no
+    // model of these recordings was found, and writing the nearest would be a made-up result.
+    let best = best_of_searches(&search, starts, units_pour_s);
+    let Some((true, pour_s, x, cost)) = best else {
+        let nearest = match &best {
+            Some((_, pour_s, x, cost)) if *cost < units_cost => {
+                let mut end = search.model(x);
+                keys::insert(&mut end, pour_key, toml::Value::Float(*pour_s));
+                end
+            }
+            _ => base.clone(),
+        };
+        return ByEar::NothingNearer {
+            missed: what_it_misses(&nearest, targets),
+        };
+    };
     let mut set = Vec::new();
     for ((knob, &(low, high)), &xi) in knobs.iter().zip(&bounds).zip(&x) {
         let note = "fitted by listening: the units' model did not sound like the recordings";
@@ -396,7 +439,7 @@ pub(crate) fn fit_by_listening(
         set_by_listening(estimates, pour_key, pour_s, note);
         set.push(pour_key.to_owned());
     }
-    Some(ListeningFit {
+    ByEar::Fitted(ListeningFit {
         cost: [units_cost, cost],
         set,
     })
@@ -426,6 +469,12 @@ fn targets_of(recordings: &[&RecordingFit], capacity_ml: f64) -> Option<Vec<Targ
             let default_distance_db =
                 log_spectral_distance(&spectrum, &Spectrum::of(&default_render, fs), fs);
             Some(Target {
+                // The file's name alone, so that the message reads alike wherever the file lies.
+                name: recording
+                    .spec
+                    .audio
+                    .file_name()
+                    .map_or_else(|| recording.name(), |n| n.to_string_lossy().into_owned()),
                 made,
                 glugs,
                 spectrum,
@@ -482,30 +531,88 @@ fn search_bounds(knobs: &[Knob], targets: &[Target]) -> Vec<(f64, f64)> {
 /// alone), its distance at most `farther` times the default bottle's (or [`NEAR_DISTANCE_DB`]).
 fn sounds_like_every_recording(model: &toml::Table, targets: &[Target], farther: f64) -> bool {
     targets.iter().all(|target| {
-        let Some(samples) = render_as_recorded(model, &target.made) else {
-            return false;
-        };
-        let listened = Listened::of(
-            &samples,
-            f64::from(target.made.sample_rate),
-            target.glugs,
-            &target.spectrum,
-        );
-        let [rate, pitch, _, bright, distance] =
-            misses(&target.listened, &listened, target.default_distance_db);
-        [rate, pitch, bright].iter().all(|&m| m < 1.0) && distance < farther * farther
+        heard_in(model, target).is_some_and(|(_, misses)| {
+            let [rate, pitch, _, bright, distance] = misses;
+            [rate, pitch, bright].iter().all(|&m| m < 1.0) && distance < farther * farther
+        })
     })
 }
 
-/// The best of the searches from `starts`: (its pour time, its point, its cost). An end a
-/// listener would take for nearer than the default bottle on every measure beats one that is
-/// not, whatever their costs (the cost weighs the measures against each other; a listener asks
-/// each in turn).
+/// What a listener hears of `model` rendered as `target` was made, and its misses from it; None
+/// if it does not render.
+fn heard_in(model: &toml::Table, target: &Target) -> Option<(Listened, [f64; 5])> {
+    let samples = render_as_recorded(model, &target.made)?;
+    let listened = Listened::of(
+        &samples,
+        f64::from(target.made.sample_rate),
+        target.glugs,
+        &target.spectrum,
+    );
+    let misses = misses(&target.listened, &listened, target.default_distance_db);
+    Some((listened, misses))
+}
+
+/// The measures on which `model` is not nearer `targets` than the default bottle, recording by
+/// recording, with what was heard of each (as [`sounds_like_every_recording`] judges them).
+fn what_it_misses(model: &toml::Table, targets: &[Target]) -> String {
+    let mut said = Vec::new();
+    for target in targets {
+        let Some((heard, [rate, pitch, _, bright, distance])) = heard_in(model, target) else {
+            said.push(format!("{}: the model does not render", target.name));
+            continue;
+        };
+        let wanted = &target.listened;
+        let missed: Vec<String> = [
+            (rate >= 1.0).then(|| {
+                format!(
+                    "{:.3} glugs a second for its {:.3}",
+                    heard.rate_per_s, wanted.rate_per_s
+                )
+            }),
+            (pitch >= 1.0).then(|| {
+                format!(
+                    "a median pitch of {:.0} Hz for its {:.0}",
+                    heard.pitch_hz, wanted.pitch_hz
+                )
+            }),
+            (bright >= 1.0).then(|| {
+                format!(
+                    "{:.0} % of the energy above {ONE_MODE_SPLIT_HZ} Hz for its {:.0} %",
+                    100.0 * heard.bright,
+                    100.0 * wanted.bright
+                )
+            }),
+            (distance >= 1.0).then(|| {
+                let against = if target.default_distance_db >= NEAR_DISTANCE_DB {
+                    format!("the default bottle's {:.2}", target.default_distance_db)
+                } else {
+                    format!("the {NEAR_DISTANCE_DB} within which models are not told apart")
+                };
+                format!(
+                    "a spectral distance of {:.2} dB against {against}",
+                    heard.distance_db
+                )
+            }),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        if !missed.is_empty() {
+            said.push(format!("{}: {}", target.name, missed.join(", ")));
+        }
+    }
+    said.join("; ")
+}
+
+/// The best of the searches from `starts`: (whether a listener takes it for nearer than the
+/// default bottle on every measure, its pour time, its point, its cost). An end that is nearer
+/// beats one that is not, whatever their costs (the cost weighs the measures against each other;
+/// a listener asks each in turn).
 fn best_of_searches(
     search: &Search,
     starts: Vec<Vec<f64>>,
     units_pour_s: f64,
-) -> Option<(f64, Vec<f64>, f64)> {
+) -> Option<(bool, f64, Vec<f64>, f64)> {
     let pour_key = Control::PourTime.quantity().scene_key;
     let mut best: Option<(bool, f64, Vec<f64>, f64)> = None;
     for start in starts {
@@ -544,7 +651,7 @@ fn best_of_searches(
             }
         }
     }
-    best.map(|(_, pour_s, x, cost)| (pour_s, x, cost))
+    best
 }
 
 /// Marks the estimate of `key` as fitted by listening, at `value` (added if the units gave none).

@@ -171,6 +171,24 @@ pub enum FitError {
         /// Units detected.
         detected: usize,
     },
+    /// The units explain too little of the recordings, and neither their model nor any fitted by
+    /// listening sounds nearer them than the default bottle on every measure a listener is asked
+    /// about: writing the nearest would be a made-up result.
+    #[error(
+        "{what}: the paper's model describes {used} of its {detected} detected unit(s), which \
+         explain too little of the recordings, and no model found sounds nearer them than the \
+         default bottle on every measure (the nearest has {missed}): no model is written"
+    )]
+    NoModelNearer {
+        /// The liquid.
+        what: String,
+        /// Units the model describes.
+        used: usize,
+        /// Units detected.
+        detected: usize,
+        /// What the nearest model found missed, recording by recording.
+        missed: String,
+    },
     /// An output file could not be written (nothing was: every file is written all or none).
     #[error("cannot write {}: {message}", shown(path))]
     Write {

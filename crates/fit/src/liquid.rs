@@ -2,7 +2,7 @@
 //! recordings, its pocket and timing from their intervals, its pour time from the rate at 135°,
 //! each estimate checked by the honesty rules of [`Estimate`].
 
-use super::by_ear::{fit_by_listening, units_set_some, ListeningFit};
+use super::by_ear::{fit_by_listening, units_set_some, ByEar, ListeningFit};
 use super::curves::FittedCurves;
 use super::error::FitError;
 use super::estimate::MIN_UNITS_FOR_MODEL;
@@ -598,20 +598,32 @@ pub(crate) fn fit_liquid(
     };
     let mut model = model_toml(&estimates, &kept_default);
     let units_set = units_set_some(&estimates);
-    let listening = if !units.is_empty() {
+    let by_ear = if !units.is_empty() {
         fit_by_listening(&model, &mut estimates, recordings, capacity_ml)
     } else {
-        None
+        ByEar::UnitsKept
     };
-    // With no constant from the units and none by listening, the model would be the default
-    // bottle: a model of no recording, which is refused as one of none would be.
-    if !units_set && listening.is_none() {
-        return Err(FitError::NothingNearer {
-            what: format!("liquid `{liquid}`"),
-            used: units.len(),
-            detected,
-        });
-    }
+    let listening = match by_ear {
+        ByEar::Fitted(listening) => Some(listening),
+        // With no constant from the units and none by listening, the model would be the default
+        // bottle: a model of no recording, which is refused as one of none would be.
+        ByEar::UnitsKept | ByEar::NothingNearer { .. } if !units_set => {
+            return Err(FitError::NothingNearer {
+                what: format!("liquid `{liquid}`"),
+                used: units.len(),
+                detected,
+            })
+        }
+        ByEar::UnitsKept => None,
+        ByEar::NothingNearer { missed } => {
+            return Err(FitError::NoModelNearer {
+                what: format!("liquid `{liquid}`"),
+                used: units.len(),
+                detected,
+                missed,
+            })
+        }
+    };
     if let Some(listening) = &listening {
         warnings.push(format!(
             "liquid `{liquid}`: the units' model did not sound like its recordings, so {} were \
