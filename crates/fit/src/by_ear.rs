@@ -586,7 +586,7 @@ fn what_it_misses(model: &toml::Table, targets: &[Target]) -> String {
                 let against = if target.default_distance_db >= NEAR_DISTANCE_DB {
                     format!("the default bottle's {:.2}", target.default_distance_db)
                 } else {
-                    format!("the {NEAR_DISTANCE_DB} within which models are not told apart")
+                    format!("the {NEAR_DISTANCE_DB} dB within which models are not told apart")
                 };
                 format!(
                     "a spectral distance of {:.2} dB against {against}",
