@@ -280,14 +280,7 @@ impl Search<'_> {
     fn cost_of(&self, table: &toml::Table) -> Option<f64> {
         let mut total = 0.0;
         for target in self.targets {
-            let samples = render_as_recorded(table, &target.made)?;
-            let listened = Listened::of(
-                &samples,
-                f64::from(target.made.sample_rate),
-                target.glugs,
-                &target.spectrum,
-            )
-            .as_candidate(target.made.duration_s);
+            let listened = listened_in(table, target)?.as_candidate(target.made.duration_s);
             total += misses(&target.listened, &listened, target.default_distance_db)
                 .iter()
                 .sum::<f64>();
@@ -538,16 +531,20 @@ fn sounds_like_every_recording(model: &toml::Table, targets: &[Target], farther:
     })
 }
 
-/// What a listener hears of `model` rendered as `target` was made, and its misses from it; None
-/// if it does not render.
-fn heard_in(model: &toml::Table, target: &Target) -> Option<(Listened, [f64; 5])> {
+/// What a listener hears of `model` rendered as `target` was made; None if it does not render.
+fn listened_in(model: &toml::Table, target: &Target) -> Option<Listened> {
     let samples = render_as_recorded(model, &target.made)?;
-    let listened = Listened::of(
+    Some(Listened::of(
         &samples,
         f64::from(target.made.sample_rate),
         target.glugs,
         &target.spectrum,
-    );
+    ))
+}
+
+/// [`listened_in`], and its misses from `target`.
+fn heard_in(model: &toml::Table, target: &Target) -> Option<(Listened, [f64; 5])> {
+    let listened = listened_in(model, target)?;
     let misses = misses(&target.listened, &listened, target.default_distance_db);
     Some((listened, misses))
 }
