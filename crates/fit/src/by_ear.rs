@@ -337,7 +337,7 @@ pub(crate) enum ByEar {
     /// Neither the units' model nor any the searches ended at sounds nearer the recordings than
     /// the default bottle on every measure: what the nearest of them missed, recording by
     /// recording.
-    NothingNearer { missed: String },
+    NoModelNearer { missed: String },
 }
 
 /// What the listening fit did for one liquid.
@@ -392,7 +392,7 @@ fn fit_to_targets(base: &toml::Table, estimates: &mut Vec<Estimate>, targets: &[
         return ByEar::UnitsKept;
     }
     let Some(units_cost) = search.cost_of(base) else {
-        return ByEar::NothingNearer {
+        return ByEar::NoModelNearer {
             missed: "the units' model does not render".to_owned(),
         };
     };
@@ -412,7 +412,7 @@ fn fit_to_targets(base: &toml::Table, estimates: &mut Vec<Estimate>, targets: &[
             }
             _ => base.clone(),
         };
-        return ByEar::NothingNearer {
+        return ByEar::NoModelNearer {
             missed: what_it_misses(&nearest, targets),
         };
     };

@@ -607,7 +607,7 @@ pub(crate) fn fit_liquid(
         ByEar::Fitted(listening) => Some(listening),
         // With no constant from the units and none by listening, the model would be the default
         // bottle: a model of no recording, which is refused as one of none would be.
-        ByEar::UnitsKept | ByEar::NothingNearer { .. } if !units_set => {
+        ByEar::UnitsKept | ByEar::NoModelNearer { .. } if !units_set => {
             return Err(FitError::NothingNearer {
                 what: format!("liquid `{liquid}`"),
                 used: units.len(),
@@ -615,7 +615,7 @@ pub(crate) fn fit_liquid(
             })
         }
         ByEar::UnitsKept => None,
-        ByEar::NothingNearer { missed } => {
+        ByEar::NoModelNearer { missed } => {
             return Err(FitError::NoModelNearer {
                 what: format!("liquid `{liquid}`"),
                 used: units.len(),
