@@ -152,6 +152,56 @@ pub fn misses(recording: &Listened, candidate: &Listened, default_distance_db: f
     ]
 }
 
+/// A measure on which a listener is asked whether a model sounds nearer a recording than the
+/// default bottle (the four, as docs/fit.md's tables report them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Measure {
+    /// The glug rate, within [`RATE_TOLERANCE`].
+    Rate,
+    /// The median glug pitch, within [`PITCH_TOLERANCE`].
+    Pitch,
+    /// The share of the energy above [`ONE_MODE_SPLIT_HZ`], within [`BRIGHT_TOLERANCE`].
+    Bright,
+    /// The log-spectral distance, below the default bottle's.
+    Distance,
+}
+
+impl Measure {
+    /// Its name, as the tables give it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Rate => "rate",
+            Self::Pitch => "pitch",
+            Self::Bright => "bright share",
+            Self::Distance => "spectral distance",
+        }
+    }
+}
+
+/// The measures on which `model` is not nearer `recording` than `default` is, each heard of the
+/// recording as it is (its noise in it) and of the renders as they are: the judge of whether a
+/// fit's model is written (MODEL.md §13, *Kept*), and of docs/fit.md's tables. Empty: nearer on
+/// every one.
+pub fn not_nearer(recording: &Listened, model: &Listened, default: &Listened) -> Vec<Measure> {
+    let within = |ours: f64, theirs: f64, tolerance: f64| {
+        !theirs.is_finite() || (ours / theirs - 1.0).abs() <= tolerance
+    };
+    let mut missed = Vec::new();
+    if !within(model.rate_per_s, recording.rate_per_s, RATE_TOLERANCE) {
+        missed.push(Measure::Rate);
+    }
+    if !within(model.pitch_hz, recording.pitch_hz, PITCH_TOLERANCE) {
+        missed.push(Measure::Pitch);
+    }
+    if model.bright.is_nan() || (model.bright - recording.bright).abs() > BRIGHT_TOLERANCE {
+        missed.push(Measure::Bright);
+    }
+    if model.distance_db.partial_cmp(&default.distance_db) != Some(std::cmp::Ordering::Less) {
+        missed.push(Measure::Distance);
+    }
+    missed
+}
+
 /// How a constant is searched: its scale and the widest span tried.
 #[derive(Debug, Clone, Copy)]
 enum Scale {
@@ -250,10 +300,18 @@ struct Target {
     made: AsRecorded,
     /// Its glugs (the pitch fall is read over as many).
     glugs: usize,
+    /// Its spectrum with its noise out, which the searches match.
     spectrum: Spectrum,
+    /// What is heard of it with its noise out (the bright share), which the searches match.
     listened: Listened,
-    /// The default bottle's log-spectral distance from it (dB).
+    /// The default bottle's log-spectral distance from [`Target::spectrum`] (dB).
     default_distance_db: f64,
+    /// Its spectrum as it is, which a listener hears.
+    as_is_spectrum: Spectrum,
+    /// What is heard of it as it is, by which a model is judged nearer than the default.
+    as_is: Listened,
+    /// What is heard of the default bottle rendered as it was made, against it as it is.
+    default_as_is: Listened,
 }
 
 /// The search: candidates rendered and listened to.
@@ -388,7 +446,7 @@ fn fit_to_targets(base: &toml::Table, estimates: &mut Vec<Estimate>, targets: &[
         bounds: &bounds,
         targets,
     };
-    if sounds_like_every_recording(base, targets, NO_FARTHER) {
+    if sounds_like_every_recording(base, targets) {
         return ByEar::UnitsKept;
     }
     let Some(units_cost) = search.cost_of(base) else {
@@ -400,10 +458,15 @@ fn fit_to_targets(base: &toml::Table, estimates: &mut Vec<Estimate>, targets: &[
     let pour_key = Control::PourTime.quantity().scene_key;
     let units_pour_s = units_value(pour_key);
     // The units' model missed at least one measure on some recording (above), so a search's end
-    // that a listener takes for nearer on every one is kept whatever its cost; where none is, no
-    // model of these recordings was found, and writing the nearest would be a made-up result.
+    // that a listener takes for nearer on every one is kept whatever its cost; where none is but
+    // the units' model is (its misses above are heard with the noise out), it stands; where
+    // neither is, no model of these recordings was found, and writing the nearest would be a
+    // made-up result.
     let best = best_of_searches(&search, starts, units_pour_s);
     let Some((true, pour_s, x, cost)) = best else {
+        if nearer_than_the_default(base, targets) {
+            return ByEar::UnitsKept;
+        }
         let nearest = match &best {
             Some((_, pour_s, x, cost)) if *cost < units_cost => {
                 let mut end = search.model(x);
@@ -461,6 +524,9 @@ fn targets_of(recordings: &[&RecordingFit], capacity_ml: f64) -> Option<Vec<Targ
             let default_render = render_as_recorded(&default, &made)?;
             let default_distance_db =
                 log_spectral_distance(&spectrum, &Spectrum::of(&default_render, fs), fs);
+            // As docs/fit.md hears them: the recording's excerpt and its spectrum as they are.
+            let as_is = Listened::of(samples, fs, 0, &recording.spectrum);
+            let default_as_is = Listened::of(&default_render, fs, glugs, &recording.spectrum);
             Some(Target {
                 // The file's name alone, so that the message reads alike wherever the file lies.
                 name: recording
@@ -473,6 +539,9 @@ fn targets_of(recordings: &[&RecordingFit], capacity_ml: f64) -> Option<Vec<Targ
                 spectrum,
                 listened,
                 default_distance_db,
+                as_is_spectrum: recording.spectrum.clone(),
+                as_is,
+                default_as_is,
             })
         })
         .collect()
@@ -520,15 +589,40 @@ fn search_bounds(knobs: &[Knob], targets: &[Target]) -> Vec<(f64, f64)> {
 }
 
 /// Whether `model`, rendered as each recording was made, passes on the four measures a listener
-/// is asked about (the fall is the headspace law's, which the units give and the search leaves
-/// alone), its distance at most `farther` times the default bottle's (or [`NEAR_DISTANCE_DB`]).
-fn sounds_like_every_recording(model: &toml::Table, targets: &[Target], farther: f64) -> bool {
+/// is asked about, heard as the searches hear them (the recordings' noise out; the fall is the
+/// headspace law's, which the units give and the search leaves alone), its distance at most
+/// [`NO_FARTHER`] times the default bottle's (or [`NEAR_DISTANCE_DB`]): so near that the searches
+/// are not run.
+fn sounds_like_every_recording(model: &toml::Table, targets: &[Target]) -> bool {
     targets.iter().all(|target| {
         heard_in(model, target).is_some_and(|(_, misses)| {
             let [rate, pitch, _, bright, distance] = misses;
-            [rate, pitch, bright].iter().all(|&m| m < 1.0) && distance < farther * farther
+            [rate, pitch, bright].iter().all(|&m| m < 1.0) && distance < NO_FARTHER * NO_FARTHER
         })
     })
+}
+
+/// Whether `model`, rendered as each recording was made, is nearer every recording than the
+/// default bottle on every measure, as [`not_nearer`] judges it.
+fn nearer_than_the_default(model: &toml::Table, targets: &[Target]) -> bool {
+    targets
+        .iter()
+        .all(|target| judged_in(model, target).is_some_and(|(_, missed)| missed.is_empty()))
+}
+
+/// What a listener hears of `model` rendered as `target` was made, against the recording as it
+/// is, and the measures on which it is not nearer than the default bottle; None if it does not
+/// render.
+fn judged_in(model: &toml::Table, target: &Target) -> Option<(Listened, Vec<Measure>)> {
+    let samples = render_as_recorded(model, &target.made)?;
+    let heard = Listened::of(
+        &samples,
+        f64::from(target.made.sample_rate),
+        target.glugs,
+        &target.as_is_spectrum,
+    );
+    let missed = not_nearer(&target.as_is, &heard, &target.default_as_is);
+    Some((heard, missed))
 }
 
 /// What a listener hears of `model` rendered as `target` was made; None if it does not render.
@@ -550,50 +644,37 @@ fn heard_in(model: &toml::Table, target: &Target) -> Option<(Listened, [f64; 5])
 }
 
 /// The measures on which `model` is not nearer `targets` than the default bottle, recording by
-/// recording, with what was heard of each (as [`sounds_like_every_recording`] judges them).
+/// recording, with what was heard of each (as [`nearer_than_the_default`] judges them).
 fn what_it_misses(model: &toml::Table, targets: &[Target]) -> String {
     let mut said = Vec::new();
     for target in targets {
-        let Some((heard, [rate, pitch, _, bright, distance])) = heard_in(model, target) else {
+        let Some((heard, missed)) = judged_in(model, target) else {
             said.push(format!("{}: the model does not render", target.name));
             continue;
         };
-        let wanted = &target.listened;
-        let missed: Vec<String> = [
-            (rate >= 1.0).then(|| {
-                format!(
+        let (wanted, default) = (&target.as_is, &target.default_as_is);
+        let missed: Vec<String> = missed
+            .iter()
+            .map(|measure| match measure {
+                Measure::Rate => format!(
                     "{:.3} glugs a second for its {:.3}",
                     heard.rate_per_s, wanted.rate_per_s
-                )
-            }),
-            (pitch >= 1.0).then(|| {
-                format!(
+                ),
+                Measure::Pitch => format!(
                     "a median pitch of {:.0} Hz for its {:.0}",
                     heard.pitch_hz, wanted.pitch_hz
-                )
-            }),
-            (bright >= 1.0).then(|| {
-                format!(
+                ),
+                Measure::Bright => format!(
                     "{:.0} % of the energy above {ONE_MODE_SPLIT_HZ} Hz for its {:.0} %",
                     100.0 * heard.bright,
                     100.0 * wanted.bright
-                )
-            }),
-            (distance >= 1.0).then(|| {
-                let against = if target.default_distance_db >= NEAR_DISTANCE_DB {
-                    format!("the default bottle's {:.2}", target.default_distance_db)
-                } else {
-                    format!("the {NEAR_DISTANCE_DB} dB within which models are not told apart")
-                };
-                format!(
-                    "a spectral distance of {:.2} dB against {against}",
-                    heard.distance_db
-                )
-            }),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
+                ),
+                Measure::Distance => format!(
+                    "a spectral distance of {:.2} dB against the default bottle's {:.2}",
+                    heard.distance_db, default.distance_db
+                ),
+            })
+            .collect();
         if !missed.is_empty() {
             said.push(format!("{}: {}", target.name, missed.join(", ")));
         }
@@ -639,7 +720,7 @@ fn best_of_searches(
             let Some(cost) = search.cost_of(&end) else {
                 break;
             };
-            let nearer = sounds_like_every_recording(&end, search.targets, 1.0);
+            let nearer = nearer_than_the_default(&end, search.targets);
             if best
                 .as_ref()
                 .is_none_or(|&(was_nearer, _, _, c)| (nearer, -cost) > (was_nearer, -c))

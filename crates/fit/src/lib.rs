@@ -40,7 +40,7 @@ pub mod compare;
 pub mod comparisons;
 
 pub use audio::{Audio, FIT_BYTES_PER_SAMPLE, MIN_SAMPLE_RATE_HZ};
-pub use by_ear::{misses, Listened, ListeningFit};
+pub use by_ear::{misses, not_nearer, Listened, ListeningFit, Measure};
 #[cfg(feature = "plot")]
 pub use compare_plot::draw_compare_plot;
 pub use curves::FittedCurves;
