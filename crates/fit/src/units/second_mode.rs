@@ -48,12 +48,18 @@ pub(super) struct EarlyLeft {
     pub samples: Vec<f64>,
 }
 
-/// What `unit`'s fit left of its first [`EARLY_S`], if the unit has fitted nothing above its
-/// stronger component (a weaker one below is replaced: a low blob an eq. 1 started at hum or the
-/// room gives, not the bright mode).
+/// What `unit`'s fit left of its first [`EARLY_S`], if the unit has fitted no second mode above
+/// its stronger component. A weaker one below is replaced (a low blob an eq. 1 started at hum or
+/// the room gives, not the bright mode), and so is one above it but within [`SEPARATE_MODES`]:
+/// that is the same mode's glide or beat, which eq. 1's second component takes in where the long
+/// mode glides (a development draw's units fitted 195 and 218 Hz for a cavity gliding down to
+/// 203 Hz as heard, and its bubble mode at 823 Hz was sought in none of them).
 pub(super) fn early_left(span: &Span, unit: &UnitFit) -> Option<EarlyLeft> {
     let main = *unit.stronger()?;
-    if unit.fitted().any(|c| c.heard_hz > main.heard_hz) {
+    if unit
+        .fitted()
+        .any(|c| c.heard_hz >= main.heard_hz * SEPARATE_MODES)
+    {
         return None;
     }
     let from = (span.onset - span.first).min(span.samples.len());
@@ -150,8 +156,13 @@ pub(super) fn with_second_mode(
     };
     // A gliding unit's pair glides too (the bright mode sweeps as the bubble forms); where that
     // fails (a glide out of range, or the unit's own mode no longer reaching its f), the main
-    // mode glides and the short one is steady; else the two steady.
-    if main.glide.is_some() {
+    // mode glides and the short one is steady; else the two steady. A unit whose fit put a
+    // second component just above its main one (its glide, fitted as two steady components) is
+    // a gliding unit too.
+    let glide_as_two = unit
+        .fitted()
+        .any(|c| c.heard_hz > main.heard_hz && c.heard_hz < main.heard_hz * SEPARATE_MODES);
+    if main.glide.is_some() || glide_as_two {
         return pair([true, true])
             .or_else(|| pair([true, false]))
             .or_else(|| pair([false, false]));
