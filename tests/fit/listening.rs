@@ -261,12 +261,20 @@ fn missed(rows: &[Row]) -> Vec<String> {
         .collect()
 }
 
+/// Holds docs/fit.md's block `name` to the fit of at least `at_least` clips, then the issue's
+/// claim on them: every clip's model nearer than the default bottle, or the clip refused.
+fn reported_and_nearer(clips: &[PathBuf], name: &str, at_least: usize) {
+    let rows = heard_and_documented(clips, name);
+    assert!(rows.len() >= at_least, "{} clips in {name}", rows.len());
+    let missed = missed(&rows);
+    assert!(missed.is_empty(), "{missed:#?}");
+}
+
 /// The development half: every fitted clip sounds nearer than the default, and docs/fit.md
 /// reports it as the fit gives it.
 #[test]
 fn development_clips_sound_nearer_than_the_default_bottle() {
-    let missed = missed(&heard_and_documented(&development(), "fit-development"));
-    assert!(missed.is_empty(), "{missed:#?}");
+    reported_and_nearer(&development(), "fit-development", 10);
 }
 
 /// The first held-out half, seen since it was run once at e092597d (one clip of it led to a rule
@@ -282,10 +290,7 @@ fn the_first_held_out_half_is_reported_as_fitted() {
 /// showed: every clip's model nearer than the default bottle, or the clip refused.
 #[test]
 fn the_second_held_out_set_is_reported_and_sounds_nearer_than_the_default_bottle() {
-    let rows = heard_and_documented(&second_held_out(), "fit-held-out-2");
-    assert!(rows.len() >= 5, "{} held-out clips", rows.len());
-    let missed = missed(&rows);
-    assert!(missed.is_empty(), "{missed:#?}");
+    reported_and_nearer(&second_held_out(), "fit-held-out-2", 5);
 }
 
 /// The third held-out set, run once with a candidate fit kept off main (docs/fit.md reports what
@@ -294,10 +299,7 @@ fn the_second_held_out_set_is_reported_and_sounds_nearer_than_the_default_bottle
 /// is refused.
 #[test]
 fn the_third_held_out_set_is_reported_as_fitted() {
-    let rows = heard_and_documented(&third_held_out(), "fit-held-out-3");
-    assert!(rows.len() >= 6, "{} held-out clips", rows.len());
-    let missed = missed(&rows);
-    assert!(missed.is_empty(), "{missed:#?}");
+    reported_and_nearer(&third_held_out(), "fit-held-out-3", 6);
 }
 
 /// Where the units explain too little of a clip and neither their model nor any fitted by
@@ -333,11 +335,8 @@ fn a_clip_no_model_sounds_nearer_is_refused_with_what_the_nearest_missed() {
 /// reports it as the fit gives it now, which this test holds.
 #[test]
 fn the_fourth_held_out_set_is_reported_as_fitted() {
-    let rows = heard_and_documented(&fourth_held_out(), "fit-held-out-4");
-    assert!(rows.len() >= 8, "{} held-out clips", rows.len());
     // Since the toilet led to a rule, the claim holds on the set as the fit now gives it.
-    let missed = missed(&rows);
-    assert!(missed.is_empty(), "{missed:#?}");
+    reported_and_nearer(&fourth_held_out(), "fit-held-out-4", 8);
 }
 
 /// The fifth held-out set, gathered when the fourth had been seen and run once, at the end, with
@@ -348,10 +347,7 @@ fn the_fourth_held_out_set_is_reported_as_fitted() {
 /// clip's model nearer than the default bottle, or the clip refused.
 #[test]
 fn the_fifth_held_out_set_is_reported_and_sounds_nearer_than_the_default_bottle() {
-    let rows = heard_and_documented(&fifth_held_out(), "fit-held-out-5");
-    assert!(rows.len() >= 8, "{} held-out clips", rows.len());
-    let missed = missed(&rows);
-    assert!(missed.is_empty(), "{missed:#?}");
+    reported_and_nearer(&fifth_held_out(), "fit-held-out-5", 8);
 }
 
 /// The sixth held-out set, gathered when the fifth had been seen (none of its clips a bottle's
@@ -362,8 +358,5 @@ fn the_fifth_held_out_set_is_reported_and_sounds_nearer_than_the_default_bottle(
 /// default bottle, or the clip refused.
 #[test]
 fn the_sixth_held_out_set_is_reported_and_sounds_nearer_than_the_default_bottle() {
-    let rows = heard_and_documented(&sixth_held_out(), "fit-held-out-6");
-    assert!(rows.len() >= 10, "{} held-out clips", rows.len());
-    let missed = missed(&rows);
-    assert!(missed.is_empty(), "{missed:#?}");
+    reported_and_nearer(&sixth_held_out(), "fit-held-out-6", 10);
 }

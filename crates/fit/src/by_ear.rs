@@ -153,7 +153,8 @@ pub fn misses(recording: &Listened, candidate: &Listened, default_distance_db: f
 }
 
 /// A measure on which a listener is asked whether a model sounds nearer a recording than the
-/// default bottle (the four, as docs/fit.md's tables report them).
+/// default bottle: the rate, the pitch, the bright share and the spectral distance, as
+/// docs/fit.md's tables report them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Measure {
     /// The glug rate, within [`RATE_TOLERANCE`].

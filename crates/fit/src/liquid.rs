@@ -572,7 +572,7 @@ pub(crate) fn fit_liquid(
             format!(
                 "the units fitted explain only {:.0} % of {}: the paper's model describes it \
                  poorly, and this model may not sound like it",
-                100.0 * r.explained.max(0.0),
+                100.0 * r.explained,
                 r.name()
             )
         })

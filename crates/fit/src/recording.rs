@@ -138,7 +138,7 @@ pub(crate) fn fit_recording(
         warnings.push(format!(
             "`{audio_key}`: the units fitted explain only {:.0} % of its energy: the paper's \
              model describes this recording poorly",
-            100.0 * found.explained.max(0.0)
+            100.0 * found.explained
         ));
     }
     let excerpt_len =

@@ -65,7 +65,7 @@ pub fn report_markdown(fit: &SessionFit) -> String {
             recording.duration_s,
             recording.detected.len(),
             recording.units.len(),
-            100.0 * recording.explained.max(0.0),
+            100.0 * recording.explained,
             if recording.explained < LOW_EXPLAINED {
                 " (low)"
             } else {

@@ -564,7 +564,7 @@ pub struct RecordingUnits {
     pub one_peak: bool,
     /// The recording's spectrum.
     pub spectrum: Spectrum,
-    /// The share of the recording's energy the units kept explain.
+    /// The share of the recording's energy the units kept explain, from 0 to 1.
     pub explained: f64,
 }
 
@@ -680,7 +680,8 @@ pub fn fit_units(samples: &[f32], sample_rate: u32) -> RecordingUnits {
         ..
     } = in_turn;
     let energy = |signal: &[f32]| signal.iter().map(|&y| f64::from(y).powi(2)).sum::<f64>();
-    let explained = 1.0 - energy(&residual) / energy(samples).max(1e-300);
+    // Units whose fits, taken out, leave more than was there explain none of it, not less.
+    let explained = (1.0 - energy(&residual) / energy(samples).max(1e-300)).max(0.0);
     RecordingUnits {
         units,
         detected,
