@@ -62,8 +62,15 @@ pub struct Anchors {
     groups: Box<[Group; GROUPS]>,
     /// The earliest `event_at`: before it, a period's step is the array loop alone.
     first_event_at: u64,
+    /// A sample at which every entry is anchored ([`NOT_ALL_ANCHORED`] if none is known): the
+    /// period start the bank last stepped to, until an entry is set anchored elsewhere. It spares
+    /// [`Anchors::leading_at`] its walk over the bank in nearly every period.
+    all_anchored_at: u64,
     period_sum: PeriodSum,
 }
+
+/// [`Anchors::all_anchored_at`] when no sample is known at which every entry is anchored.
+const NOT_ALL_ANCHORED: u64 = u64::MAX;
 
 /// Groups of [`LANES`] entries in [`Anchors`].
 const GROUPS: usize = MAX_COMPONENTS / LANES;
@@ -106,6 +113,7 @@ impl Default for Anchors {
             len: 0,
             groups: Box::new([Group::default(); GROUPS]),
             first_event_at: u64::MAX,
+            all_anchored_at: NOT_ALL_ANCHORED,
             period_sum: PeriodSum::default(),
         }
     }
@@ -121,6 +129,9 @@ impl Anchors {
     /// Entry `index` from `component`'s state at its start.
     fn set(&mut self, index: usize, component: &AnchoredComponent) {
         let first_sample = component.component.first_sample();
+        if first_sample != self.all_anchored_at {
+            self.all_anchored_at = NOT_ALL_ANCHORED;
+        }
         self.set_anchor(index, component.first_anchor);
         let (group, lane) = self.entry_mut(index);
         [group.next_re[lane], group.next_im[lane]] = component.first_next_anchor;
@@ -186,6 +197,9 @@ impl Anchors {
     /// How many entries from the first are anchored at `sample`.
     #[inline]
     fn leading_at(&self, sample: u64) -> usize {
+        if sample == self.all_anchored_at {
+            return self.len;
+        }
         (0..self.len)
             .take_while(|&index| {
                 let (group, lane) = self.entry(index);
@@ -241,11 +255,14 @@ impl BankComponent for AnchoredComponent {
     fn cleared(anchors: &mut Anchors) {
         anchors.len = 0;
         anchors.first_event_at = u64::MAX;
+        anchors.all_anchored_at = NOT_ALL_ANCHORED;
         anchors.period_sum.period_start = None;
     }
 
     fn advance_all(components: &mut Vec<Self>, anchors: &mut Anchors, period_start: u64) {
         step_anchors(anchors, period_start);
+        // The step anchors every entry there, and no event moves an anchor's sample.
+        anchors.all_anchored_at = period_start;
         if period_start < anchors.first_event_at {
             return;
         }
