@@ -10,6 +10,9 @@ use crate::command::sake_glug;
 use sake_glug_render::clips::{ClipSource, Glug};
 use sake_glug_render::loudness::LoudnessMeter;
 use sake_glug_render::sinks::ahap_json;
+use sake_glug_render::{render_scene_to_vec, trim, Scene};
+
+use crate::support::BUSY_SCENE;
 
 /// The mono f32 samples of a WAV the renderer wrote, and its rate.
 fn wav(path: &Path) -> (Vec<f32>, u32) {
@@ -539,4 +542,30 @@ fn a_file_that_clips_is_named_with_its_count() {
     ]);
     assert!(!held.contains("warning"), "{held}");
     assert!(!render(&["render", "-o", "plain.wav"]).contains("warning"));
+}
+
+/// The summary's peak is the largest |y| the render wrote, read here from the samples: on a
+/// held pour, whose blocks the engine's one output pass measures as it goes; through ramps of
+/// tilt and gain, measured after the block; with the limiter at work; and in a trimmed render,
+/// whose fade comes after the engine's pass.
+#[test]
+fn the_summary_peak_is_the_largest_sample_written() {
+    let held = "duration_s = 3.0\ntilt_deg = 135.0\n[output]\ndrain = \"follow\"\n";
+    let limited = format!("{held}gain_db = 24.0\n");
+    let scenes = [
+        ("held pour", Scene::parse(held).unwrap()),
+        ("ramps", Scene::parse(BUSY_SCENE).unwrap()),
+        ("limiter", Scene::parse(&limited).unwrap()),
+        ("trimmed", trim::trimmed(Scene::default(), -30.0).unwrap()),
+    ];
+    assert!(scenes[3].1.fade_out.is_some(), "the trimmed render fades");
+    for (name, scene) in scenes {
+        let (samples, summary) = render_scene_to_vec(&scene).unwrap();
+        let largest = samples.iter().fold(0.0f32, |m, y| m.max(y.abs()));
+        assert!(largest > 0.01, "{name}: the scene sounds");
+        assert_eq!(summary.peak.to_bits(), largest.to_bits(), "{name}");
+        if name == "limiter" {
+            assert_eq!(largest, 1.0, "the limiter holds the ceiling");
+        }
+    }
 }

@@ -27,6 +27,7 @@ pub use controls::{
 };
 pub use glide::Glide;
 pub use headspace::Headspace;
+pub use output::peak;
 use output::OutputStage;
 use pour::MAX_ONSETS_PER_SAMPLE;
 pub use pour::{Outflow, Pour, PourStats, UnitOnset};
@@ -80,6 +81,9 @@ pub struct Engine<S: Synthesis = AnchoredF32> {
     /// and nothing but rendering has touched the engine since: the pour's inputs and the
     /// output's targets it took are in force, for [`Engine::process_unchanged`].
     constant_block_taken: bool,
+    /// The largest |y| of the last block's output, where the output stage knew it from its own
+    /// pass (see [`Engine::block_peak`]).
+    block_peak: Option<f32>,
 }
 
 /// The inputs that drove the pour over the last span that held them constant: as given, and
@@ -159,6 +163,7 @@ impl<S: Synthesis> Engine<S> {
             actuator: None,
             held_pour: HeldPour::default(),
             constant_block_taken: false,
+            block_peak: None,
         };
         engine.reset();
         engine
@@ -306,6 +311,14 @@ impl<S: Synthesis> Engine<S> {
         self.resting_under.is_some()
     }
 
+    /// The largest |y| of the last block's output, where the engine knows it without reading
+    /// the block again: a block under constant controls at a settled gain and ceiling, whose
+    /// output stage is one pass over the whole block, or a settled block of silence. `None`
+    /// where it does not (then the caller reads the samples).
+    pub fn block_peak(&self) -> Option<f32> {
+        self.block_peak
+    }
+
     /// Nothing sounds and, under constant controls, nothing would start: the rest is silence.
     pub fn is_settled(&self) -> bool {
         self.synthesis.is_empty() && self.resting_under.is_some()
@@ -328,6 +341,7 @@ impl<S: Synthesis> Engine<S> {
         on_unit: &mut impl FnMut(&UnitOnset, Voicing),
     ) {
         self.constant_block_taken = false;
+        self.block_peak = None;
         if out.is_empty() {
             return;
         }
@@ -341,6 +355,7 @@ impl<S: Synthesis> Engine<S> {
             // Settled under the same controls: the block is silence, so it costs a fill and not
             // a walk over its grid periods. An empty bank only needs the last period start.
             out.fill(0.0);
+            self.block_peak = Some(0.0);
             self.output
                 .pass_silence(&controls.gain_db, self.ceiling(), out.len());
             let end = self.sample + out.len() as u64;
@@ -418,7 +433,7 @@ impl<S: Synthesis> Engine<S> {
             done += span;
         }
         if settled {
-            self.output.apply_settled(out);
+            self.block_peak = Some(self.output.apply_settled(out));
         }
         self.constant_block_taken = true;
     }
@@ -437,6 +452,7 @@ impl<S: Synthesis> Engine<S> {
         out: &mut [f32],
         on_unit: &mut impl FnMut(&UnitOnset, Voicing),
     ) {
+        self.block_peak = None;
         if !(self.constant_block_taken && self.take_steady_span(out)) {
             self.process_observed(controls, out, on_unit);
         }
@@ -456,8 +472,9 @@ impl<S: Synthesis> Engine<S> {
         {
             return false;
         }
-        let sanitized = &self.held_pour.sanitized;
-        let Some(advanced) = self.pour.advance_plain(self.sample, len as u64, sanitized) else {
+        // The controls, the constants and the bottle are those of the constant block before
+        // (`constant_block_taken`: anything else that touches the engine clears it).
+        let Some(advanced) = self.pour.advance_plain_unchanged(self.sample, len as u64) else {
             return false;
         };
         self.poured(advanced, true);

@@ -236,11 +236,26 @@ impl OutputStage {
     /// [`OutputStage::begin_constant_block`]): sample by sample the same operations, so a block
     /// at once gives the bits and counts of its spans one by one; a silent span (zeros) stays
     /// zeros.
+    /// Returns the block's largest |y| as written, which the pass knows without another.
     #[inline]
-    pub fn apply_settled(&mut self, out: &mut [f32]) {
-        let ceiling = self.ceiling.value as f32;
-        if gain_and_flush(out, self.gain.value, ceiling) {
+    pub fn apply_settled(&mut self, out: &mut [f32]) -> f32 {
+        self.gain_and_limit(out, self.gain.value, self.ceiling.value as f32)
+    }
+
+    /// The gain, then the limiter, at one gain and ceiling; returns the largest |y| written.
+    #[inline]
+    fn gain_and_limit(&mut self, out: &mut [f32], gain: f64, ceiling: f32) -> f32 {
+        let largest = gain_and_flush(out, gain);
+        if largest > ceiling.to_bits() {
             self.limit(out, ceiling);
+            return peak(out);
+        }
+        // The largest magnitude before the flush: a denormal one was flushed to 0, and so was
+        // every other sample below it.
+        if largest < f32::MIN_POSITIVE.to_bits() {
+            0.0
+        } else {
+            f32::from_bits(largest)
         }
     }
 
@@ -267,11 +282,9 @@ impl OutputStage {
         if gained.key != Some(key) {
             gained.key = Some(key);
             gained.samples = *sum;
-            gained.within = !gain_and_flush(
-                &mut gained.samples,
-                self.gain.value,
-                self.ceiling.value as f32,
-            );
+            let ceiling = self.ceiling.value as f32;
+            gained.within =
+                gain_and_flush(&mut gained.samples, self.gain.value) <= ceiling.to_bits();
         }
         if !gained.within {
             return false;
@@ -292,7 +305,7 @@ impl OutputStage {
         if constant_gain && self.ceiling.is_settled() {
             // The usual span, in one pass; the limiter's own pass only when it has work to do.
             let ceiling = self.ceiling.value as f32;
-            if gain_and_flush(out, self.gain.value, ceiling) {
+            if gain_and_flush(out, self.gain.value) > ceiling.to_bits() {
                 self.limit(out, ceiling);
             }
             return;
@@ -345,20 +358,20 @@ impl OutputStage {
     }
 }
 
-/// The output gain, then the limiter's flush of denormals to 0, in one pass: returns whether any
-/// sample is NaN, infinite or past `ceiling`, the only samples on which the limiter does more
+/// The output gain, then the limiter's flush of denormals to 0, in one pass: returns the bits of
+/// the largest |y| before the flush, which lie past `ceiling`'s exactly when some sample is NaN,
+/// infinite or past `ceiling`, the only samples on which the limiter does more
 /// (then [`OutputStage::limit`] runs over the result and gives the very bits and counts it gives
 /// without the flush: a flushed sample was finite and below 2^−126, under any ceiling, which is
 /// at least [`CEILING`]'s minimum, so it counts for nothing, and the limiter makes it 0 too).
 /// Compiled like the synthesis for AVX2 and AVX-512 (the same IEEE operations in each lane, so
 /// the same bits as the baseline).
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
-fn gain_and_flush(out: &mut [f32], gain: f64, ceiling: f32) -> bool {
+fn gain_and_flush(out: &mut [f32], gain: f64) -> u32 {
     const { assert!(CEILING.min as f32 >= f32::MIN_POSITIVE) };
     // The bits of |y| order as the magnitudes do, and NaN's lie above infinity's: the largest
     // is past the ceiling's exactly when some sample is NaN, infinite or past the ceiling (an
     // integer maximum, where the comparisons themselves would each need a reduction).
-    let magnitude = |y: f32| y.to_bits() & !(1 << 31);
     let mut largest = 0;
     for y in out.iter_mut() {
         let value = (*y as f64 * gain) as f32;
@@ -369,7 +382,23 @@ fn gain_and_flush(out: &mut [f32], gain: f64, ceiling: f32) -> bool {
             value
         };
     }
-    largest > ceiling.to_bits()
+    largest
+}
+
+/// |y| as bits: they order as the magnitudes do (NaN's above infinity's), so a maximum over
+/// them is an integer maximum, which vectorises where a float `max`, for its NaN rules, does not.
+#[inline(always)]
+fn magnitude(y: f32) -> u32 {
+    y.to_bits() & !(1 << 31)
+}
+
+/// The largest |y| of samples that are finite (an output block, which the limiter has been
+/// through): what a render reports as its peak. Compiled like [`gain_and_flush`].
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
+pub fn peak(samples: &[f32]) -> f32 {
+    // Below 2^31, the bits also order as an i32's, which the SIMD maximum works on.
+    let largest = samples.iter().map(|&y| magnitude(y) as i32).max();
+    f32::from_bits(largest.unwrap_or(0) as u32)
 }
 
 #[cfg(test)]
@@ -387,7 +416,7 @@ mod tests {
     }
 
     #[test]
-    fn the_one_pass_span_gives_the_bits_and_counts_of_gain_then_limiter() {
+    fn the_one_pass_span_gives_the_bits_counts_and_peak_of_gain_then_limiter() {
         let specials = [
             0.0,
             -0.0,
@@ -435,9 +464,9 @@ mod tests {
                     let counts = gain_then_limiter(&mut expected, gain, ceiling);
                     let mut stage = OutputStage::new(48_000.0);
                     let mut got = input.clone();
-                    if gain_and_flush(&mut got, gain, ceiling) {
-                        stage.limit(&mut got, ceiling);
-                    }
+                    let got_peak = stage.gain_and_limit(&mut got, gain, ceiling);
+                    let expected_peak = expected.iter().fold(0.0f32, |m, y| m.max(y.abs()));
+                    assert_eq!(got_peak.to_bits(), expected_peak.to_bits(), "{input:?}");
                     let bits = |samples: &[f32]| samples.iter().map(|y| y.to_bits()).collect();
                     let (got_bits, expected_bits): (Vec<u32>, Vec<u32>) =
                         (bits(&got), bits(&expected));

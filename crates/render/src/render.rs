@@ -192,7 +192,12 @@ pub fn render_scene<E: From<RenderError>>(
             Some(last) => {
                 write_zeros(&mut sink, held_zeros)?;
                 sink(&block[..=last])?;
-                peak = peak.max(block_peak(block));
+                // The engine's own pass knows the block's peak, unless a fade came after it.
+                let block_peak = match engine.block_peak() {
+                    Some(block_peak) if scene.fade_out.is_none() => block_peak,
+                    _ => sake_glug_engine::peak(block),
+                };
+                peak = peak.max(block_peak);
                 written = position + last as u64 + 1;
                 held_zeros = (len - last - 1) as u64;
             }
@@ -321,16 +326,6 @@ fn refuse_endless_decays(scene: &Scene) -> Result<(), RenderError> {
 /// to end, 0 included, is refused before rendering by [`refuse_endless_decays`].)
 fn endless(scene: &Scene, engine: &Engine) -> bool {
     scene.config.drain == DrainMode::Follow && !engine.is_resting()
-}
-
-/// The largest |y| of a block. The engine's output is finite, and the bits of a finite float
-/// without its sign order as its magnitude does (and as an i32, being below 2^31), so this is an
-/// integer maximum, which vectorises (a float `max` does not, for its NaN rules); compiled for
-/// AVX2 too, picked at run time.
-#[multiversion::multiversion(targets("x86_64+avx2+avx"))]
-pub(crate) fn block_peak(block: &[f32]) -> f32 {
-    let magnitude = |y: &f32| (y.to_bits() & !(1 << 31)) as i32;
-    f32::from_bits(block.iter().map(magnitude).max().unwrap_or(0) as u32)
 }
 
 fn write_zeros<E>(sink: &mut impl FnMut(&[f32]) -> Result<(), E>, count: u64) -> Result<(), E> {

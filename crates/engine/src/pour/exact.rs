@@ -51,12 +51,14 @@ impl BinadeSteps {
         if ratio >= IMPLICIT_BIT as f64 {
             return None;
         }
-        let whole = ratio.floor();
-        let fraction = ratio - whole;
+        // The floor of a positive number below 2^53 by truncation to an integer, which is
+        // exact: `f64::floor` is a call into libm on x86-64's baseline (no SSE4.1 `roundsd`).
+        let whole = ratio as u64;
+        let fraction = ratio - whole as f64;
         if fraction == 0.5 {
             return None;
         }
-        let delta = whole as u64 + u64::from(fraction > 0.5);
+        let delta = whole + u64::from(fraction > 0.5);
         // Each step's exact result must stay in the binade, where the unit is u: x − a at or above
         // 2^e, which holds while m − δ − 1 ≥ 2^52 (the exact m − a/u lies above m − δ − 1); x + a
         // below 2^(e+1), which holds while m + δ + 1 ≤ 2^53. With δ = 0 (a below half a unit)

@@ -316,15 +316,25 @@ impl Pour {
         count: u64,
         controls: &ControlValues,
     ) -> Option<Advanced> {
-        let run = self.plain.as_mut()?;
         // As `advance` would find it: no step of its own first, and the run covering the span.
-        if count == 0
-            || run.samples_left < count
-            || self.config_changed
+        if self.config_changed
             || !self
                 .bottle
                 .is_steady_under(controls, self.config.capacity_ml)
         {
+            return None;
+        }
+        self.advance_plain_unchanged(first_sample, count)
+    }
+
+    /// [`Pour::advance_plain`] where the caller knows that neither the controls nor the constants
+    /// changed, and no refill was asked for, since the last step, which was taken under the
+    /// controls the run was planned for (the engine's blocks under the very controls of a
+    /// constant block before them): only whether the run covers the span is left to check.
+    #[inline]
+    pub fn advance_plain_unchanged(&mut self, first_sample: u64, count: u64) -> Option<Advanced> {
+        let run = self.plain.as_mut()?;
+        if count == 0 || run.samples_left < count {
             return None;
         }
         run.samples_left -= count;

@@ -550,13 +550,19 @@ impl AnchoredComponent {
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx", "x86_64+avx2+avx"))]
 fn sum_period(components: &[AnchoredComponent], groups: &[Group], out: &mut [f32; GRID]) {
     let mut sum = [0.0; GRID];
-    for (components, group) in components.chunks(LANES).zip(groups) {
-        for ((component, &re), &im) in components
-            .iter()
-            .zip(&group.anchor_re)
-            .zip(&group.anchor_im)
-        {
-            component.synthesize_period([re, im], &mut sum);
+    // Whole groups in a loop of a known length, which the compiler unrolls (a loop over a
+    // chunk of unknown length was unrolled or not as the build's partition fell), then the
+    // rest: the same components in the same order.
+    let whole = components.chunks_exact(LANES);
+    let rest = whole.remainder();
+    for (components, group) in whole.zip(groups) {
+        for (lane, component) in components.iter().enumerate() {
+            component.synthesize_period([group.anchor_re[lane], group.anchor_im[lane]], &mut sum);
+        }
+    }
+    if let Some(group) = groups.get(components.len() / LANES) {
+        for (lane, component) in rest.iter().enumerate() {
+            component.synthesize_period([group.anchor_re[lane], group.anchor_im[lane]], &mut sum);
         }
     }
     *out = sum;

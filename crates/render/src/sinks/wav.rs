@@ -250,7 +250,7 @@ impl WavFile {
         self.written = written;
         // Counted only in a block whose peak (a vectorised maximum) passes full scale: a
         // sample-by-sample count cost four instructions a sample of every render.
-        if crate::render::block_peak(samples) > FULL_SCALE {
+        if sake_glug_engine::peak(samples) > FULL_SCALE {
             self.clipped += samples.iter().filter(|y| y.abs() > FULL_SCALE).count() as u64;
         }
         let bytes: &[u8] = match self.format {
