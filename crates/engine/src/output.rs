@@ -236,6 +236,7 @@ impl OutputStage {
     /// [`OutputStage::begin_constant_block`]): sample by sample the same operations, so a block
     /// at once gives the bits and counts of its spans one by one; a silent span (zeros) stays
     /// zeros.
+    ///
     /// Returns the block's largest |y| as written, which the pass knows without another.
     #[inline]
     pub fn apply_settled(&mut self, out: &mut [f32]) -> f32 {
